@@ -1,0 +1,167 @@
+//! Energy density, total energy and the reflected / transmitted / trapped fractions
+//! (paper Eq. 5, generalised to many resonators, exponent p and walls).
+//!
+//! ```text
+//! e_n = m_n u_n'^2/2 + [n = s_j] (eps_j v_j'^2/2 + kappa_j (u_n - v_j)^{p_j+1}/(p_j+1))
+//!       + ([u_{n-1} - u_n]_+^{5/2} + [u_n - u_{n+1}]_+^{5/2}) / 5
+//! ```
+//!
+//! Each contact's potential (2/5) d^{5/2} is split half to each neighbour. A wall contact belongs
+//! wholly to its end site, so that the sum of e_n is the conserved Hamiltonian through wall
+//! collisions.
+
+use crate::error::ModelError;
+use crate::force::{hertz_potential, odd_power};
+use crate::model::{Boundary, Model};
+
+/// A "defect region" of sites [lo, hi] (inclusive, internal 0-based numbering). Energy left of
+/// it is reflected, right of it transmitted, inside it trapped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Region {
+    lo: usize,
+    hi: usize,
+}
+
+impl Region {
+    /// A region of sites `lo..=hi` in a chain of `n_sites`.
+    pub fn new(lo: i64, hi: i64, n_sites: usize) -> Result<Self, ModelError> {
+        if lo < 0 || hi < lo || hi >= n_sites as i64 {
+            return Err(ModelError::BadRegion { lo, hi, n_sites });
+        }
+        Ok(Self { lo: lo as usize, hi: hi as usize })
+    }
+
+    /// First site of the region.
+    pub fn lo(&self) -> usize {
+        self.lo
+    }
+
+    /// Last site of the region.
+    pub fn hi(&self) -> usize {
+        self.hi
+    }
+}
+
+/// Energy fractions of one moment, normalised by the total of the density passed in.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fractions {
+    /// R: share of sites left of the region.
+    pub reflected: f64,
+    /// T: share of sites right of the region.
+    pub transmitted: f64,
+    /// E_tr: share inside the region.
+    pub trapped: f64,
+    /// The total the shares are normalised by.
+    pub total: f64,
+}
+
+impl Fractions {
+    /// Splits a per-site density into the three shares of `region`.
+    pub fn from_density(density: &[f64], region: Region) -> Self {
+        let left: f64 = density[..region.lo].iter().sum();
+        let inside: f64 = density[region.lo..=region.hi].iter().sum();
+        let right: f64 = density[region.hi + 1..].iter().sum();
+        let total = left + inside + right;
+        Self { reflected: left / total, transmitted: right / total, trapped: inside / total, total }
+    }
+}
+
+/// Energy density per site (length `n_sites`) of state `y` at time `t`, written into `density`.
+pub fn energy_density(model: &Model, t: f64, y: &[f64], density: &mut [f64]) {
+    let n_sites = model.n_sites();
+    let n_dof = model.n_dof();
+    let q = &y[..n_dof];
+    let u = &q[..n_sites];
+    kinetic_density(model, y, density);
+    for bond in 0..n_sites - 1 {
+        let half = 0.5 * hertz_potential(u[bond] - u[bond + 1]);
+        density[bond] += half;
+        density[bond + 1] += half;
+    }
+    if model.boundary() == Boundary::Fixed {
+        density[0] += hertz_potential(-u[0]);
+        density[n_sites - 1] += hertz_potential(u[n_sites - 1]);
+    }
+    for (j, r) in model.resonators().iter().enumerate() {
+        let stretch = u[r.site] - q[n_sites + j];
+        let p1 = r.p + 1;
+        density[r.site] += r.coupling.at(t) * odd_power(stretch, r.p) * stretch / f64::from(p1);
+    }
+}
+
+/// Kinetic energy per site (host and resonators together), length `n_sites`: the quantity the
+/// woodpile experiment measures (paper Section III, Fig. 2 c, f).
+pub fn kinetic_density(model: &Model, y: &[f64], density: &mut [f64]) {
+    let n_sites = model.n_sites();
+    let n_dof = model.n_dof();
+    let qdot = &y[n_dof..];
+    for (site, e) in density.iter_mut().enumerate().take(n_sites) {
+        *e = 0.5 * model.site_mass(site) * qdot[site] * qdot[site];
+    }
+    for (j, r) in model.resonators().iter().enumerate() {
+        let w = qdot[n_sites + j];
+        density[r.site] += 0.5 * r.eps * w * w;
+    }
+}
+
+/// Total energy E = sum_n e_n, computed without allocating.
+pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
+    let n_sites = model.n_sites();
+    let n_dof = model.n_dof();
+    let (q, qdot) = y.split_at(n_dof);
+    let u = &q[..n_sites];
+    let mut e = 0.0;
+    for site in 0..n_sites {
+        e += 0.5 * model.site_mass(site) * qdot[site] * qdot[site];
+    }
+    for bond in 0..n_sites - 1 {
+        e += hertz_potential(u[bond] - u[bond + 1]);
+    }
+    if model.boundary() == Boundary::Fixed {
+        e += hertz_potential(-u[0]) + hertz_potential(u[n_sites - 1]);
+    }
+    for (j, r) in model.resonators().iter().enumerate() {
+        let w = qdot[n_sites + j];
+        let stretch = u[r.site] - q[n_sites + j];
+        e += 0.5 * r.eps * w * w
+            + r.coupling.at(t) * odd_power(stretch, r.p) * stretch / f64::from(r.p + 1);
+    }
+    e
+}
+
+/// Total momentum sum m_n u_n' + sum eps_j v_j' (conserved with free ends).
+pub fn total_momentum(model: &Model, y: &[f64]) -> f64 {
+    let n_dof = model.n_dof();
+    y[n_dof..].iter().zip(model.inv_mass()).map(|(v, inv_m)| v / inv_m).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Coupling, Resonator};
+
+    #[test]
+    fn density_sums_to_total_energy() {
+        let res = vec![Resonator { site: 2, eps: 3.0, coupling: Coupling::Constant(0.8), p: 3 }];
+        let model = Model::new(5, Boundary::Fixed, res).unwrap();
+        let y = vec![-0.1, 0.2, 0.1, 0.05, 0.3, -0.2, 0.5, -1.0, 0.3, 0.2, 0.1, 0.7];
+        let mut e = vec![0.0; 5];
+        energy_density(&model, 0.0, &y, &mut e);
+        let sum: f64 = e.iter().sum();
+        assert!((sum - total_energy(&model, 0.0, &y)).abs() < 1e-14);
+        // The wall bonds: site 0 at -0.1 is pressed into the left wall, site 4 at 0.3 into the right.
+        assert!(e[0] >= hertz_potential(0.1));
+    }
+
+    #[test]
+    fn fractions_split_the_total() {
+        let region = Region::new(1, 2, 5).unwrap();
+        let f = Fractions::from_density(&[1.0, 2.0, 3.0, 4.0, 0.0], region);
+        assert_eq!(f.total, 10.0);
+        assert!((f.reflected - 0.1).abs() < 1e-15);
+        assert!((f.trapped - 0.5).abs() < 1e-15);
+        assert!((f.transmitted - 0.4).abs() < 1e-15);
+        assert!(Region::new(3, 2, 5).is_err());
+        assert!(Region::new(0, 5, 5).is_err());
+    }
+}

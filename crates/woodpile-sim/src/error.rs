@@ -1,0 +1,126 @@
+//! Error types of the simulation core. Every failure carries the numbers needed to act on it.
+
+use thiserror::Error;
+
+/// A model that cannot be simulated: raised by constructors, before any step is taken.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum ModelError {
+    /// The chain has no sites.
+    #[error("the chain needs at least one site")]
+    EmptyChain,
+    /// A site index points outside the chain.
+    #[error("{what} site index {site} is outside the chain of {n_sites} sites")]
+    SiteOutOfRange {
+        /// What the index was for ("resonator 2", "impulse").
+        what: String,
+        /// The offending index (0-based, internal numbering).
+        site: usize,
+        /// Number of sites in the chain.
+        n_sites: usize,
+    },
+    /// A parameter that must be finite and positive is not.
+    #[error("{what} must be finite and > 0, got {value}")]
+    NotPositive {
+        /// Which parameter ("resonator 0 eps", "mass of site 3").
+        what: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A parameter that must be finite and non-negative is not.
+    #[error("{what} must be finite and >= 0, got {value}")]
+    Negative {
+        /// Which parameter.
+        what: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// A parameter that must be finite is NaN or infinite.
+    #[error("{what} must be finite, got {value}")]
+    NotFinite {
+        /// Which parameter.
+        what: String,
+        /// The offending value.
+        value: f64,
+    },
+    /// An even coupling exponent p > 1 would not be a restoring force.
+    #[error("resonator {index}: coupling exponent p must be 1 or an odd integer >= 3, got {p}")]
+    BadExponent {
+        /// Resonator index.
+        index: usize,
+        /// The offending exponent.
+        p: u32,
+    },
+    /// The per-site mass list does not match the number of sites.
+    #[error("{n_masses} site masses given for a chain of {n_sites} sites")]
+    MassCount {
+        /// Number of masses given.
+        n_masses: usize,
+        /// Number of sites.
+        n_sites: usize,
+    },
+    /// A region [lo, hi] that is empty or leaves the chain.
+    #[error("fraction region [{lo}, {hi}] must satisfy 0 <= lo <= hi < {n_sites} (internal numbering)")]
+    BadRegion {
+        /// Lower site (inclusive).
+        lo: i64,
+        /// Upper site (inclusive).
+        hi: i64,
+        /// Number of sites.
+        n_sites: usize,
+    },
+}
+
+/// A run that failed. Never returned as numbers: the caller reports it and writes nothing.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum SimError {
+    /// The model or run configuration was invalid.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The state became NaN or infinite.
+    #[error("the solution became non-finite at t = {t:.6} (site index {site}); the step is unstable, reduce dt or tolerance")]
+    NonFinite {
+        /// Time of the first non-finite state seen.
+        t: f64,
+        /// First degree of freedom found non-finite (sites first, then resonators).
+        site: usize,
+    },
+    /// The total energy of a conservative run drifted beyond the allowed bound.
+    #[error("energy drift {drift:.3e} exceeds the allowed {limit:.1e} at t = {t:.6}; the integration is not accurate enough")]
+    EnergyDrift {
+        /// Time at which the drift was detected.
+        t: f64,
+        /// Relative drift |E(t) - E(0)| / E(0).
+        drift: f64,
+        /// The allowed bound.
+        limit: f64,
+    },
+    /// An adaptive method needed a step below its floor.
+    #[error("step size underflow at t = {t:.6}: dt = {dt:.3e}; the tolerance cannot be met")]
+    StepUnderflow {
+        /// Time at which the step collapsed.
+        t: f64,
+        /// The step that was too small.
+        dt: f64,
+    },
+    /// The run exceeded its step budget.
+    #[error("step budget of {max_steps} exhausted at t = {t:.6}")]
+    TooManySteps {
+        /// Time reached.
+        t: f64,
+        /// The budget.
+        max_steps: u64,
+    },
+    /// `auto` could not verify the tolerance by step halving.
+    #[error("method auto could not reach tolerance {tolerance:.1e}: estimated error still {estimate:.2e} at dt = {dt:.3e}")]
+    NotConverged {
+        /// Requested tolerance.
+        tolerance: f64,
+        /// Last Richardson error estimate.
+        estimate: f64,
+        /// Last (finest) step tried.
+        dt: f64,
+    },
+    /// A run setting (t_end, dt, tolerance, sample interval) is invalid.
+    #[error("invalid run setting: {0}")]
+    BadRun(String),
+}

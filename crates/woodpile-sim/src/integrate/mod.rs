@@ -1,0 +1,251 @@
+//! Time integration: steppers and the one driver that runs them.
+//!
+//! A method implements only [`Stepper::step`]. The [`drive`] function owns the time loop, the
+//! sample grid, failure detection (non-finite state, energy drift, step underflow, step budget)
+//! and the statistics. Observers see the state at the sample times only, between steps, so the
+//! numerics never know who is watching.
+//!
+//! Methods (see [`Method`]): RK4 (the paper's), Störmer–Verlet and its symplectic compositions
+//! of order 4 and 6, and the adaptive Dormand–Prince 8(5,3).
+
+mod dop853;
+mod method;
+mod rk;
+mod symplectic;
+
+pub use dop853::Dop853;
+pub use method::{
+    Accuracy, Method, MethodChoice, Plan, AUTO_METHOD, BLOW_UP_DRIFT, DRIFT_PER_TOL,
+};
+pub use rk::{ExplicitRk, Rk4, Tableau};
+pub use symplectic::{Composition, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6};
+
+use crate::energy::total_energy;
+use crate::error::SimError;
+use crate::model::Model;
+
+/// What a step attempt did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepOutcome {
+    /// The state was advanced by the requested `h`; `h_next` is the method's proposal.
+    Accepted {
+        /// Proposed next step.
+        h_next: f64,
+    },
+    /// The state is unchanged; retry with `h_next`.
+    Rejected {
+        /// Proposed retry step.
+        h_next: f64,
+    },
+}
+
+/// One integration method. It advances the state; everything else belongs to [`drive`].
+pub trait Stepper {
+    /// Short name, as used in scene files ("rk4", "verlet", ...).
+    fn name(&self) -> &'static str;
+
+    /// Attempts a step of size `h` from `(t, y)`, updating `y` in place when accepted.
+    fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64) -> StepOutcome;
+
+    /// Right-hand-side (force) evaluations so far.
+    fn rhs_evals(&self) -> u64;
+
+    /// An initial step for adaptive methods; fixed-step methods are never asked.
+    fn initial_step(&mut self, _model: &Model, _t: f64, _y: &[f64], t_end: f64) -> f64 {
+        t_end / 100.0
+    }
+}
+
+/// Sees the state at every sample time (including t = 0 and t_end).
+pub trait Observer {
+    /// Called between steps at sample time `t` with state `y`.
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]);
+
+    /// Forgets everything recorded: a run is being repeated (the `auto` verification ladder).
+    fn reset(&mut self);
+}
+
+impl Observer for () {
+    fn observe(&mut self, _: &Model, _: f64, _: &[f64]) {}
+    fn reset(&mut self) {}
+}
+
+impl<A: Observer, B: Observer> Observer for (A, B) {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        self.0.observe(model, t, y);
+        self.1.observe(model, t, y);
+    }
+    fn reset(&mut self) {
+        self.0.reset();
+        self.1.reset();
+    }
+}
+
+/// How step sizes are chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepControl {
+    /// Equal steps no longer than `dt`, tiling each sample interval exactly.
+    Fixed {
+        /// Largest step.
+        dt: f64,
+    },
+    /// The stepper's own error control; the driver only enforces `h_min`.
+    Adaptive {
+        /// Steps below this are a [`SimError::StepUnderflow`].
+        h_min: f64,
+    },
+}
+
+/// Everything the driver needs besides the model, stepper and state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriveConfig {
+    /// Integrate over [0, t_end].
+    pub t_end: f64,
+    /// Observers and checks run every `sample_every` (and at t_end).
+    pub sample_every: f64,
+    /// Step-size policy.
+    pub control: StepControl,
+    /// Budget of accepted plus rejected steps.
+    pub max_steps: u64,
+    /// Largest allowed relative energy drift |E(t) - E(0)|/E(0), checked at samples when the
+    /// model conserves energy; `None` disables the check.
+    pub energy_drift_limit: Option<f64>,
+}
+
+/// What a run cost and how well it kept its invariants.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps: u64,
+    /// Rejected step attempts (adaptive methods).
+    pub rejected: u64,
+    /// Right-hand-side evaluations.
+    pub rhs_evals: u64,
+    /// Largest relative energy drift seen at the samples (0 if not conservative).
+    pub max_energy_drift: f64,
+}
+
+/// Integrates `y` from t = 0 to `cfg.t_end` with `stepper`, calling `observer` at the samples.
+///
+/// Errors: a non-finite state, an energy drift beyond the limit, a step below the floor, or an
+/// exhausted budget stop the run; the state is then meaningless and must not be reported.
+pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
+    model: &Model,
+    stepper: &mut S,
+    y: &mut [f64],
+    cfg: &DriveConfig,
+    observer: &mut O,
+) -> Result<Stats, SimError> {
+    validate(cfg)?;
+    let conservative = !model.is_time_dependent();
+    let e0 = total_energy(model, 0.0, y);
+    let drift_limit = cfg.energy_drift_limit.filter(|_| conservative && e0 > 0.0);
+    let n_intervals = intervals(cfg.t_end, cfg.sample_every);
+    let mut stats = Stats::default();
+    let mut attempts: u64 = 0;
+    let mut t = 0.0;
+    let mut h = match cfg.control {
+        StepControl::Fixed { dt } => dt,
+        StepControl::Adaptive { .. } => stepper.initial_step(model, t, y, cfg.t_end),
+    };
+    check_finite(y, t)?;
+    observer.observe(model, t, y);
+
+    for k in 1..=n_intervals {
+        let target = if k == n_intervals { cfg.t_end } else { k as f64 * cfg.sample_every };
+        match cfg.control {
+            StepControl::Fixed { dt } => {
+                let span = target - t;
+                let n_steps = (span / dt - 1e-9).ceil().max(1.0) as u64;
+                let h_eq = span / n_steps as f64;
+                for i in 0..n_steps {
+                    stepper.step(model, t, y, h_eq);
+                    t = if i + 1 == n_steps { target } else { t + h_eq };
+                    stats.steps += 1;
+                    if stats.steps > cfg.max_steps {
+                        return Err(SimError::TooManySteps { t, max_steps: cfg.max_steps });
+                    }
+                    check_finite(y, t)?;
+                }
+            }
+            StepControl::Adaptive { h_min } => {
+                while t < target {
+                    let remaining = target - t;
+                    let lands = h >= remaining * (1.0 - 1e-12);
+                    let h_try = if lands { remaining } else { h };
+                    attempts += 1;
+                    if attempts > cfg.max_steps {
+                        return Err(SimError::TooManySteps { t, max_steps: cfg.max_steps });
+                    }
+                    match stepper.step(model, t, y, h_try) {
+                        StepOutcome::Accepted { h_next } => {
+                            t = if lands { target } else { t + h_try };
+                            stats.steps += 1;
+                            check_finite(y, t)?;
+                            // A step shortened to land on a sample says nothing about the
+                            // step the method could take: keep the larger proposal.
+                            h = if lands { h_next.max(h) } else { h_next };
+                        }
+                        StepOutcome::Rejected { h_next } => {
+                            stats.rejected += 1;
+                            h = h_next;
+                        }
+                    }
+                    if !(h >= h_min) {
+                        return Err(SimError::StepUnderflow { t, dt: h });
+                    }
+                }
+            }
+        }
+        if let Some(limit) = drift_limit {
+            let drift = ((total_energy(model, t, y) - e0) / e0).abs();
+            stats.max_energy_drift = stats.max_energy_drift.max(drift);
+            if !(drift <= limit) {
+                return Err(SimError::EnergyDrift { t, drift, limit });
+            }
+        } else if conservative && e0 > 0.0 {
+            let drift = ((total_energy(model, t, y) - e0) / e0).abs();
+            stats.max_energy_drift = stats.max_energy_drift.max(drift);
+        }
+        observer.observe(model, t, y);
+    }
+    stats.rhs_evals = stepper.rhs_evals();
+    Ok(stats)
+}
+
+/// Number of sample intervals covering [0, t_end]; the last may be shorter.
+pub fn intervals(t_end: f64, sample_every: f64) -> u64 {
+    ((t_end / sample_every) - 1e-9).ceil().max(1.0) as u64
+}
+
+fn validate(cfg: &DriveConfig) -> Result<(), SimError> {
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    if !positive(cfg.t_end) {
+        return Err(SimError::BadRun(format!("t_end must be finite and > 0, got {}", cfg.t_end)));
+    }
+    if !positive(cfg.sample_every) {
+        return Err(SimError::BadRun(format!(
+            "sample interval must be finite and > 0, got {}",
+            cfg.sample_every
+        )));
+    }
+    match cfg.control {
+        StepControl::Fixed { dt } if !positive(dt) => {
+            Err(SimError::BadRun(format!("dt must be finite and > 0, got {dt}")))
+        }
+        StepControl::Adaptive { h_min } if !(h_min >= 0.0) => {
+            Err(SimError::BadRun(format!("h_min must be >= 0, got {h_min}")))
+        }
+        _ => Ok(()),
+    }
+}
+
+fn check_finite(y: &[f64], t: f64) -> Result<(), SimError> {
+    // Summing first keeps the common (finite) case to one vectorisable pass.
+    if y.iter().sum::<f64>().is_finite() {
+        return Ok(());
+    }
+    let site = y.iter().position(|x| !x.is_finite()).unwrap_or(0);
+    let n_dof = y.len() / 2;
+    Err(SimError::NonFinite { t, site: site % n_dof })
+}

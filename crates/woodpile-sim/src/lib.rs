@@ -1,0 +1,30 @@
+//! The physics engine of woodpile: a Hertzian chain carrying internal resonators ("mass-with-mass"
+//! defects), its energy, and the integrators that advance it.
+//!
+//! This crate knows nothing about TOML, parquet, files, terminals or threads: it takes validated
+//! values and returns numbers or a [`SimError`]. Paper references are to *Lattices With Internal
+//! Resonator Defects* (Hauver et al.).
+//!
+//! The pieces, in the order a simulation uses them:
+//! - [`model`]: the chain, its boundary, its resonators and their coupling law (Eqs. 3, 7, 14).
+//! - [`force`]: the right-hand side, accelerations from positions.
+//! - [`energy`]: energy density, total energy, R/T/E_tr fractions (Eq. 5 generalised).
+//! - [`integrate`]: the steppers (RK4, Störmer–Verlet, symplectic compositions, DOP853) and the
+//!   single driver that owns the time loop, sampling and failure detection.
+//! - [`observe`]: sampled time series of the fractions and the space-time velocity field.
+//! - [`run`]: "simulate a scene, return its fractions" as one function.
+//! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
+#![warn(missing_docs)]
+
+pub mod energy;
+mod error;
+pub mod force;
+pub mod integrate;
+pub mod model;
+pub mod observe;
+pub mod run;
+pub mod testing;
+pub mod units;
+
+pub use error::{ModelError, SimError};
+pub use model::{Boundary, Coupling, Model, Resonator};

@@ -1,0 +1,315 @@
+//! The chain and its resonators: paper Eq. 3 (one linear resonator), Eq. 7 (nonlinear coupling
+//! exponent p), Eq. 14 (time-dependent coupling kappa(t)), with per-site masses for the
+//! dimensional woodpile of Section III.
+//!
+//! Dimensionless equations of motion (sites n = 0..n_sites, internal 0-based numbering):
+//!
+//! ```text
+//! m_n u_n'' = [u_{n-1} - u_n]_+^{3/2} - [u_n - u_{n+1}]_+^{3/2} - sum_j kappa_j(t) (u_j - v_j)^{p_j} delta_{n s_j}
+//! eps_j v_j'' = kappa_j(t) (u_{s_j} - v_j)^{p_j}
+//! ```
+//!
+//! The state vector is flat: `y = [q, q']` with `q = [u_0 .. u_{S-1}, v_0 .. v_{R-1}]`, so that
+//! `n_dof = S + R` and `y.len() = 2 n_dof`. Contacts push, never pull (`[x]_+ = max(x, 0)`).
+
+use crate::error::ModelError;
+
+/// What lies beyond the two end sites.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Boundary {
+    /// Immovable walls at u_{-1} = u_{S} = 0 (the paper's "zero boundary conditions"): an end
+    /// site pushing outwards compresses a Hertzian contact with the wall.
+    Fixed,
+    /// Free ends: the end sites have a single neighbour.
+    Free,
+}
+
+/// The resonator coupling strength kappa, constant or switched on by a tanh ramp.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Coupling {
+    /// kappa(t) = kappa.
+    Constant(f64),
+    /// kappa(t) = k1 + (k2 - k1) (1 + tanh((t - t0)/tau)) / 2 (paper Eq. 14).
+    Ramp {
+        /// Value long before t0.
+        k1: f64,
+        /// Value long after t0.
+        k2: f64,
+        /// Centre of the ramp.
+        t0: f64,
+        /// Width of the ramp (> 0).
+        tau: f64,
+    },
+}
+
+impl Coupling {
+    /// kappa at time `t`.
+    #[inline]
+    pub fn at(&self, t: f64) -> f64 {
+        match *self {
+            Coupling::Constant(k) => k,
+            Coupling::Ramp { k1, k2, t0, tau } => {
+                k1 + (k2 - k1) * 0.5 * (1.0 + ((t - t0) / tau).tanh())
+            }
+        }
+    }
+
+    /// Whether kappa depends on time (the energy is then not conserved).
+    pub fn is_time_dependent(&self) -> bool {
+        matches!(self, Coupling::Ramp { k1, k2, .. } if k1 != k2)
+    }
+
+    /// The largest value kappa takes over all times.
+    pub fn max_value(&self) -> f64 {
+        match *self {
+            Coupling::Constant(k) => k,
+            Coupling::Ramp { k1, k2, .. } => k1.max(k2),
+        }
+    }
+}
+
+/// One internal resonator: a mass `eps` attached to site `site` by the force
+/// `kappa(t) (u_site - v)^p`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resonator {
+    /// Host site (0-based internal index).
+    pub site: usize,
+    /// Mass ratio eps = m / M (Eq. 4), > 0.
+    pub eps: f64,
+    /// Coupling strength kappa(t) >= 0.
+    pub coupling: Coupling,
+    /// Coupling exponent: 1 (linear) or odd >= 3 (nonlinear, Section IV.B).
+    pub p: u32,
+}
+
+impl Resonator {
+    /// Linear angular frequency of the host (mass `host_mass`) and resonator pair vibrating
+    /// against each other: omega^2 = kappa (1/m + 1/eps), at the largest kappa the coupling takes.
+    /// For p > 1 this is the frequency at unit stretch, a scale rather than a constant.
+    pub fn linear_omega(&self, host_mass: f64) -> f64 {
+        (self.coupling.max_value() * (1.0 / host_mass + 1.0 / self.eps)).sqrt()
+    }
+}
+
+/// A validated chain with its resonators. Construct with [`Model::new`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    n_sites: usize,
+    boundary: Boundary,
+    resonators: Vec<Resonator>,
+    /// Per-site masses; `None` means all unit masses (the dimensionless scenes), which lets the
+    /// force loop skip a multiply per site.
+    site_masses: Option<Vec<f64>>,
+    /// 1/mass for every degree of freedom (sites then resonators).
+    inv_mass: Vec<f64>,
+}
+
+impl Model {
+    /// A chain of `n_sites` unit masses with the given boundary and resonators.
+    pub fn new(
+        n_sites: usize,
+        boundary: Boundary,
+        resonators: Vec<Resonator>,
+    ) -> Result<Self, ModelError> {
+        Self::with_masses(n_sites, boundary, resonators, None)
+    }
+
+    /// A chain with explicit per-site masses (dimensionless, relative to the reference mass of
+    /// the rescaling; see [`crate::units`]).
+    pub fn with_masses(
+        n_sites: usize,
+        boundary: Boundary,
+        resonators: Vec<Resonator>,
+        site_masses: Option<Vec<f64>>,
+    ) -> Result<Self, ModelError> {
+        if n_sites == 0 {
+            return Err(ModelError::EmptyChain);
+        }
+        for (index, r) in resonators.iter().enumerate() {
+            validate_resonator(index, r, n_sites)?;
+        }
+        if let Some(masses) = &site_masses {
+            if masses.len() != n_sites {
+                return Err(ModelError::MassCount { n_masses: masses.len(), n_sites });
+            }
+            for (site, &m) in masses.iter().enumerate() {
+                positive(&format!("mass of site {site}"), m)?;
+            }
+        }
+        let site_masses = site_masses.filter(|m| m.iter().any(|&x| x != 1.0));
+        let mut inv_mass: Vec<f64> = match &site_masses {
+            Some(m) => m.iter().map(|x| 1.0 / x).collect(),
+            None => vec![1.0; n_sites],
+        };
+        inv_mass.extend(resonators.iter().map(|r| 1.0 / r.eps));
+        Ok(Self { n_sites, boundary, resonators, site_masses, inv_mass })
+    }
+
+    /// Number of chain sites S.
+    pub fn n_sites(&self) -> usize {
+        self.n_sites
+    }
+
+    /// Number of degrees of freedom S + R (positions only).
+    pub fn n_dof(&self) -> usize {
+        self.n_sites + self.resonators.len()
+    }
+
+    /// Length of the flat state vector `[q, q']`.
+    pub fn state_len(&self) -> usize {
+        2 * self.n_dof()
+    }
+
+    /// The boundary condition.
+    pub fn boundary(&self) -> Boundary {
+        self.boundary
+    }
+
+    /// The resonators, in the order their coordinates follow the sites in the state.
+    pub fn resonators(&self) -> &[Resonator] {
+        &self.resonators
+    }
+
+    /// Mass of site `site` (1 unless per-site masses were given).
+    pub fn site_mass(&self, site: usize) -> f64 {
+        self.site_masses.as_ref().map_or(1.0, |m| m[site])
+    }
+
+    /// 1/mass per degree of freedom; `None` when every site mass is 1 (resonator masses apply
+    /// regardless).
+    pub(crate) fn site_masses(&self) -> Option<&[f64]> {
+        self.site_masses.as_deref()
+    }
+
+    /// 1/mass for every degree of freedom (sites then resonators).
+    pub fn inv_mass(&self) -> &[f64] {
+        &self.inv_mass
+    }
+
+    /// Whether any coupling depends on time (energy then is not conserved).
+    pub fn is_time_dependent(&self) -> bool {
+        self.resonators.iter().any(|r| r.coupling.is_time_dependent())
+    }
+
+    /// The fastest linear resonator frequency omega = sqrt(kappa (1/m + 1/eps)): the stiffness
+    /// scale that bounds explicit steps (dt * omega must stay below a method's stability limit).
+    pub fn max_linear_omega(&self) -> f64 {
+        self.resonators
+            .iter()
+            .map(|r| r.linear_omega(self.site_mass(r.site)))
+            .fold(0.0, f64::max)
+    }
+
+    /// A state vector at rest: all displacements and velocities zero.
+    pub fn rest_state(&self) -> Vec<f64> {
+        vec![0.0; self.state_len()]
+    }
+
+    /// Gives site `site` the velocity `velocity` (the striker impulse of Eq. 2).
+    pub fn apply_impulse(&self, y: &mut [f64], site: usize, velocity: f64) -> Result<(), ModelError> {
+        if site >= self.n_sites {
+            return Err(ModelError::SiteOutOfRange {
+                what: "impulse".into(),
+                site,
+                n_sites: self.n_sites,
+            });
+        }
+        finite("impulse velocity", velocity)?;
+        y[self.n_dof() + site] = velocity;
+        Ok(())
+    }
+}
+
+fn validate_resonator(index: usize, r: &Resonator, n_sites: usize) -> Result<(), ModelError> {
+    if r.site >= n_sites {
+        return Err(ModelError::SiteOutOfRange {
+            what: format!("resonator {index}"),
+            site: r.site,
+            n_sites,
+        });
+    }
+    positive(&format!("resonator {index} eps"), r.eps)?;
+    if !(r.p == 1 || (r.p >= 3 && r.p % 2 == 1)) {
+        return Err(ModelError::BadExponent { index, p: r.p });
+    }
+    match r.coupling {
+        Coupling::Constant(k) => non_negative(&format!("resonator {index} kappa"), k)?,
+        Coupling::Ramp { k1, k2, t0, tau } => {
+            non_negative(&format!("resonator {index} kappa.k1"), k1)?;
+            non_negative(&format!("resonator {index} kappa.k2"), k2)?;
+            finite(&format!("resonator {index} kappa.t0"), t0)?;
+            positive(&format!("resonator {index} kappa.tau"), tau)?;
+        }
+    }
+    Ok(())
+}
+
+fn finite(what: &str, value: f64) -> Result<(), ModelError> {
+    if value.is_finite() {
+        Ok(())
+    } else {
+        Err(ModelError::NotFinite { what: what.into(), value })
+    }
+}
+
+fn positive(what: &str, value: f64) -> Result<(), ModelError> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        Err(ModelError::NotPositive { what: what.into(), value })
+    }
+}
+
+fn non_negative(what: &str, value: f64) -> Result<(), ModelError> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(())
+    } else {
+        Err(ModelError::Negative { what: what.into(), value })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn res(site: usize, eps: f64, p: u32) -> Resonator {
+        Resonator { site, eps, coupling: Coupling::Constant(1.0), p }
+    }
+
+    #[test]
+    fn rejects_bad_resonators() {
+        assert!(matches!(
+            Model::new(5, Boundary::Fixed, vec![res(5, 1.0, 1)]),
+            Err(ModelError::SiteOutOfRange { site: 5, .. })
+        ));
+        assert!(matches!(
+            Model::new(5, Boundary::Fixed, vec![res(0, 0.0, 1)]),
+            Err(ModelError::NotPositive { .. })
+        ));
+        assert!(matches!(
+            Model::new(5, Boundary::Fixed, vec![res(0, 1.0, 4)]),
+            Err(ModelError::BadExponent { p: 4, .. })
+        ));
+        assert!(matches!(
+            Model::new(5, Boundary::Fixed, vec![res(0, 1.0, 0)]),
+            Err(ModelError::BadExponent { p: 0, .. })
+        ));
+        assert!(Model::new(5, Boundary::Fixed, vec![res(0, 1.0, 19)]).is_ok());
+    }
+
+    #[test]
+    fn ramp_interpolates_between_k1_and_k2() {
+        let c = Coupling::Ramp { k1: 0.0, k2: 2.5, t0: 40.0, tau: 0.1 };
+        assert!(c.at(0.0).abs() < 1e-12);
+        assert!((c.at(40.0) - 1.25).abs() < 1e-12);
+        assert!((c.at(100.0) - 2.5).abs() < 1e-12);
+        assert!(c.is_time_dependent());
+        assert!(!Coupling::Constant(1.0).is_time_dependent());
+    }
+
+    #[test]
+    fn unit_masses_are_not_stored() {
+        let m = Model::with_masses(3, Boundary::Free, vec![], Some(vec![1.0; 3])).unwrap();
+        assert!(m.site_masses().is_none());
+    }
+}

@@ -1,0 +1,160 @@
+//! Observers: what a run records at its sample times, kept out of the numerics.
+//!
+//! - [`FractionSeries`]: R, T, E_tr and E as time series, so that a different read-out time is a
+//!   re-reduction rather than a re-simulation.
+//! - [`KineticSeries`]: kinetic-energy fractions normalised by the impact energy, as the woodpile
+//!   experiment measures them (paper Fig. 2 c, f).
+//! - [`SpaceTimeField`]: a decimated site-by-time velocity map (paper Figs. 3, 8, 10).
+
+use crate::energy::{energy_density, kinetic_density, Fractions, Region};
+use crate::integrate::Observer;
+use crate::model::Model;
+
+/// Energy fractions of one region at every sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FractionSeries {
+    region: Region,
+    density: Vec<f64>,
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// R(t), normalised by E(t).
+    pub reflected: Vec<f64>,
+    /// T(t), normalised by E(t).
+    pub transmitted: Vec<f64>,
+    /// E_tr(t), normalised by E(t).
+    pub trapped: Vec<f64>,
+    /// Total energy E(t).
+    pub energy: Vec<f64>,
+}
+
+impl FractionSeries {
+    /// An empty series for `region` of `model`.
+    pub fn new(model: &Model, region: Region) -> Self {
+        Self {
+            region,
+            density: vec![0.0; model.n_sites()],
+            t: Vec::new(),
+            reflected: Vec::new(),
+            transmitted: Vec::new(),
+            trapped: Vec::new(),
+            energy: Vec::new(),
+        }
+    }
+}
+
+impl Observer for FractionSeries {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        energy_density(model, t, y, &mut self.density);
+        let f = Fractions::from_density(&self.density, self.region);
+        self.t.push(t);
+        self.reflected.push(f.reflected);
+        self.transmitted.push(f.transmitted);
+        self.trapped.push(f.trapped);
+        self.energy.push(f.total);
+    }
+
+    fn reset(&mut self) {
+        for v in [&mut self.t, &mut self.reflected, &mut self.transmitted, &mut self.trapped, &mut self.energy] {
+            v.clear();
+        }
+    }
+}
+
+/// Kinetic-energy fractions of one region at every sample, normalised by a fixed energy (the
+/// impact energy), so that they need not sum to one: kinetic energy is not conserved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KineticSeries {
+    region: Region,
+    normalisation: f64,
+    density: Vec<f64>,
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// Kinetic energy left of the region / normalisation.
+    pub reflected: Vec<f64>,
+    /// Kinetic energy right of the region / normalisation.
+    pub transmitted: Vec<f64>,
+    /// Kinetic energy inside the region / normalisation.
+    pub trapped: Vec<f64>,
+}
+
+impl KineticSeries {
+    /// An empty series for `region`, dividing by `normalisation` (> 0).
+    pub fn new(model: &Model, region: Region, normalisation: f64) -> Self {
+        Self {
+            region,
+            normalisation,
+            density: vec![0.0; model.n_sites()],
+            t: Vec::new(),
+            reflected: Vec::new(),
+            transmitted: Vec::new(),
+            trapped: Vec::new(),
+        }
+    }
+}
+
+impl Observer for KineticSeries {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        kinetic_density(model, y, &mut self.density);
+        let f = Fractions::from_density(&self.density, self.region);
+        let scale = f.total / self.normalisation;
+        self.t.push(t);
+        self.reflected.push(f.reflected * scale);
+        self.transmitted.push(f.transmitted * scale);
+        self.trapped.push(f.trapped * scale);
+    }
+
+    fn reset(&mut self) {
+        for v in [&mut self.t, &mut self.reflected, &mut self.transmitted, &mut self.trapped] {
+            v.clear();
+        }
+    }
+}
+
+/// Site velocities u_n'(t) on a decimated grid: every `time_stride`-th sample and every
+/// `site_stride`-th site. Stored as f32: a picture needs no more, and the file stays small.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpaceTimeField {
+    time_stride: usize,
+    site_stride: usize,
+    seen: usize,
+    /// Sample times kept.
+    pub t: Vec<f64>,
+    /// Internal indices of the sites kept.
+    pub sites: Vec<usize>,
+    /// Velocities, row-major: `velocity[i * sites.len() + k]` is site `sites[k]` at `t[i]`.
+    pub velocity: Vec<f32>,
+}
+
+impl SpaceTimeField {
+    /// A field keeping every `time_stride`-th sample and every `site_stride`-th site (both >= 1).
+    pub fn new(model: &Model, time_stride: usize, site_stride: usize) -> Self {
+        let site_stride = site_stride.max(1);
+        Self {
+            time_stride: time_stride.max(1),
+            site_stride,
+            seen: 0,
+            t: Vec::new(),
+            sites: (0..model.n_sites()).step_by(site_stride).collect(),
+            velocity: Vec::new(),
+        }
+    }
+}
+
+impl Observer for SpaceTimeField {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        let keep = self.seen % self.time_stride == 0;
+        self.seen += 1;
+        if !keep {
+            return;
+        }
+        let velocities = &y[model.n_dof()..];
+        self.t.push(t);
+        self.velocity.extend(self.sites.iter().map(|&s| velocities[s] as f32));
+    }
+
+    fn reset(&mut self) {
+        self.seen = 0;
+        self.t.clear();
+        self.velocity.clear();
+    }
+}

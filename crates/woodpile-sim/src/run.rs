@@ -1,0 +1,150 @@
+//! "Simulate a scene, return its energy fractions" as one function: every caller (the CLI's
+//! `simulate`, every pipeline sweep, the tests) goes through [`simulate`].
+//!
+//! `method = "auto"` is verified, not trusted: it runs the calibrated step `dt` and its double
+//! `2 dt`, estimates the finer run's error by Richardson's rule for the observed order 2.5,
+//! |F(dt) - F(2 dt)| / (2^2.5 - 1), and accepts when that estimate is at most half the tolerance;
+//! otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
+//! without a stiffness model having to foresee them.
+
+use crate::energy::{energy_density, Fractions, Region};
+use crate::error::SimError;
+use crate::integrate::{
+    Accuracy, MethodChoice, Observer, Plan, Stats, BLOW_UP_DRIFT, DRIFT_PER_TOL,
+};
+use crate::model::Model;
+
+/// Halvings `auto` tries before giving up.
+const MAX_HALVINGS: u32 = 6;
+
+/// Richardson denominator 2^q - 1 for the observed order q = 2.5 of the fixed-step methods on
+/// Hertzian chains (see `integrate::method`).
+const RICHARDSON: f64 = 4.656_854_249_492_38;
+
+/// A fully specified, validated simulation: model, initial impulse, horizon, region, method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// The chain and its resonators.
+    pub model: Model,
+    /// Site given the initial velocity (internal index).
+    pub impulse_site: usize,
+    /// The initial velocity V of that site.
+    pub impulse_velocity: f64,
+    /// Integrate over [0, t_end].
+    pub t_end: f64,
+    /// Region whose energy counts as trapped.
+    pub region: Region,
+    /// Requested method.
+    pub method: MethodChoice,
+    /// Requested accuracy.
+    pub accuracy: Accuracy,
+    /// Observers and checks run this often.
+    pub sample_every: f64,
+}
+
+/// What a successful run produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// Fractions at t_end, normalised by E(t_end).
+    pub fractions: Fractions,
+    /// E(0).
+    pub e_initial: f64,
+    /// E(t_end).
+    pub e_final: f64,
+    /// The resolved method and step control of the reported run.
+    pub plan: Plan,
+    /// Cost and invariants of the reported run.
+    pub stats: Stats,
+    /// Cost of every run made, including `auto`'s verification runs.
+    pub total_rhs_evals: u64,
+    /// For `auto`: the Richardson estimate of the reported run's error, the largest change of
+    /// R, T or E_tr between it and the run at twice its step divided by 2^2.5 - 1.
+    pub error_estimate: Option<f64>,
+    /// The state at t_end (`[q, q']`).
+    pub final_state: Vec<f64>,
+}
+
+/// Runs `scenario`, showing every sample of the reported run to `observer`.
+pub fn simulate<O: Observer + ?Sized>(
+    scenario: &Scenario,
+    observer: &mut O,
+) -> Result<Outcome, SimError> {
+    let plan = Plan::choose(&scenario.model, scenario.method, scenario.accuracy)?;
+    match scenario.method {
+        MethodChoice::Named(_) => run_plan(scenario, &plan, observer),
+        MethodChoice::Auto => verified(scenario, plan, observer),
+    }
+}
+
+fn verified<O: Observer + ?Sized>(
+    scenario: &Scenario,
+    plan: Plan,
+    observer: &mut O,
+) -> Result<Outcome, SimError> {
+    let tol = scenario.accuracy.tolerance;
+    // Verification runs only guard against blow-up; the accepted run must also keep energy.
+    let guarded = Plan { drift_limit: BLOW_UP_DRIFT, ..plan };
+    let mut dt = plan.dt().unwrap_or(0.01);
+    let mut spent = 0;
+    let mut coarse = match run_plan(scenario, &guarded.with_dt(2.0 * dt), &mut ()) {
+        Ok(out) => {
+            spent += out.stats.rhs_evals;
+            Some(out)
+        }
+        Err(SimError::NonFinite { .. } | SimError::EnergyDrift { .. }) => None,
+        Err(e) => return Err(e),
+    };
+    let mut estimate = f64::INFINITY;
+    for _ in 0..=MAX_HALVINGS {
+        observer.reset();
+        let fine = run_plan(scenario, &guarded.with_dt(dt), observer)?;
+        spent += fine.stats.rhs_evals;
+        estimate = coarse
+            .as_ref()
+            .map_or(f64::INFINITY, |c| largest_change(&c.fractions, &fine.fractions) / RICHARDSON);
+        let drift_ok = fine.stats.max_energy_drift <= (DRIFT_PER_TOL * tol).max(1e-12);
+        if estimate <= 0.5 * tol && drift_ok {
+            return Ok(Outcome {
+                plan: Plan { drift_limit: plan.drift_limit, ..fine.plan },
+                total_rhs_evals: spent,
+                error_estimate: Some(estimate),
+                ..fine
+            });
+        }
+        coarse = Some(fine);
+        dt *= 0.5;
+    }
+    Err(SimError::NotConverged { tolerance: tol, estimate, dt: 2.0 * dt })
+}
+
+fn largest_change(a: &Fractions, b: &Fractions) -> f64 {
+    (a.reflected - b.reflected)
+        .abs()
+        .max((a.transmitted - b.transmitted).abs())
+        .max((a.trapped - b.trapped).abs())
+}
+
+fn run_plan<O: Observer + ?Sized>(
+    scenario: &Scenario,
+    plan: &Plan,
+    observer: &mut O,
+) -> Result<Outcome, SimError> {
+    let model: &Model = &scenario.model;
+    let mut y = model.rest_state();
+    model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)?;
+    let e_initial = crate::energy::total_energy(model, 0.0, &y);
+    let stats = plan.run(model, &mut y, scenario.t_end, scenario.sample_every, observer)?;
+    let mut density = vec![0.0; model.n_sites()];
+    energy_density(model, scenario.t_end, &y, &mut density);
+    let fractions = Fractions::from_density(&density, scenario.region);
+    Ok(Outcome {
+        fractions,
+        e_initial,
+        e_final: fractions.total,
+        plan: *plan,
+        stats,
+        total_rhs_evals: stats.rhs_evals,
+        error_estimate: None,
+        final_state: y,
+    })
+}

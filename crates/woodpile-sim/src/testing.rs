@@ -1,0 +1,99 @@
+//! Known-answer cases and scene builders shared by tests and benchmarks.
+//!
+//! The known answers are exact: a host–resonator pair is a linear oscillator with
+//! omega^2 = kappa (1/m + 1/eps); a head-on Hertz collision of two equal free beads exchanges
+//! their velocities and conserves energy and momentum.
+
+use crate::energy::Region;
+use crate::integrate::{Accuracy, MethodChoice};
+use crate::model::{Boundary, Coupling, Model, Resonator};
+use crate::run::Scenario;
+
+/// Half-width N of the paper's chains (sites -N..N).
+pub const PAPER_N: usize = 100;
+/// The paper's impact site n_S in Sections IV–V.
+pub const PAPER_IMPULSE_SITE: i64 = -25;
+
+/// Internal index of paper site `n` in a chain of sites -half_width..half_width.
+pub fn paper_site(n: i64, half_width: usize) -> usize {
+    (n + half_width as i64) as usize
+}
+
+/// One site carrying one linear resonator, free ends: a two-body linear oscillator. The state
+/// starts with the resonator displaced by `x0` and everything at rest. Returns the model, the
+/// state, and the angular frequency of the relative coordinate u - v.
+pub fn linear_oscillator(eps: f64, kappa: f64, x0: f64) -> (Model, Vec<f64>, f64) {
+    let res = vec![Resonator { site: 0, eps, coupling: Coupling::Constant(kappa), p: 1 }];
+    let model = Model::new(1, Boundary::Free, res).expect("valid oscillator");
+    let mut y = model.rest_state();
+    y[1] = x0;
+    let omega = (kappa * (1.0 + 1.0 / eps)).sqrt();
+    (model, y, omega)
+}
+
+/// Two equal free beads, the first moving at velocity 1 towards the second at rest.
+pub fn two_bead_collision() -> (Model, Vec<f64>) {
+    let model = Model::new(2, Boundary::Free, vec![]).expect("valid chain");
+    let mut y = model.rest_state();
+    y[2] = 1.0;
+    (model, y)
+}
+
+/// A defect of the paper's dimensionless scenes, in paper numbering.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PaperDefect {
+    /// Paper site n.
+    pub site: i64,
+    /// Mass ratio.
+    pub eps: f64,
+    /// Coupling.
+    pub coupling: Coupling,
+    /// Exponent.
+    pub p: u32,
+}
+
+impl PaperDefect {
+    /// A linear defect with constant kappa.
+    pub fn linear(site: i64, eps: f64, kappa: f64) -> Self {
+        Self { site, eps, coupling: Coupling::Constant(kappa), p: 1 }
+    }
+}
+
+/// The paper's standard scene: N = 100, fixed walls, n_S = -25, V = 1, t_end = 150, region
+/// [min defect - 1, max defect + 1], with the given method and accuracy.
+pub fn paper_scene(defects: &[PaperDefect], method: MethodChoice, accuracy: Accuracy) -> Scenario {
+    let n_sites = 2 * PAPER_N + 1;
+    let resonators = defects
+        .iter()
+        .map(|d| Resonator { site: paper_site(d.site, PAPER_N), eps: d.eps, coupling: d.coupling, p: d.p })
+        .collect();
+    let model = Model::new(n_sites, Boundary::Fixed, resonators).expect("valid paper scene");
+    let lo = defects.iter().map(|d| d.site).min().unwrap_or(0) - 1;
+    let hi = defects.iter().map(|d| d.site).max().unwrap_or(0) + 1;
+    let region = Region::new(
+        paper_site(lo, PAPER_N) as i64,
+        paper_site(hi, PAPER_N) as i64,
+        n_sites,
+    )
+    .expect("region inside the chain");
+    Scenario {
+        model,
+        impulse_site: paper_site(PAPER_IMPULSE_SITE, PAPER_N),
+        impulse_velocity: 1.0,
+        t_end: 150.0,
+        region,
+        method,
+        accuracy,
+        sample_every: 1.0,
+    }
+}
+
+/// Accuracy by tolerance alone.
+pub fn tolerance(tol: f64) -> Accuracy {
+    Accuracy { tolerance: tol, tolerance_explicit: true, dt: None }
+}
+
+/// Accuracy by a fixed step alone (drift bound: blow-up guard only).
+pub fn fixed_dt(dt: f64) -> Accuracy {
+    Accuracy { tolerance: 1e-8, tolerance_explicit: false, dt: Some(dt) }
+}
