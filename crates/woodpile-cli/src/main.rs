@@ -34,12 +34,18 @@ pub(crate) struct Failure {
 impl Failure {
     /// Bad input: exit code 2.
     pub(crate) fn input(error: impl Into<anyhow::Error>) -> Self {
-        Self { code: 2, error: error.into() }
+        Self {
+            code: 2,
+            error: error.into(),
+        }
     }
 
     /// The computation failed: exit code 3.
     pub(crate) fn simulation(error: impl Into<anyhow::Error>) -> Self {
-        Self { code: 3, error: error.into() }
+        Self {
+            code: 3,
+            error: error.into(),
+        }
     }
 }
 

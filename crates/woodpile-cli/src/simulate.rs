@@ -29,7 +29,11 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         .map_err(Failure::simulation)?;
     let wall_s = started.elapsed().as_secs_f64();
     let report = report(&scene, &outcome, wall_s);
-    let text = if args.pretty { serde_json::to_string_pretty(&report) } else { serde_json::to_string(&report) };
+    let text = if args.pretty {
+        serde_json::to_string_pretty(&report)
+    } else {
+        serde_json::to_string(&report)
+    };
     println!("{}", text.map_err(Failure::simulation)?);
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! `woodpile simulate` through the real binary: the SPEC §3 contract and its error cases
 //! (issue 2: unknown key, eps <= 0, even p > 1, defect or impulse off the chain, t_end <= 0,
 //! non-finite value, unreadable file).
+#![allow(clippy::unwrap_used)]
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -20,26 +21,44 @@ fn scene_file(text: &str) -> PathBuf {
 
 fn simulate(text: &str) -> (Output, PathBuf) {
     let path = scene_file(text);
-    let out = Command::new(env!("CARGO_BIN_EXE_woodpile")).arg("simulate").arg(&path).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .arg("simulate")
+        .arg(&path)
+        .output()
+        .unwrap();
     (out, path)
 }
 
 fn json_number(stdout: &str, key: &str) -> f64 {
     let v: serde_json::Value = serde_json::from_str(stdout).unwrap();
-    v[key].as_f64().unwrap_or_else(|| panic!("{key} missing in {stdout}"))
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key} missing in {stdout}"))
 }
 
 /// The reference "single" scene (eps = 3) through the binary with method auto at 1e-8: R, T and
 /// E_tr within 1e-7 of the independent reference, and every contract key present.
 #[test]
 fn simulate_prints_the_contract_json() {
-    let (out, _) = simulate("[[defect]]\nsite = 0\neps = 3.0\n\n[run]\nmethod = \"auto\"\ntolerance = 1e-8\n");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (out, _) =
+        simulate("[[defect]]\nsite = 0\neps = 3.0\n\n[run]\nmethod = \"auto\"\ntolerance = 1e-8\n");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert_eq!(stdout.lines().count(), 1, "one JSON object on one line");
-    for (key, reference) in [("R", 0.22497244831703267), ("T", 0.748225253767974), ("E_tr", 0.026802297914993292)] {
+    for (key, reference) in [
+        ("R", 0.22497244831703267),
+        ("T", 0.748225253767974),
+        ("E_tr", 0.026802297914993292),
+    ] {
         let got = json_number(&stdout, key);
-        assert!((got - reference).abs() < 1e-7, "{key}: {got} vs {reference}");
+        assert!(
+            (got - reference).abs() < 1e-7,
+            "{key}: {got} vs {reference}"
+        );
     }
     assert_eq!(json_number(&stdout, "E_initial"), 0.5);
     assert!((json_number(&stdout, "E_final") - 0.5).abs() < 1e-6);
@@ -53,8 +72,14 @@ fn simulate_prints_the_contract_json() {
 /// A named fixed-step method with dt runs exactly that method.
 #[test]
 fn named_method_with_dt() {
-    let (out, _) = simulate("[[defect]]\nsite = 0\neps = 3.0\n[run]\nmethod = \"yoshida6\"\ndt = 0.01\nt_end = 20.0\n");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (out, _) = simulate(
+        "[[defect]]\nsite = 0\neps = 3.0\n[run]\nmethod = \"yoshida6\"\ndt = 0.01\nt_end = 20.0\n",
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let stdout = String::from_utf8(out.stdout).unwrap();
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(v["method"], "yoshida6");
@@ -66,7 +91,11 @@ fn named_method_with_dt() {
 fn physical_scene_reports_derived_parameters() {
     let text = "[chain]\nn = 20\nboundary = \"free\"\n[impulse]\nsite = -19\n[physical]\ncontact = 2.47e9\nmass = 0.866e-3\nvelocity = 1.98\n[[defect]]\nsite = 0\nmass = 0.838e-3\nresonator_mass = 0.894e-3\nstiffness = 3.961e6\n[run]\nt_end = 30.0\nmethod = \"rk4\"\ndt = 0.01\n";
     let (out, _) = simulate(text);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let d = &v["physical"]["defects"][0];
     assert!((d["eps"].as_f64().unwrap() - 0.894 / 0.866).abs() < 1e-12);
@@ -82,19 +111,51 @@ fn bad_scenes_exit_nonzero_with_a_clear_message() {
         ("[chain]\nn = 100\nfoo = 1\n", "foo", "unknown field"),
         ("[[defect]]\nsite = 0\neps = 0.0\n", "defect[0].eps", "> 0"),
         ("[[defect]]\nsite = 0\neps = -2.0\n", "defect[0].eps", "> 0"),
-        ("[[defect]]\nsite = 0\neps = 1.0\np = 4\n", "defect[0].p", "odd"),
-        ("[[defect]]\nsite = 101\neps = 1.0\n", "defect[0].site", "off the chain"),
+        (
+            "[[defect]]\nsite = 0\neps = 1.0\np = 4\n",
+            "defect[0].p",
+            "odd",
+        ),
+        (
+            "[[defect]]\nsite = 101\neps = 1.0\n",
+            "defect[0].site",
+            "off the chain",
+        ),
         ("[impulse]\nsite = -150\n", "impulse.site", "off the chain"),
         ("[run]\nt_end = 0.0\n", "run.t_end", "> 0"),
         ("[run]\nt_end = -5.0\n", "run.t_end", "> 0"),
-        ("[[defect]]\nsite = 0\neps = nan\n", "defect[0].eps", "finite"),
-        ("[[defect]]\nsite = 0\neps = 1.0\nkappa = inf\n", "defect[0].kappa", "finite"),
+        (
+            "[[defect]]\nsite = 0\neps = nan\n",
+            "defect[0].eps",
+            "finite",
+        ),
+        (
+            "[[defect]]\nsite = 0\neps = 1.0\nkappa = inf\n",
+            "defect[0].kappa",
+            "finite",
+        ),
         ("[impulse]\nvelocity = inf\n", "impulse.velocity", "finite"),
-        ("[run]\nmethod = \"euler\"\n", "run.method", "unknown method"),
-        ("[[defect]]\nsite = 0\neps = 1.0\nkappa = { k1 = 0.0, k2 = 1.0, t0 = 1.0 }\n", "defect[0].kappa.tau", "required"),
-        ("[fractions]\nregion = [3, 1]\n", "fractions.region", "greater"),
+        (
+            "[run]\nmethod = \"euler\"\n",
+            "run.method",
+            "unknown method",
+        ),
+        (
+            "[[defect]]\nsite = 0\neps = 1.0\nkappa = { k1 = 0.0, k2 = 1.0, t0 = 1.0 }\n",
+            "defect[0].kappa.tau",
+            "required",
+        ),
+        (
+            "[fractions]\nregion = [3, 1]\n",
+            "fractions.region",
+            "greater",
+        ),
         ("[[defect]]\neps = 1.0\n", "defect[0].site", "required"),
-        ("[chain]\nboundary = \"periodic\"\n", "chain.boundary", "fixed"),
+        (
+            "[chain]\nboundary = \"periodic\"\n",
+            "chain.boundary",
+            "fixed",
+        ),
         ("[[defect]\nsite = 0\n", "line 1", "TOML parse error"),
     ];
     for (text, key, reason) in cases {
@@ -104,7 +165,10 @@ fn bad_scenes_exit_nonzero_with_a_clear_message() {
         assert!(out.stdout.is_empty(), "{text:?}: printed a result");
         let file = path.display().to_string();
         for needle in [file.as_str(), key, reason] {
-            assert!(stderr.contains(needle), "{text:?}: {stderr:?} lacks {needle:?}");
+            assert!(
+                stderr.contains(needle),
+                "{text:?}: {stderr:?} lacks {needle:?}"
+            );
         }
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
@@ -118,15 +182,28 @@ fn unreadable_file_exits_nonzero() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("/nonexistent/scene.toml") && stderr.contains("cannot read"), "{stderr}");
+    assert!(
+        stderr.contains("/nonexistent/scene.toml") && stderr.contains("cannot read"),
+        "{stderr}"
+    );
 }
 
 /// A run that blows up is reported as a failure (exit 3), never as numbers.
 #[test]
 fn blow_up_exits_3_without_numbers() {
-    let (out, _) = simulate("[[defect]]\nsite = 0\neps = 0.001\n[run]\nmethod = \"rk4\"\ndt = 0.9\nt_end = 60.0\n");
-    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    let (out, _) = simulate(
+        "[[defect]]\nsite = 0\neps = 0.001\n[run]\nmethod = \"rk4\"\ndt = 0.9\nt_end = 60.0\n",
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(out.stdout.is_empty());
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("simulation failed") && stderr.contains("t = "), "{stderr}");
+    assert!(
+        stderr.contains("simulation failed") && stderr.contains("t = "),
+        "{stderr}"
+    );
 }

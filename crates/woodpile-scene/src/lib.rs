@@ -46,8 +46,10 @@ pub enum SceneError {
 
 /// Reads and validates the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::Read { file: path.to_path_buf(), reason: e.to_string() })?;
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+        file: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
     parse(&text, path)
 }
 

@@ -85,10 +85,16 @@ fn non_negative(key: &str, x: f64) -> Result<f64, Invalid> {
 }
 
 pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
-    let chain = file.chain.unwrap_or(raw::Chain { n: None, boundary: None });
+    let chain = file.chain.unwrap_or(raw::Chain {
+        n: None,
+        boundary: None,
+    });
     let n = chain.n.unwrap_or(DEFAULT_N);
     if !(1..=MAX_N).contains(&n) {
-        return Err(invalid("chain.n", format!("must be an integer in 1..={MAX_N}, got {n}")));
+        return Err(invalid(
+            "chain.n",
+            format!("must be an integer in 1..={MAX_N}, got {n}"),
+        ));
     }
     let half_width = n as usize;
     let n_sites = 2 * half_width + 1;
@@ -96,14 +102,23 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         "fixed" => Boundary::Fixed,
         "free" => Boundary::Free,
         other => {
-            return Err(invalid("chain.boundary", format!("must be \"fixed\" or \"free\", got \"{other}\"")))
+            return Err(invalid(
+                "chain.boundary",
+                format!("must be \"fixed\" or \"free\", got \"{other}\""),
+            ))
         }
     };
     let on_chain = |key: &str, site: i64| -> Result<usize, Invalid> {
         if (-n..=n).contains(&site) {
             Ok((site + n) as usize)
         } else {
-            Err(invalid(key, format!("site {site} is off the chain (sites run from {} to {n})", -n)))
+            Err(invalid(
+                key,
+                format!(
+                    "site {site} is off the chain (sites run from {} to {n})",
+                    -n
+                ),
+            ))
         }
     };
 
@@ -128,7 +143,10 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         let site = on_chain(&key("site"), site_paper)?;
         let p = d.p.unwrap_or(1);
         if !(p == 1 || (p >= 3 && p % 2 == 1 && p <= 99)) {
-            return Err(invalid(key("p"), format!("must be 1 or an odd integer from 3 to 99, got {p}")));
+            return Err(invalid(
+                key("p"),
+                format!("must be 1 or an odd integer from 3 to 99, got {p}"),
+            ));
         }
         let p = p as u32;
         let (eps, coupling) = match scales {
@@ -140,10 +158,16 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
                         _ => d.stiffness.is_some(),
                     };
                     if given {
-                        return Err(invalid(key(k), "is only allowed in a scene with a [physical] table"));
+                        return Err(invalid(
+                            key(k),
+                            "is only allowed in a scene with a [physical] table",
+                        ));
                     }
                 }
-                let eps = positive(&key("eps"), d.eps.ok_or_else(|| invalid(key("eps"), "is required"))?)?;
+                let eps = positive(
+                    &key("eps"),
+                    d.eps.ok_or_else(|| invalid(key("eps"), "is required"))?,
+                )?;
                 let coupling = match &d.kappa {
                     None => Coupling::Constant(1.0),
                     Some(v) => coupling(&key("kappa"), v)?,
@@ -159,60 +183,123 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
                         ));
                     }
                 }
-                let m = positive(&key("resonator_mass"), d.resonator_mass.ok_or_else(|| invalid(key("resonator_mass"), "is required in a [physical] scene"))?)?;
-                let k = non_negative(&key("stiffness"), d.stiffness.ok_or_else(|| invalid(key("stiffness"), "is required in a [physical] scene"))?)?;
+                let m = positive(
+                    &key("resonator_mass"),
+                    d.resonator_mass.ok_or_else(|| {
+                        invalid(key("resonator_mass"), "is required in a [physical] scene")
+                    })?,
+                )?;
+                let k = non_negative(
+                    &key("stiffness"),
+                    d.stiffness.ok_or_else(|| {
+                        invalid(key("stiffness"), "is required in a [physical] scene")
+                    })?,
+                )?;
                 let host = positive(&key("mass"), d.mass.unwrap_or(sc.mass_kg))?;
                 masses[site] = sc.mass_ratio(host);
                 let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, p));
-                derived.push(DerivedDefect { site: site_paper, host_mass_ratio: masses[site], eps, kappa });
+                derived.push(DerivedDefect {
+                    site: site_paper,
+                    host_mass_ratio: masses[site],
+                    eps,
+                    kappa,
+                });
                 (eps, Coupling::Constant(kappa))
             }
         };
-        resonators.push(Resonator { site, eps, coupling, p });
+        resonators.push(Resonator {
+            site,
+            eps,
+            coupling,
+            p,
+        });
     }
     let model = Model::with_masses(n_sites, boundary, resonators, Some(masses))
         .map_err(|e| invalid("defect", e.to_string()))?;
 
-    let impulse = file.impulse.unwrap_or(raw::Impulse { site: None, velocity: None });
+    let impulse = file.impulse.unwrap_or(raw::Impulse {
+        site: None,
+        velocity: None,
+    });
     let impulse_site = on_chain("impulse.site", impulse.site.unwrap_or(DEFAULT_IMPULSE_SITE))?;
     let impulse_velocity = match (impulse.velocity, scales) {
         (Some(_), Some(_)) => {
-            return Err(invalid("impulse.velocity", "is physical.velocity in a [physical] scene"));
+            return Err(invalid(
+                "impulse.velocity",
+                "is physical.velocity in a [physical] scene",
+            ));
         }
         (Some(v), None) => finite("impulse.velocity", v)?,
         (None, _) => 1.0,
     };
 
-    let run = file.run.unwrap_or(raw::Run { t_end: None, method: None, tolerance: None, dt: None, sample_every: None });
+    let run = file.run.unwrap_or(raw::Run {
+        t_end: None,
+        method: None,
+        tolerance: None,
+        dt: None,
+        sample_every: None,
+    });
     let t_end = positive("run.t_end", run.t_end.unwrap_or(DEFAULT_T_END))?;
     let method = match run.method.as_deref().unwrap_or("auto") {
         "auto" => MethodChoice::Auto,
         name => MethodChoice::Named(Method::from_name(name).ok_or_else(|| {
             let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            invalid("run.method", format!("unknown method \"{name}\"; expected \"auto\" or one of {}", names.join(", ")))
+            invalid(
+                "run.method",
+                format!(
+                    "unknown method \"{name}\"; expected \"auto\" or one of {}",
+                    names.join(", ")
+                ),
+            )
         })?),
     };
     let tolerance = positive("run.tolerance", run.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
     let dt = run.dt.map(|dt| positive("run.dt", dt)).transpose()?;
     if let Some(dt) = dt {
         match method {
-            MethodChoice::Auto => return Err(invalid("run.dt", "needs a fixed-step method; \"auto\" chooses its own step from run.tolerance")),
-            MethodChoice::Named(m) if m.is_adaptive() => {
-                return Err(invalid("run.dt", format!("method \"{}\" is adaptive and takes run.tolerance, not dt", m.name())))
+            MethodChoice::Auto => {
+                return Err(invalid(
+                    "run.dt",
+                    "needs a fixed-step method; \"auto\" chooses its own step from run.tolerance",
+                ))
             }
-            _ if dt > t_end => return Err(invalid("run.dt", format!("{dt} is longer than run.t_end = {t_end}"))),
+            MethodChoice::Named(m) if m.is_adaptive() => {
+                return Err(invalid(
+                    "run.dt",
+                    format!(
+                        "method \"{}\" is adaptive and takes run.tolerance, not dt",
+                        m.name()
+                    ),
+                ))
+            }
+            _ if dt > t_end => {
+                return Err(invalid(
+                    "run.dt",
+                    format!("{dt} is longer than run.t_end = {t_end}"),
+                ))
+            }
             _ => {}
         }
     }
-    let sample_every = positive("run.sample_every", run.sample_every.unwrap_or(DEFAULT_SAMPLE_EVERY))?;
+    let sample_every = positive(
+        "run.sample_every",
+        run.sample_every.unwrap_or(DEFAULT_SAMPLE_EVERY),
+    )?;
 
     let region_paper = match file.fractions.and_then(|f| f.region) {
         Some(r) => {
             let [lo, hi] = r[..] else {
-                return Err(invalid("fractions.region", format!("must be [lo, hi], got {} values", r.len())));
+                return Err(invalid(
+                    "fractions.region",
+                    format!("must be [lo, hi], got {} values", r.len()),
+                ));
             };
             if lo > hi {
-                return Err(invalid("fractions.region", format!("lo = {lo} is greater than hi = {hi}")));
+                return Err(invalid(
+                    "fractions.region",
+                    format!("lo = {lo} is greater than hi = {hi}"),
+                ));
             }
             [lo, hi]
         }
@@ -220,7 +307,8 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     };
     let lo = on_chain("fractions.region", region_paper[0])?;
     let hi = on_chain("fractions.region", region_paper[1])?;
-    let region = Region::new(lo as i64, hi as i64, n_sites).map_err(|e| invalid("fractions.region", e.to_string()))?;
+    let region = Region::new(lo as i64, hi as i64, n_sites)
+        .map_err(|e| invalid("fractions.region", e.to_string()))?;
 
     let scenario = Scenario {
         model,
@@ -229,11 +317,23 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         t_end,
         region,
         method,
-        accuracy: Accuracy { tolerance, tolerance_explicit: run.tolerance.is_some(), dt },
+        accuracy: Accuracy {
+            tolerance,
+            tolerance_explicit: run.tolerance.is_some(),
+            dt,
+        },
         sample_every,
     };
-    let physical = scales.map(|scales| Physical { scales, defects: derived });
-    Ok(Scene { scenario, half_width, region_paper, physical })
+    let physical = scales.map(|scales| Physical {
+        scales,
+        defects: derived,
+    });
+    Ok(Scene {
+        scenario,
+        half_width,
+        region_paper,
+        physical,
+    })
 }
 
 /// SPEC §1: the region spans the defects and one neighbour on each side, [min - 1, max + 1]
@@ -251,19 +351,27 @@ fn coupling(key: &str, value: &toml::Value) -> Result<Coupling, Invalid> {
         match v {
             toml::Value::Float(x) => Ok(*x),
             toml::Value::Integer(i) => Ok(*i as f64),
-            other => Err(invalid(k, format!("must be a number, got {}", other.type_str()))),
+            other => Err(invalid(
+                k,
+                format!("must be a number, got {}", other.type_str()),
+            )),
         }
     };
     match value {
         toml::Value::Table(t) => {
             for k in t.keys() {
                 if !["k1", "k2", "t0", "tau"].contains(&k.as_str()) {
-                    return Err(invalid(format!("{key}.{k}"), "unknown key; a ramp has k1, k2, t0, tau"));
+                    return Err(invalid(
+                        format!("{key}.{k}"),
+                        "unknown key; a ramp has k1, k2, t0, tau",
+                    ));
                 }
             }
             let get = |k: &str| -> Result<f64, Invalid> {
                 let full = format!("{key}.{k}");
-                let v = t.get(k).ok_or_else(|| invalid(&full, "is required in a ramp { k1, k2, t0, tau }"))?;
+                let v = t
+                    .get(k)
+                    .ok_or_else(|| invalid(&full, "is required in a ramp { k1, k2, t0, tau }"))?;
                 number(&full, v)
             };
             Ok(Coupling::Ramp {

@@ -28,7 +28,10 @@ impl Region {
         if lo < 0 || hi < lo || hi >= n_sites as i64 {
             return Err(ModelError::BadRegion { lo, hi, n_sites });
         }
-        Ok(Self { lo: lo as usize, hi: hi as usize })
+        Ok(Self {
+            lo: lo as usize,
+            hi: hi as usize,
+        })
     }
 
     /// First site of the region.
@@ -62,7 +65,12 @@ impl Fractions {
         let inside: f64 = density[region.lo..=region.hi].iter().sum();
         let right: f64 = density[region.hi + 1..].iter().sum();
         let total = left + inside + right;
-        Self { reflected: left / total, transmitted: right / total, trapped: inside / total, total }
+        Self {
+            reflected: left / total,
+            transmitted: right / total,
+            trapped: inside / total,
+            total,
+        }
     }
 }
 
@@ -111,8 +119,8 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
     let (q, qdot) = y.split_at(n_dof);
     let u = &q[..n_sites];
     let mut e = 0.0;
-    for site in 0..n_sites {
-        e += 0.5 * model.site_mass(site) * qdot[site] * qdot[site];
+    for (site, w) in qdot[..n_sites].iter().enumerate() {
+        e += 0.5 * model.site_mass(site) * w * w;
     }
     for bond in 0..n_sites - 1 {
         e += hertz_potential(u[bond] - u[bond + 1]);
@@ -132,7 +140,11 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
 /// Total momentum sum m_n u_n' + sum eps_j v_j' (conserved with free ends).
 pub fn total_momentum(model: &Model, y: &[f64]) -> f64 {
     let n_dof = model.n_dof();
-    y[n_dof..].iter().zip(model.inv_mass()).map(|(v, inv_m)| v / inv_m).sum()
+    y[n_dof..]
+        .iter()
+        .zip(model.inv_mass())
+        .map(|(v, inv_m)| v / inv_m)
+        .sum()
 }
 
 #[cfg(test)]
@@ -142,9 +154,16 @@ mod tests {
 
     #[test]
     fn density_sums_to_total_energy() {
-        let res = vec![Resonator { site: 2, eps: 3.0, coupling: Coupling::Constant(0.8), p: 3 }];
+        let res = vec![Resonator {
+            site: 2,
+            eps: 3.0,
+            coupling: Coupling::Constant(0.8),
+            p: 3,
+        }];
         let model = Model::new(5, Boundary::Fixed, res).unwrap();
-        let y = vec![-0.1, 0.2, 0.1, 0.05, 0.3, -0.2, 0.5, -1.0, 0.3, 0.2, 0.1, 0.7];
+        let y = vec![
+            -0.1, 0.2, 0.1, 0.05, 0.3, -0.2, 0.5, -1.0, 0.3, 0.2, 0.1, 0.7,
+        ];
         let mut e = vec![0.0; 5];
         energy_density(&model, 0.0, &y, &mut e);
         let sum: f64 = e.iter().sum();

@@ -59,7 +59,9 @@ pub enum ModelError {
         n_sites: usize,
     },
     /// A region [lo, hi] that is empty or leaves the chain.
-    #[error("fraction region [{lo}, {hi}] must satisfy 0 <= lo <= hi < {n_sites} (internal numbering)")]
+    #[error(
+        "fraction region [{lo}, {hi}] must satisfy 0 <= lo <= hi < {n_sites} (internal numbering)"
+    )]
     BadRegion {
         /// Lower site (inclusive).
         lo: i64,

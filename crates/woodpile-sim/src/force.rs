@@ -91,8 +91,18 @@ mod tests {
     #[test]
     fn force_is_minus_gradient_of_potential() {
         let res = vec![
-            Resonator { site: 1, eps: 0.7, coupling: Coupling::Constant(1.3), p: 1 },
-            Resonator { site: 2, eps: 2.0, coupling: Coupling::Constant(0.4), p: 3 },
+            Resonator {
+                site: 1,
+                eps: 0.7,
+                coupling: Coupling::Constant(1.3),
+                p: 1,
+            },
+            Resonator {
+                site: 2,
+                eps: 2.0,
+                coupling: Coupling::Constant(0.4),
+                p: 3,
+            },
         ];
         let masses = Some(vec![1.0, 2.0, 0.5, 1.5]);
         let model = Model::with_masses(4, Boundary::Fixed, res, masses).unwrap();
@@ -109,7 +119,11 @@ mod tests {
             let down = crate::energy::total_energy(&model, 0.0, &y);
             let force = -(up - down) / (2.0 * h);
             let mass = 1.0 / model.inv_mass()[i];
-            assert!((force - mass * acc[i]).abs() < 1e-8, "dof {i}: {force} vs {}", mass * acc[i]);
+            assert!(
+                (force - mass * acc[i]).abs() < 1e-8,
+                "dof {i}: {force} vs {}",
+                mass * acc[i]
+            );
         }
     }
 

@@ -130,7 +130,10 @@ impl Model {
         }
         if let Some(masses) = &site_masses {
             if masses.len() != n_sites {
-                return Err(ModelError::MassCount { n_masses: masses.len(), n_sites });
+                return Err(ModelError::MassCount {
+                    n_masses: masses.len(),
+                    n_sites,
+                });
             }
             for (site, &m) in masses.iter().enumerate() {
                 positive(&format!("mass of site {site}"), m)?;
@@ -142,7 +145,13 @@ impl Model {
             None => vec![1.0; n_sites],
         };
         inv_mass.extend(resonators.iter().map(|r| 1.0 / r.eps));
-        Ok(Self { n_sites, boundary, resonators, site_masses, inv_mass })
+        Ok(Self {
+            n_sites,
+            boundary,
+            resonators,
+            site_masses,
+            inv_mass,
+        })
     }
 
     /// Number of chain sites S.
@@ -188,7 +197,9 @@ impl Model {
 
     /// Whether any coupling depends on time (energy then is not conserved).
     pub fn is_time_dependent(&self) -> bool {
-        self.resonators.iter().any(|r| r.coupling.is_time_dependent())
+        self.resonators
+            .iter()
+            .any(|r| r.coupling.is_time_dependent())
     }
 
     /// The fastest linear resonator frequency omega = sqrt(kappa (1/m + 1/eps)): the stiffness
@@ -206,7 +217,12 @@ impl Model {
     }
 
     /// Gives site `site` the velocity `velocity` (the striker impulse of Eq. 2).
-    pub fn apply_impulse(&self, y: &mut [f64], site: usize, velocity: f64) -> Result<(), ModelError> {
+    pub fn apply_impulse(
+        &self,
+        y: &mut [f64],
+        site: usize,
+        velocity: f64,
+    ) -> Result<(), ModelError> {
         if site >= self.n_sites {
             return Err(ModelError::SiteOutOfRange {
                 what: "impulse".into(),
@@ -248,7 +264,10 @@ fn finite(what: &str, value: f64) -> Result<(), ModelError> {
     if value.is_finite() {
         Ok(())
     } else {
-        Err(ModelError::NotFinite { what: what.into(), value })
+        Err(ModelError::NotFinite {
+            what: what.into(),
+            value,
+        })
     }
 }
 
@@ -256,7 +275,10 @@ fn positive(what: &str, value: f64) -> Result<(), ModelError> {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(ModelError::NotPositive { what: what.into(), value })
+        Err(ModelError::NotPositive {
+            what: what.into(),
+            value,
+        })
     }
 }
 
@@ -264,7 +286,10 @@ fn non_negative(what: &str, value: f64) -> Result<(), ModelError> {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(ModelError::Negative { what: what.into(), value })
+        Err(ModelError::Negative {
+            what: what.into(),
+            value,
+        })
     }
 }
 
@@ -273,7 +298,12 @@ mod tests {
     use super::*;
 
     fn res(site: usize, eps: f64, p: u32) -> Resonator {
-        Resonator { site, eps, coupling: Coupling::Constant(1.0), p }
+        Resonator {
+            site,
+            eps,
+            coupling: Coupling::Constant(1.0),
+            p,
+        }
     }
 
     #[test]
@@ -299,7 +329,12 @@ mod tests {
 
     #[test]
     fn ramp_interpolates_between_k1_and_k2() {
-        let c = Coupling::Ramp { k1: 0.0, k2: 2.5, t0: 40.0, tau: 0.1 };
+        let c = Coupling::Ramp {
+            k1: 0.0,
+            k2: 2.5,
+            t0: 40.0,
+            tau: 0.1,
+        };
         assert!(c.at(0.0).abs() < 1e-12);
         assert!((c.at(40.0) - 1.25).abs() < 1e-12);
         assert!((c.at(100.0) - 2.5).abs() < 1e-12);

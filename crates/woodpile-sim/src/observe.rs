@@ -54,7 +54,13 @@ impl Observer for FractionSeries {
     }
 
     fn reset(&mut self) {
-        for v in [&mut self.t, &mut self.reflected, &mut self.transmitted, &mut self.trapped, &mut self.energy] {
+        for v in [
+            &mut self.t,
+            &mut self.reflected,
+            &mut self.transmitted,
+            &mut self.trapped,
+            &mut self.energy,
+        ] {
             v.clear();
         }
     }
@@ -104,7 +110,12 @@ impl Observer for KineticSeries {
     }
 
     fn reset(&mut self) {
-        for v in [&mut self.t, &mut self.reflected, &mut self.transmitted, &mut self.trapped] {
+        for v in [
+            &mut self.t,
+            &mut self.reflected,
+            &mut self.transmitted,
+            &mut self.trapped,
+        ] {
             v.clear();
         }
     }
@@ -149,7 +160,8 @@ impl Observer for SpaceTimeField {
         }
         let velocities = &y[model.n_dof()..];
         self.t.push(t);
-        self.velocity.extend(self.sites.iter().map(|&s| velocities[s] as f32));
+        self.velocity
+            .extend(self.sites.iter().map(|&s| velocities[s] as f32));
     }
 
     fn reset(&mut self) {

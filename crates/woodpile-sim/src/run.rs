@@ -83,7 +83,10 @@ fn verified<O: Observer + ?Sized>(
 ) -> Result<Outcome, SimError> {
     let tol = scenario.accuracy.tolerance;
     // Verification runs only guard against blow-up; the accepted run must also keep energy.
-    let guarded = Plan { drift_limit: BLOW_UP_DRIFT, ..plan };
+    let guarded = Plan {
+        drift_limit: BLOW_UP_DRIFT,
+        ..plan
+    };
     let mut dt = plan.dt().unwrap_or(0.01);
     let mut spent = 0;
     let mut coarse = match run_plan(scenario, &guarded.with_dt(2.0 * dt), &mut ()) {
@@ -99,13 +102,16 @@ fn verified<O: Observer + ?Sized>(
         observer.reset();
         let fine = run_plan(scenario, &guarded.with_dt(dt), observer)?;
         spent += fine.stats.rhs_evals;
-        estimate = coarse
-            .as_ref()
-            .map_or(f64::INFINITY, |c| largest_change(&c.fractions, &fine.fractions) / RICHARDSON);
+        estimate = coarse.as_ref().map_or(f64::INFINITY, |c| {
+            largest_change(&c.fractions, &fine.fractions) / RICHARDSON
+        });
         let drift_ok = fine.stats.max_energy_drift <= (DRIFT_PER_TOL * tol).max(1e-12);
         if estimate <= 0.5 * tol && drift_ok {
             return Ok(Outcome {
-                plan: Plan { drift_limit: plan.drift_limit, ..fine.plan },
+                plan: Plan {
+                    drift_limit: plan.drift_limit,
+                    ..fine.plan
+                },
                 total_rhs_evals: spent,
                 error_estimate: Some(estimate),
                 ..fine
@@ -114,7 +120,11 @@ fn verified<O: Observer + ?Sized>(
         coarse = Some(fine);
         dt *= 0.5;
     }
-    Err(SimError::NotConverged { tolerance: tol, estimate, dt: 2.0 * dt })
+    Err(SimError::NotConverged {
+        tolerance: tol,
+        estimate,
+        dt: 2.0 * dt,
+    })
 }
 
 fn largest_change(a: &Fractions, b: &Fractions) -> f64 {
@@ -133,7 +143,13 @@ fn run_plan<O: Observer + ?Sized>(
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)?;
     let e_initial = crate::energy::total_energy(model, 0.0, &y);
-    let stats = plan.run(model, &mut y, scenario.t_end, scenario.sample_every, observer)?;
+    let stats = plan.run(
+        model,
+        &mut y,
+        scenario.t_end,
+        scenario.sample_every,
+        observer,
+    )?;
     let mut density = vec![0.0; model.n_sites()];
     energy_density(model, scenario.t_end, &y, &mut density);
     let fractions = Fractions::from_density(&density, scenario.region);

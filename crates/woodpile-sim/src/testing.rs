@@ -23,7 +23,12 @@ pub fn paper_site(n: i64, half_width: usize) -> usize {
 /// starts with the resonator displaced by `x0` and everything at rest. Returns the model, the
 /// state, and the angular frequency of the relative coordinate u - v.
 pub fn linear_oscillator(eps: f64, kappa: f64, x0: f64) -> (Model, Vec<f64>, f64) {
-    let res = vec![Resonator { site: 0, eps, coupling: Coupling::Constant(kappa), p: 1 }];
+    let res = vec![Resonator {
+        site: 0,
+        eps,
+        coupling: Coupling::Constant(kappa),
+        p: 1,
+    }];
     let model = Model::new(1, Boundary::Free, res).expect("valid oscillator");
     let mut y = model.rest_state();
     y[1] = x0;
@@ -55,7 +60,12 @@ pub struct PaperDefect {
 impl PaperDefect {
     /// A linear defect with constant kappa.
     pub fn linear(site: i64, eps: f64, kappa: f64) -> Self {
-        Self { site, eps, coupling: Coupling::Constant(kappa), p: 1 }
+        Self {
+            site,
+            eps,
+            coupling: Coupling::Constant(kappa),
+            p: 1,
+        }
     }
 }
 
@@ -65,7 +75,12 @@ pub fn paper_scene(defects: &[PaperDefect], method: MethodChoice, accuracy: Accu
     let n_sites = 2 * PAPER_N + 1;
     let resonators = defects
         .iter()
-        .map(|d| Resonator { site: paper_site(d.site, PAPER_N), eps: d.eps, coupling: d.coupling, p: d.p })
+        .map(|d| Resonator {
+            site: paper_site(d.site, PAPER_N),
+            eps: d.eps,
+            coupling: d.coupling,
+            p: d.p,
+        })
         .collect();
     let model = Model::new(n_sites, Boundary::Fixed, resonators).expect("valid paper scene");
     let lo = defects.iter().map(|d| d.site).min().unwrap_or(0) - 1;
@@ -90,10 +105,18 @@ pub fn paper_scene(defects: &[PaperDefect], method: MethodChoice, accuracy: Accu
 
 /// Accuracy by tolerance alone.
 pub fn tolerance(tol: f64) -> Accuracy {
-    Accuracy { tolerance: tol, tolerance_explicit: true, dt: None }
+    Accuracy {
+        tolerance: tol,
+        tolerance_explicit: true,
+        dt: None,
+    }
 }
 
 /// Accuracy by a fixed step alone (drift bound: blow-up guard only).
 pub fn fixed_dt(dt: f64) -> Accuracy {
-    Accuracy { tolerance: 1e-8, tolerance_explicit: false, dt: Some(dt) }
+    Accuracy {
+        tolerance: 1e-8,
+        tolerance_explicit: false,
+        dt: Some(dt),
+    }
 }

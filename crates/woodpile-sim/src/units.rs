@@ -27,12 +27,23 @@ pub struct Scales {
 impl Scales {
     /// Validated scales: all three must be finite and > 0.
     pub fn new(mass_kg: f64, hertz: f64, velocity: f64) -> Result<Self, ModelError> {
-        for (what, value) in [("mass", mass_kg), ("contact constant a", hertz), ("velocity", velocity)] {
+        for (what, value) in [
+            ("mass", mass_kg),
+            ("contact constant a", hertz),
+            ("velocity", velocity),
+        ] {
             if !(value.is_finite() && value > 0.0) {
-                return Err(ModelError::NotPositive { what: format!("physical {what}"), value });
+                return Err(ModelError::NotPositive {
+                    what: format!("physical {what}"),
+                    value,
+                });
             }
         }
-        Ok(Self { mass_kg, hertz, velocity })
+        Ok(Self {
+            mass_kg,
+            hertz,
+            velocity,
+        })
     }
 
     /// Length scale L = (M V^2 / a)^{2/5} in metres.

@@ -4,6 +4,7 @@
 //! closes, so the velocity's local error on a step containing that instant is O(h^{5/2}) for any
 //! method built on polynomials. Measured orders are therefore about 2.5 for RK4 and the order-4
 //! and order-6 compositions, and 2 for Verlet, which is what these tests assert.
+#![allow(clippy::unwrap_used)]
 
 use woodpile_sim::energy::{energy_density, Fractions, Region};
 use woodpile_sim::integrate::{
@@ -16,7 +17,12 @@ use woodpile_sim::SimError;
 /// A short chain (sites -20..20), defect eps = 3 at 0, impulse at -8, t in [0, 40]: the wave
 /// crosses the defect and splits, with every kind of contact event, in a test-sized run.
 fn short_scene() -> (Model, Vec<f64>, Region) {
-    let res = vec![Resonator { site: 20, eps: 3.0, coupling: Coupling::Constant(1.0), p: 1 }];
+    let res = vec![Resonator {
+        site: 20,
+        eps: 3.0,
+        coupling: Coupling::Constant(1.0),
+        p: 1,
+    }];
     let model = Model::new(41, Boundary::Fixed, res).unwrap();
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, 12, 1.0).unwrap();
@@ -38,7 +44,13 @@ fn run(stepper: &mut dyn Stepper, control: StepControl) -> (f64, f64) {
 
 fn run_state(stepper: &mut dyn Stepper, control: StepControl) -> (f64, f64, Vec<f64>) {
     let (model, mut y, region) = short_scene();
-    let cfg = DriveConfig { t_end: T_END, sample_every: 1.0, control, max_steps: 10_000_000, energy_drift_limit: None };
+    let cfg = DriveConfig {
+        t_end: T_END,
+        sample_every: 1.0,
+        control,
+        max_steps: 10_000_000,
+        energy_drift_limit: None,
+    };
     let stats = drive(&model, stepper, &mut y, &cfg, &mut ()).unwrap();
     (trapped(&model, &y, region), stats.max_energy_drift, y)
 }
@@ -56,7 +68,11 @@ fn stepper(method: Method, model: &Model) -> Box<dyn Stepper> {
 /// The tight reference: Yoshida-6 at dt = 5e-4 (its own error, judged by halving, is < 1e-11).
 fn reference() -> f64 {
     let (model, ..) = short_scene();
-    run(stepper(Method::Yoshida6, &model).as_mut(), StepControl::Fixed { dt: 5e-4 }).0
+    run(
+        stepper(Method::Yoshida6, &model).as_mut(),
+        StepControl::Fixed { dt: 5e-4 },
+    )
+    .0
 }
 
 fn slope(dts: &[f64], errs: &[f64]) -> f64 {
@@ -64,7 +80,10 @@ fn slope(dts: &[f64], errs: &[f64]) -> f64 {
     let xs: Vec<f64> = dts.iter().map(|d| d.ln()).collect();
     let ys: Vec<f64> = errs.iter().map(|e| e.ln()).collect();
     let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
-    xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
+    xs.iter()
+        .zip(&ys)
+        .map(|(x, y)| (x - mx) * (y - my))
+        .sum::<f64>()
         / xs.iter().map(|x| (x - mx) * (x - mx)).sum::<f64>()
 }
 
@@ -75,19 +94,35 @@ fn slope(dts: &[f64], errs: &[f64]) -> f64 {
 #[test]
 fn convergence_orders_on_the_hertz_chain() {
     let (model, ..) = short_scene();
-    let reference = run_state(stepper(Method::Yoshida6, &model).as_mut(), StepControl::Fixed { dt: 5e-4 }).2;
+    let reference = run_state(
+        stepper(Method::Yoshida6, &model).as_mut(),
+        StepControl::Fixed { dt: 5e-4 },
+    )
+    .2;
     let dts = [0.08, 0.04, 0.02, 0.01];
-    for (method, lo, hi) in [(Method::Verlet, 1.8, 2.3), (Method::Rk4, 2.0, 3.2), (Method::Yoshida4, 2.0, 3.2), (Method::Yoshida6, 2.0, 3.2)] {
+    for (method, lo, hi) in [
+        (Method::Verlet, 1.8, 2.3),
+        (Method::Rk4, 2.0, 3.2),
+        (Method::Yoshida4, 2.0, 3.2),
+        (Method::Yoshida6, 2.0, 3.2),
+    ] {
         let errs: Vec<f64> = dts
             .iter()
             .map(|&dt| {
                 let y = run_state(stepper(method, &model).as_mut(), StepControl::Fixed { dt }).2;
-                y.iter().zip(&reference).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max)
+                y.iter()
+                    .zip(&reference)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max)
             })
             .collect();
         let p = slope(&dts, &errs);
         eprintln!("{}: measured order {p:.2} (errors {errs:?})", method.name());
-        assert!(p > lo && p < hi, "{}: order {p:.2} outside [{lo}, {hi}]; errors {errs:?}", method.name());
+        assert!(
+            p > lo && p < hi,
+            "{}: order {p:.2} outside [{lo}, {hi}]; errors {errs:?}",
+            method.name()
+        );
     }
 }
 
@@ -101,11 +136,18 @@ fn every_method_agrees_with_the_reference_at_tight_settings() {
         let control = if method.is_adaptive() {
             StepControl::Adaptive { h_min: 1e-13 }
         } else {
-            StepControl::Fixed { dt: if method == Method::Verlet { 2e-4 } else { 2e-3 } }
+            StepControl::Fixed {
+                dt: if method == Method::Verlet { 2e-4 } else { 2e-3 },
+            }
         };
         let e = run(stepper(method, &model).as_mut(), control).0;
         let bound = if method == Method::Verlet { 1e-8 } else { 1e-9 };
-        assert!((e - reference).abs() < bound, "{}: {:.3e}", method.name(), (e - reference).abs());
+        assert!(
+            (e - reference).abs() < bound,
+            "{}: {:.3e}",
+            method.name(),
+            (e - reference).abs()
+        );
     }
 }
 
@@ -114,43 +156,114 @@ fn every_method_agrees_with_the_reference_at_tight_settings() {
 #[test]
 fn energy_is_conserved_within_stated_bounds() {
     let (model, ..) = short_scene();
-    for (method, bound) in [(Method::Rk4, 1e-6), (Method::Verlet, 1e-4), (Method::Yoshida4, 1e-5), (Method::Yoshida6, 1e-6)] {
-        let (_, drift) = run(stepper(method, &model).as_mut(), StepControl::Fixed { dt: 0.01 });
-        assert!(drift < bound && drift > 0.0, "{}: drift {drift:.3e}", method.name());
+    for (method, bound) in [
+        (Method::Rk4, 1e-6),
+        (Method::Verlet, 1e-4),
+        (Method::Yoshida4, 1e-5),
+        (Method::Yoshida6, 1e-6),
+    ] {
+        let (_, drift) = run(
+            stepper(method, &model).as_mut(),
+            StepControl::Fixed { dt: 0.01 },
+        );
+        assert!(
+            drift < bound && drift > 0.0,
+            "{}: drift {drift:.3e}",
+            method.name()
+        );
     }
     let (model, y0, _) = short_scene();
     let drift_until = |t_end: f64| {
         let mut y = y0.clone();
-        let cfg = DriveConfig { t_end, sample_every: 1.0, control: StepControl::Fixed { dt: 0.02 }, max_steps: 10_000_000, energy_drift_limit: None };
-        drive(&model, &mut SymplecticStepper::new(&model, VERLET), &mut y, &cfg, &mut ()).unwrap().max_energy_drift
+        let cfg = DriveConfig {
+            t_end,
+            sample_every: 1.0,
+            control: StepControl::Fixed { dt: 0.02 },
+            max_steps: 10_000_000,
+            energy_drift_limit: None,
+        };
+        drive(
+            &model,
+            &mut SymplecticStepper::new(&model, VERLET),
+            &mut y,
+            &cfg,
+            &mut (),
+        )
+        .unwrap()
+        .max_energy_drift
     };
     let (short, long) = (drift_until(200.0), drift_until(400.0));
-    assert!(long < 1.5 * short, "Verlet drift grows: {short:.3e} -> {long:.3e}");
+    assert!(
+        long < 1.5 * short,
+        "Verlet drift grows: {short:.3e} -> {long:.3e}"
+    );
 }
 
 /// Failures are errors, never numbers: a step far beyond stability is reported with its time.
 #[test]
 fn blow_up_is_an_error() {
-    let res = vec![Resonator { site: 20, eps: 1e-3, coupling: Coupling::Constant(1.0), p: 1 }];
+    let res = vec![Resonator {
+        site: 20,
+        eps: 1e-3,
+        coupling: Coupling::Constant(1.0),
+        p: 1,
+    }];
     let model = Model::new(41, Boundary::Fixed, res).unwrap();
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, 12, 1.0).unwrap();
-    let cfg = DriveConfig { t_end: T_END, sample_every: 1.0, control: StepControl::Fixed { dt: 0.5 }, max_steps: 1_000_000, energy_drift_limit: Some(1e-3) };
-    let err = drive(&model, &mut ExplicitRk::<Rk4>::new(&model), &mut y, &cfg, &mut ()).unwrap_err();
-    assert!(matches!(err, SimError::NonFinite { .. } | SimError::EnergyDrift { .. }), "{err:?}");
+    let cfg = DriveConfig {
+        t_end: T_END,
+        sample_every: 1.0,
+        control: StepControl::Fixed { dt: 0.5 },
+        max_steps: 1_000_000,
+        energy_drift_limit: Some(1e-3),
+    };
+    let err = drive(
+        &model,
+        &mut ExplicitRk::<Rk4>::new(&model),
+        &mut y,
+        &cfg,
+        &mut (),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(
+            err,
+            SimError::NonFinite { .. } | SimError::EnergyDrift { .. }
+        ),
+        "{err:?}"
+    );
 }
 
 /// The plan never hands a fixed-step method a step beyond its linear stability bound.
 #[test]
 fn tolerance_driven_steps_respect_the_stability_bound() {
     for eps in [1e-4, 1e-2, 1.0] {
-        let res = vec![Resonator { site: 0, eps, coupling: Coupling::Constant(1.0), p: 1 }];
+        let res = vec![Resonator {
+            site: 0,
+            eps,
+            coupling: Coupling::Constant(1.0),
+            p: 1,
+        }];
         let model = Model::new(3, Boundary::Fixed, res).unwrap();
-        for method in [Method::Rk4, Method::Verlet, Method::Yoshida4, Method::Yoshida6] {
-            let acc = Accuracy { tolerance: 1e-3, tolerance_explicit: true, dt: None };
+        for method in [
+            Method::Rk4,
+            Method::Verlet,
+            Method::Yoshida4,
+            Method::Yoshida6,
+        ] {
+            let acc = Accuracy {
+                tolerance: 1e-3,
+                tolerance_explicit: true,
+                dt: None,
+            };
             let plan = Plan::choose(&model, MethodChoice::Named(method), acc).unwrap();
             let dt = plan.dt().unwrap();
-            assert!(dt * model.max_linear_omega() < method.stability_limit(), "{} eps {eps}: dt {dt}", method.name());
+            assert!(
+                dt * model.max_linear_omega() < method.stability_limit(),
+                "{} eps {eps}: dt {dt}",
+                method.name()
+            );
         }
     }
 }
@@ -158,12 +271,30 @@ fn tolerance_driven_steps_respect_the_stability_bound() {
 /// Free ends conserve momentum along the whole chain run.
 #[test]
 fn free_chain_conserves_momentum() {
-    let res = vec![Resonator { site: 20, eps: 3.0, coupling: Coupling::Constant(1.0), p: 3 }];
+    let res = vec![Resonator {
+        site: 20,
+        eps: 3.0,
+        coupling: Coupling::Constant(1.0),
+        p: 3,
+    }];
     let model = Model::new(41, Boundary::Free, res).unwrap();
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, 12, 1.0).unwrap();
     let p0 = woodpile_sim::energy::total_momentum(&model, &y);
-    let cfg = DriveConfig { t_end: 60.0, sample_every: 1.0, control: StepControl::Fixed { dt: 0.01 }, max_steps: 1_000_000, energy_drift_limit: Some(1e-5) };
-    drive(&model, &mut ExplicitRk::<Rk4>::new(&model), &mut y, &cfg, &mut ()).unwrap();
+    let cfg = DriveConfig {
+        t_end: 60.0,
+        sample_every: 1.0,
+        control: StepControl::Fixed { dt: 0.01 },
+        max_steps: 1_000_000,
+        energy_drift_limit: Some(1e-5),
+    };
+    drive(
+        &model,
+        &mut ExplicitRk::<Rk4>::new(&model),
+        &mut y,
+        &cfg,
+        &mut (),
+    )
+    .unwrap();
     assert!((woodpile_sim::energy::total_momentum(&model, &y) - p0).abs() < 1e-12);
 }

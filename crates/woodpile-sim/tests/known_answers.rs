@@ -1,6 +1,7 @@
 //! Exact answers: the linear host–resonator oscillator and the two-bead Hertz collision.
 //! Convergence orders on the smooth oscillator are the classical ones; on the Hertzian chain they
 //! are not (see `chain_accuracy.rs`).
+#![allow(clippy::unwrap_used)]
 
 use woodpile_sim::energy::{total_energy, total_momentum};
 use woodpile_sim::integrate::{
@@ -61,7 +62,10 @@ fn linear_oscillator_convergence_orders_are_classical() {
         }
         let order = fixed_steppers(&model)[i].1;
         let p = slope(&dts, &errs);
-        assert!((p - order).abs() < 0.3, "{name}: measured order {p:.2}, classical {order}; errors {errs:?}");
+        assert!(
+            (p - order).abs() < 0.3,
+            "{name}: measured order {p:.2}, classical {order}; errors {errs:?}"
+        );
     }
 }
 
@@ -73,8 +77,18 @@ fn dop853_meets_its_tolerance_on_the_oscillator() {
     let exact = 0.1 * (omega * t_end).cos();
     for rtol in [1e-6, 1e-9, 1e-12] {
         let mut y = y0.clone();
-        let cfg = DriveConfig { control: StepControl::Adaptive { h_min: 1e-12 }, ..fixed(t_end, 1.0) };
-        let stats = drive(&model, &mut Dop853::new(&model, rtol, rtol), &mut y, &cfg, &mut ()).unwrap();
+        let cfg = DriveConfig {
+            control: StepControl::Adaptive { h_min: 1e-12 },
+            ..fixed(t_end, 1.0)
+        };
+        let stats = drive(
+            &model,
+            &mut Dop853::new(&model, rtol, rtol),
+            &mut y,
+            &cfg,
+            &mut (),
+        )
+        .unwrap();
         let err = (y[0] - y[1] - exact).abs();
         assert!(err < 100.0 * rtol, "rtol {rtol}: error {err:.3e}");
         assert!(stats.steps > 0);
@@ -101,7 +115,10 @@ fn resonator_linear_frequency() {
     }
     let period = (crossings[4] - crossings[0]) / 2.0;
     let expected = 2.0 * std::f64::consts::PI / omega;
-    assert!((period / expected - 1.0).abs() < 1e-6, "period {period} vs {expected}");
+    assert!(
+        (period / expected - 1.0).abs() < 1e-6,
+        "period {period} vs {expected}"
+    );
 }
 
 /// Two equal free beads: the Hertz collision exchanges their velocities exactly, conserving
@@ -113,11 +130,28 @@ fn two_bead_collision_swaps_velocities() {
     let p0 = total_momentum(&model, &y0);
     for (mut stepper, _) in fixed_steppers(&model) {
         let mut y = y0.clone();
-        drive(&model, stepper.as_mut(), &mut y, &fixed(20.0, 0.001), &mut ()).unwrap();
+        drive(
+            &model,
+            stepper.as_mut(),
+            &mut y,
+            &fixed(20.0, 0.001),
+            &mut (),
+        )
+        .unwrap();
         let name = stepper.name();
         assert!(y[2].abs() < 1e-6, "{name}: first bead keeps {}", y[2]);
-        assert!((y[3] - 1.0).abs() < 1e-6, "{name}: second bead gets {}", y[3]);
-        assert!((total_energy(&model, 20.0, &y) - e0).abs() < 1e-10, "{name}: energy");
-        assert!((total_momentum(&model, &y) - p0).abs() < 1e-12, "{name}: momentum");
+        assert!(
+            (y[3] - 1.0).abs() < 1e-6,
+            "{name}: second bead gets {}",
+            y[3]
+        );
+        assert!(
+            (total_energy(&model, 20.0, &y) - e0).abs() < 1e-10,
+            "{name}: energy"
+        );
+        assert!(
+            (total_momentum(&model, &y) - p0).abs() < 1e-12,
+            "{name}: momentum"
+        );
     }
 }

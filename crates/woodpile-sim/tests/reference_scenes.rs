@@ -1,6 +1,7 @@
 //! The five public reference scenes (independent DOP853 implementation at rtol 1e-12, fixed walls,
 //! wall bond in the end site, fractions normalised by E(t_end); copied from the project brief).
 //! They settle conventions: impulse site, walls, region and normalisation.
+#![allow(clippy::unwrap_used)]
 
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::Coupling;
@@ -37,7 +38,12 @@ fn references() -> Vec<Reference> {
         },
         Reference {
             kind: "nonlinear p=7",
-            defects: vec![PaperDefect { site: 0, eps: 0.2, coupling: Coupling::Constant(1.0), p: 7 }],
+            defects: vec![PaperDefect {
+                site: 0,
+                eps: 0.2,
+                coupling: Coupling::Constant(1.0),
+                p: 7,
+            }],
             r: 0.054044447118414524,
             t: 0.9364092134599586,
             e_tr: 0.009546339421626734,
@@ -57,7 +63,12 @@ fn references() -> Vec<Reference> {
                 PaperDefect {
                     site: 0,
                     eps: 10.0,
-                    coupling: Coupling::Ramp { k1: 0.0, k2: 2.5, t0: 40.0, tau: 0.1 },
+                    coupling: Coupling::Ramp {
+                        k1: 0.0,
+                        k2: 2.5,
+                        t0: 40.0,
+                        tau: 0.1,
+                    },
                     p: 1,
                 },
                 lin(20, 10.0, 2.5),
@@ -78,12 +89,24 @@ fn auto_matches_reference_scenes() {
         let scene = paper_scene(&r.defects, MethodChoice::Auto, tolerance(1e-8));
         let out = simulate(&scene, &mut ()).unwrap();
         let f = out.fractions;
-        let errs = [(f.reflected - r.r).abs(), (f.transmitted - r.t).abs(), (f.trapped - r.e_tr).abs()];
-        eprintln!("{:>14}: errs {:.2e} {:.2e} {:.2e}  steps {}  evals {}", r.kind, errs[0], errs[1], errs[2], out.stats.steps, out.stats.rhs_evals);
+        let errs = [
+            (f.reflected - r.r).abs(),
+            (f.transmitted - r.t).abs(),
+            (f.trapped - r.e_tr).abs(),
+        ];
+        eprintln!(
+            "{:>14}: errs {:.2e} {:.2e} {:.2e}  steps {}  evals {}",
+            r.kind, errs[0], errs[1], errs[2], out.stats.steps, out.stats.rhs_evals
+        );
         for e in errs {
             assert!(e < 1e-7, "{}: fraction error {e:.3e}", r.kind);
         }
-        assert!((out.e_final - r.e_final).abs() / r.e_final < 1e-7, "{}: E_final {}", r.kind, out.e_final);
+        assert!(
+            (out.e_final - r.e_final).abs() / r.e_final < 1e-7,
+            "{}: E_final {}",
+            r.kind,
+            out.e_final
+        );
     }
 }
 
@@ -91,7 +114,11 @@ fn auto_matches_reference_scenes() {
 #[test]
 fn rk4_at_small_step_matches_reference_scenes() {
     for r in references().into_iter().take(2) {
-        let scene = paper_scene(&r.defects, MethodChoice::Named(Method::Rk4), woodpile_sim::testing::fixed_dt(0.01));
+        let scene = paper_scene(
+            &r.defects,
+            MethodChoice::Named(Method::Rk4),
+            woodpile_sim::testing::fixed_dt(0.01),
+        );
         let out = simulate(&scene, &mut ()).unwrap();
         let err = (out.fractions.trapped - r.e_tr).abs();
         eprintln!("rk4 {}: {err:.2e}", r.kind);

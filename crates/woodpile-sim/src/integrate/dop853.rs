@@ -6,6 +6,10 @@
 //! (first-same-as-last), so 12 right-hand sides per accepted step. Error norm and step
 //! controller follow DOP853: err = |h| err5^2 / sqrt(n (err5^2 + 0.01 err3^2)) in the RMS norm
 //! scaled by atol + rtol max(|y|, |y_new|), and h_new = h min(10, max(0.2, 0.9 err^{-1/8})).
+//!
+//! The constants keep the 30 digits published with DOP853, so that they can be checked against
+//! the source by eye; the compiler rounds them to f64.
+#![allow(clippy::excessive_precision)]
 
 use super::rk::rk_stages;
 use super::{StepOutcome, Stepper};
@@ -31,8 +35,15 @@ const C: [f64; STAGES] = [
 const A: [&[f64]; STAGES] = [
     &[],
     &[5.260_015_195_876_773_187_855_875_444_88e-2],
-    &[1.972_505_698_453_789_945_445_953_291_83e-2, 5.917_517_095_361_369_836_337_859_875_49e-2],
-    &[2.958_758_547_680_684_918_168_929_937_75e-2, 0.0, 8.876_275_643_042_054_754_506_789_813_24e-2],
+    &[
+        1.972_505_698_453_789_945_445_953_291_83e-2,
+        5.917_517_095_361_369_836_337_859_875_49e-2,
+    ],
+    &[
+        2.958_758_547_680_684_918_168_929_937_75e-2,
+        0.0,
+        8.876_275_643_042_054_754_506_789_813_24e-2,
+    ],
     &[
         2.413_651_341_592_666_855_023_697_986_65e-1,
         0.0,
@@ -196,11 +207,26 @@ impl Stepper for Dop853 {
         "dop853"
     }
 
+    #[allow(clippy::needless_range_loop)] // one pass over components, reading 12 stage rows
     fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64) -> StepOutcome {
         let len = y.len();
         let reuse = self.fsal_at == Some(t);
-        rk_stages(model, t, y, h, &A, &C, &mut self.stages, &mut self.scratch, !reuse);
-        self.evals += if reuse { STAGES as u64 - 1 } else { STAGES as u64 };
+        rk_stages(
+            model,
+            t,
+            y,
+            h,
+            &A,
+            &C,
+            &mut self.stages,
+            &mut self.scratch,
+            !reuse,
+        );
+        self.evals += if reuse {
+            STAGES as u64 - 1
+        } else {
+            STAGES as u64
+        };
 
         self.y_new.copy_from_slice(y);
         let mut err5 = 0.0;
@@ -222,7 +248,11 @@ impl Stepper for Dop853 {
             err3 += (e3 / sc) * (e3 / sc);
         }
         let denom = err5 + 0.01 * err3;
-        let err = if denom > 0.0 { h.abs() * err5 / (denom * len as f64).sqrt() } else { 0.0 };
+        let err = if denom > 0.0 {
+            h.abs() * err5 / (denom * len as f64).sqrt()
+        } else {
+            0.0
+        };
 
         if err.is_nan() {
             return StepOutcome::Rejected { h_next: 0.2 * h };
@@ -233,7 +263,11 @@ impl Stepper for Dop853 {
             model.rhs(t + h, y, &mut self.stages[..len]);
             self.evals += 1;
             self.fsal_at = Some(t + h);
-            let factor = if err == 0.0 { 10.0 } else { (0.9 * err.powf(-0.125)).clamp(0.2, 10.0) };
+            let factor = if err == 0.0 {
+                10.0
+            } else {
+                (0.9 * err.powf(-0.125)).clamp(0.2, 10.0)
+            };
             StepOutcome::Accepted { h_next: h * factor }
         } else {
             self.fsal_at = if reuse { Some(t) } else { None };
@@ -257,7 +291,11 @@ impl Stepper for Dop853 {
         };
         let d0 = rms(&|i| y[i] / self.scale(y[i], y[i]));
         let d1 = rms(&|i| f0[i] / self.scale(y[i], y[i]));
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6
+        } else {
+            0.01 * d0 / d1
+        };
         let y1: Vec<f64> = (0..len).map(|i| y[i] + h0 * f0[i]).collect();
         let mut f1 = vec![0.0; len];
         model.rhs(t + h0, &y1, &mut f1);

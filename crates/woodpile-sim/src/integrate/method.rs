@@ -25,8 +25,13 @@ pub enum Method {
 
 impl Method {
     /// Every method, in a stable order.
-    pub const ALL: [Method; 5] =
-        [Method::Rk4, Method::Verlet, Method::Yoshida4, Method::Yoshida6, Method::Dop853];
+    pub const ALL: [Method; 5] = [
+        Method::Rk4,
+        Method::Verlet,
+        Method::Yoshida4,
+        Method::Yoshida6,
+        Method::Dop853,
+    ];
 
     /// The name used in scene files.
     pub fn name(self) -> &'static str {
@@ -136,11 +141,26 @@ struct ErrorModel {
 
 fn error_model(method: Method) -> ErrorModel {
     match method {
-        Method::Verlet => ErrorModel { coef: 1.5e-2, order: 2.0 },
-        Method::Rk4 => ErrorModel { coef: 1.5e-3, order: 2.5 },
-        Method::Yoshida4 => ErrorModel { coef: 1.0e-2, order: 2.5 },
-        Method::Yoshida6 => ErrorModel { coef: 3.0e-3, order: 2.5 },
-        Method::Dop853 => ErrorModel { coef: 1.0, order: 8.0 },
+        Method::Verlet => ErrorModel {
+            coef: 1.5e-2,
+            order: 2.0,
+        },
+        Method::Rk4 => ErrorModel {
+            coef: 1.5e-3,
+            order: 2.5,
+        },
+        Method::Yoshida4 => ErrorModel {
+            coef: 1.0e-2,
+            order: 2.5,
+        },
+        Method::Yoshida6 => ErrorModel {
+            coef: 3.0e-3,
+            order: 2.5,
+        },
+        Method::Dop853 => ErrorModel {
+            coef: 1.0,
+            order: 8.0,
+        },
     }
 }
 
@@ -163,14 +183,22 @@ const MAX_OMEGA_DT: f64 = 0.5;
 impl Plan {
     /// Resolves `choice` and `accuracy` for `model`. For [`MethodChoice::Auto`] this is the
     /// first (finest) plan of the verification ladder run by [`crate::run::simulate`].
-    pub fn choose(model: &Model, choice: MethodChoice, accuracy: Accuracy) -> Result<Plan, SimError> {
+    pub fn choose(
+        model: &Model,
+        choice: MethodChoice,
+        accuracy: Accuracy,
+    ) -> Result<Plan, SimError> {
         let tol = accuracy.tolerance;
         if !(tol.is_finite() && tol > 0.0) {
-            return Err(SimError::BadRun(format!("tolerance must be finite and > 0, got {tol}")));
+            return Err(SimError::BadRun(format!(
+                "tolerance must be finite and > 0, got {tol}"
+            )));
         }
         if let Some(dt) = accuracy.dt {
             if !(dt.is_finite() && dt > 0.0) {
-                return Err(SimError::BadRun(format!("dt must be finite and > 0, got {dt}")));
+                return Err(SimError::BadRun(format!(
+                    "dt must be finite and > 0, got {dt}"
+                )));
             }
         }
         let method = match choice {
@@ -190,12 +218,22 @@ impl Plan {
         }
         let (dt, drift_limit) = match accuracy.dt {
             Some(dt) => {
-                let limit = if accuracy.tolerance_explicit { tolerance_drift } else { BLOW_UP_DRIFT };
+                let limit = if accuracy.tolerance_explicit {
+                    tolerance_drift
+                } else {
+                    BLOW_UP_DRIFT
+                };
                 (dt, limit)
             }
             None => (Self::dt_for(model, method, tol), tolerance_drift),
         };
-        Ok(Plan { method, control: StepControl::Fixed { dt }, rtol: 0.0, atol: 0.0, drift_limit })
+        Ok(Plan {
+            method,
+            control: StepControl::Fixed { dt },
+            rtol: 0.0,
+            atol: 0.0,
+            drift_limit,
+        })
     }
 
     /// The fixed step predicted to reach `tol` with `method` on `model`: the calibrated error
@@ -203,14 +241,29 @@ impl Plan {
     pub fn dt_for(model: &Model, method: Method, tol: f64) -> f64 {
         let em = error_model(method);
         let omega = model.max_linear_omega();
-        let resolved = if omega > 0.0 { MAX_OMEGA_DT / omega } else { f64::INFINITY };
-        let stable = if omega > 0.0 { 0.9 * method.stability_limit() / omega } else { f64::INFINITY };
-        (tol / em.coef).powf(1.0 / em.order).min(resolved).min(stable).min(0.25)
+        let resolved = if omega > 0.0 {
+            MAX_OMEGA_DT / omega
+        } else {
+            f64::INFINITY
+        };
+        let stable = if omega > 0.0 {
+            0.9 * method.stability_limit() / omega
+        } else {
+            f64::INFINITY
+        };
+        (tol / em.coef)
+            .powf(1.0 / em.order)
+            .min(resolved)
+            .min(stable)
+            .min(0.25)
     }
 
     /// The same plan with a fixed step `dt` (for the verification ladder).
     pub fn with_dt(&self, dt: f64) -> Plan {
-        Plan { control: StepControl::Fixed { dt }, ..*self }
+        Plan {
+            control: StepControl::Fixed { dt },
+            ..*self
+        }
     }
 
     /// The fixed step, if any.
@@ -239,16 +292,34 @@ impl Plan {
         };
         match self.method {
             Method::Rk4 => drive(model, &mut ExplicitRk::<Rk4>::new(model), y, &cfg, observer),
-            Method::Verlet => drive(model, &mut SymplecticStepper::new(model, VERLET), y, &cfg, observer),
-            Method::Yoshida4 => {
-                drive(model, &mut SymplecticStepper::new(model, YOSHIDA4), y, &cfg, observer)
-            }
-            Method::Yoshida6 => {
-                drive(model, &mut SymplecticStepper::new(model, YOSHIDA6), y, &cfg, observer)
-            }
-            Method::Dop853 => {
-                drive(model, &mut Dop853::new(model, self.rtol, self.atol), y, &cfg, observer)
-            }
+            Method::Verlet => drive(
+                model,
+                &mut SymplecticStepper::new(model, VERLET),
+                y,
+                &cfg,
+                observer,
+            ),
+            Method::Yoshida4 => drive(
+                model,
+                &mut SymplecticStepper::new(model, YOSHIDA4),
+                y,
+                &cfg,
+                observer,
+            ),
+            Method::Yoshida6 => drive(
+                model,
+                &mut SymplecticStepper::new(model, YOSHIDA6),
+                y,
+                &cfg,
+                observer,
+            ),
+            Method::Dop853 => drive(
+                model,
+                &mut Dop853::new(model, self.rtol, self.atol),
+                y,
+                &cfg,
+                observer,
+            ),
         }
     }
 }

@@ -64,7 +64,17 @@ impl<T: Tableau> Stepper for ExplicitRk<T> {
 
     fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64) -> StepOutcome {
         let len = y.len();
-        rk_stages(model, t, y, h, T::A, T::C, &mut self.stages, &mut self.scratch, true);
+        rk_stages(
+            model,
+            t,
+            y,
+            h,
+            T::A,
+            T::C,
+            &mut self.stages,
+            &mut self.scratch,
+            true,
+        );
         self.evals += T::B.len() as u64;
         for (i, &b) in T::B.iter().enumerate() {
             if b != 0.0 {

@@ -25,7 +25,11 @@ pub struct Composition {
 }
 
 /// Störmer–Verlet (velocity Verlet), order 2.
-pub const VERLET: Composition = Composition { name: "verlet", order: 2, gammas: &[1.0] };
+pub const VERLET: Composition = Composition {
+    name: "verlet",
+    order: 2,
+    gammas: &[1.0],
+};
 
 /// Yoshida's / Forest–Ruth's triple jump, order 4: gamma_1 = gamma_3 = 1/(2 - 2^{1/3}),
 /// gamma_2 = -2^{1/3}/(2 - 2^{1/3}).
@@ -40,6 +44,7 @@ pub const YOSHIDA4: Composition = Composition {
 };
 
 /// Yoshida's 7-stage composition of order 6, solution A (Yoshida 1990; HLW Eq. V.3.11).
+#[allow(clippy::excessive_precision)] // digits as published
 pub const YOSHIDA6: Composition = Composition {
     name: "yoshida6",
     order: 6,
@@ -66,7 +71,12 @@ pub struct SymplecticStepper {
 impl SymplecticStepper {
     /// A stepper for `model` using `composition`.
     pub fn new(model: &Model, composition: Composition) -> Self {
-        Self { composition, acc: vec![0.0; model.n_dof()], cached_at: None, evals: 0 }
+        Self {
+            composition,
+            acc: vec![0.0; model.n_dof()],
+            cached_at: None,
+            evals: 0,
+        }
     }
 }
 
@@ -128,6 +138,9 @@ mod tests {
         assert!(cubes.abs() < 1e-14);
         let cubes6: f64 = YOSHIDA6.gammas.iter().map(|g| g * g * g).sum();
         let fifths6: f64 = YOSHIDA6.gammas.iter().map(|g| g.powi(5)).sum();
-        assert!(cubes6.abs() < 1e-12 && fifths6.abs() < 1e-12, "{cubes6} {fifths6}");
+        assert!(
+            cubes6.abs() < 1e-12 && fifths6.abs() < 1e-12,
+            "{cubes6} {fifths6}"
+        );
     }
 }
