@@ -170,3 +170,78 @@ impl Observer for SpaceTimeField {
         self.velocity.clear();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrate::{Accuracy, Method, MethodChoice};
+    use crate::run::simulate;
+    use crate::testing::{paper_scene, PaperDefect};
+
+    fn scene() -> crate::run::Scenario {
+        let accuracy = Accuracy {
+            tolerance: 1e-6,
+            tolerance_explicit: true,
+            dt: Some(0.02),
+        };
+        let mut s = paper_scene(
+            &[PaperDefect::linear(0, 3.0, 1.0)],
+            MethodChoice::Named(Method::Rk4),
+            accuracy,
+        );
+        s.t_end = 60.0;
+        s
+    }
+
+    /// The series samples 0, 1, ..., t_end, its shares sum to one, and its last entry is the
+    /// run's final fractions.
+    #[test]
+    fn fraction_series_ends_at_the_final_fractions() {
+        let s = scene();
+        let mut series = FractionSeries::new(&s.model, s.region);
+        let out = simulate(&s, &mut series).unwrap();
+        assert_eq!(series.t.len(), 61);
+        assert_eq!(series.t[0], 0.0);
+        assert_eq!(*series.t.last().unwrap(), 60.0);
+        for i in 0..series.t.len() {
+            let sum = series.reflected[i] + series.transmitted[i] + series.trapped[i];
+            assert!((sum - 1.0).abs() < 1e-12);
+        }
+        assert_eq!(*series.trapped.last().unwrap(), out.fractions.trapped);
+        // Before the wave arrives everything is reflected-side energy (the impulse is at -25).
+        assert!((series.reflected[0] - 1.0).abs() < 1e-15);
+    }
+
+    /// Kinetic fractions start as the whole impact energy on the left and never exceed it.
+    #[test]
+    fn kinetic_series_is_normalised_by_the_impact_energy() {
+        let s = scene();
+        let mut kin = KineticSeries::new(&s.model, s.region, 0.5);
+        simulate(&s, &mut kin).unwrap();
+        assert!((kin.reflected[0] - 1.0).abs() < 1e-15);
+        for i in 0..kin.t.len() {
+            let total = kin.reflected[i] + kin.transmitted[i] + kin.trapped[i];
+            assert!(
+                total <= 1.0 + 1e-9 && total > 0.0,
+                "t = {}: {total}",
+                kin.t[i]
+            );
+        }
+    }
+
+    /// The field keeps every k-th sample and site, row-major, and resets cleanly.
+    #[test]
+    fn space_time_field_is_decimated() {
+        let s = scene();
+        let mut field = SpaceTimeField::new(&s.model, 2, 4);
+        simulate(&s, &mut field).unwrap();
+        assert_eq!(field.sites.len(), 51); // 201 sites, every 4th
+        assert_eq!(field.t.len(), 31); // 61 samples, every 2nd
+        assert_eq!(field.velocity.len(), field.t.len() * field.sites.len());
+        // At t = 0 only the impulse site (index 75) moves, and it is kept only if 4 divides 75.
+        let moving: usize = field.velocity[..51].iter().filter(|v| **v != 0.0).count();
+        assert_eq!(moving, usize::from(75 % 4 == 0));
+        field.reset();
+        assert!(field.t.is_empty() && field.velocity.is_empty());
+    }
+}
