@@ -2,36 +2,61 @@
 //!
 //! - [`FractionSeries`]: R, T, E_tr and E as time series, so that a different read-out time is a
 //!   re-reduction rather than a re-simulation.
-//! - [`KineticSeries`]: kinetic-energy fractions normalised by the impact energy, as the woodpile
-//!   experiment measures them (paper Fig. 2 c, f).
+//! - [`FractionSeries::kinetic`]: kinetic-energy fractions normalised by the impact energy, as
+//!   the woodpile experiment measures them (paper Fig. 2 c, f).
 //! - [`SpaceTimeField`]: a decimated site-by-time velocity map (paper Figs. 3, 8, 10).
 
 use crate::energy::{energy_density, kinetic_density, Fractions, Region};
 use crate::integrate::Observer;
 use crate::model::Model;
 
-/// Energy fractions of one region at every sample.
+/// Which energy a [`FractionSeries`] splits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SeriesKind {
+    /// Total energy density, shares normalised by E(t): they sum to one.
+    Energy,
+    /// Kinetic energy only, shares divided by a fixed `normalisation` (the impact energy), as the
+    /// woodpile experiment measures them: kinetic energy is not conserved, so they need not sum
+    /// to one.
+    Kinetic {
+        /// The energy the shares are divided by (> 0).
+        normalisation: f64,
+    },
+}
+
+/// Fractions of one region at every sample: R(t), T(t), E_tr(t) and the total.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FractionSeries {
     region: Region,
+    kind: SeriesKind,
     density: Vec<f64>,
     /// Sample times.
     pub t: Vec<f64>,
-    /// R(t), normalised by E(t).
+    /// Share left of the region.
     pub reflected: Vec<f64>,
-    /// T(t), normalised by E(t).
+    /// Share right of the region.
     pub transmitted: Vec<f64>,
-    /// E_tr(t), normalised by E(t).
+    /// Share inside the region.
     pub trapped: Vec<f64>,
-    /// Total energy E(t).
+    /// The energy split at each sample (total, or kinetic).
     pub energy: Vec<f64>,
 }
 
 impl FractionSeries {
-    /// An empty series for `region` of `model`.
+    /// An empty total-energy series for `region` of `model`.
     pub fn new(model: &Model, region: Region) -> Self {
+        Self::of_kind(model, region, SeriesKind::Energy)
+    }
+
+    /// An empty kinetic-energy series for `region`, divided by `normalisation`.
+    pub fn kinetic(model: &Model, region: Region, normalisation: f64) -> Self {
+        Self::of_kind(model, region, SeriesKind::Kinetic { normalisation })
+    }
+
+    fn of_kind(model: &Model, region: Region, kind: SeriesKind) -> Self {
         Self {
             region,
+            kind,
             density: vec![0.0; model.n_sites()],
             t: Vec::new(),
             reflected: Vec::new(),
@@ -44,12 +69,22 @@ impl FractionSeries {
 
 impl Observer for FractionSeries {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
-        energy_density(model, t, y, &mut self.density);
+        let scale = match self.kind {
+            SeriesKind::Energy => {
+                energy_density(model, t, y, &mut self.density);
+                None
+            }
+            SeriesKind::Kinetic { normalisation } => {
+                kinetic_density(model, y, &mut self.density);
+                Some(normalisation)
+            }
+        };
         let f = Fractions::from_density(&self.density, self.region);
+        let factor = scale.map_or(1.0, |n| f.total / n);
         self.t.push(t);
-        self.reflected.push(f.reflected);
-        self.transmitted.push(f.transmitted);
-        self.trapped.push(f.trapped);
+        self.reflected.push(f.reflected * factor);
+        self.transmitted.push(f.transmitted * factor);
+        self.trapped.push(f.trapped * factor);
         self.energy.push(f.total);
     }
 
@@ -60,61 +95,6 @@ impl Observer for FractionSeries {
             &mut self.transmitted,
             &mut self.trapped,
             &mut self.energy,
-        ] {
-            v.clear();
-        }
-    }
-}
-
-/// Kinetic-energy fractions of one region at every sample, normalised by a fixed energy (the
-/// impact energy), so that they need not sum to one: kinetic energy is not conserved.
-#[derive(Debug, Clone, PartialEq)]
-pub struct KineticSeries {
-    region: Region,
-    normalisation: f64,
-    density: Vec<f64>,
-    /// Sample times.
-    pub t: Vec<f64>,
-    /// Kinetic energy left of the region / normalisation.
-    pub reflected: Vec<f64>,
-    /// Kinetic energy right of the region / normalisation.
-    pub transmitted: Vec<f64>,
-    /// Kinetic energy inside the region / normalisation.
-    pub trapped: Vec<f64>,
-}
-
-impl KineticSeries {
-    /// An empty series for `region`, dividing by `normalisation` (> 0).
-    pub fn new(model: &Model, region: Region, normalisation: f64) -> Self {
-        Self {
-            region,
-            normalisation,
-            density: vec![0.0; model.n_sites()],
-            t: Vec::new(),
-            reflected: Vec::new(),
-            transmitted: Vec::new(),
-            trapped: Vec::new(),
-        }
-    }
-}
-
-impl Observer for KineticSeries {
-    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
-        kinetic_density(model, y, &mut self.density);
-        let f = Fractions::from_density(&self.density, self.region);
-        let scale = f.total / self.normalisation;
-        self.t.push(t);
-        self.reflected.push(f.reflected * scale);
-        self.transmitted.push(f.transmitted * scale);
-        self.trapped.push(f.trapped * scale);
-    }
-
-    fn reset(&mut self) {
-        for v in [
-            &mut self.t,
-            &mut self.reflected,
-            &mut self.transmitted,
-            &mut self.trapped,
         ] {
             v.clear();
         }
@@ -216,7 +196,7 @@ mod tests {
     #[test]
     fn kinetic_series_is_normalised_by_the_impact_energy() {
         let s = scene();
-        let mut kin = KineticSeries::new(&s.model, s.region, 0.5);
+        let mut kin = FractionSeries::kinetic(&s.model, s.region, 0.5);
         simulate(&s, &mut kin).unwrap();
         assert!((kin.reflected[0] - 1.0).abs() < 1e-15);
         for i in 0..kin.t.len() {

@@ -120,3 +120,14 @@ pub fn fixed_dt(dt: f64) -> Accuracy {
         dt: Some(dt),
     }
 }
+
+/// Least-squares slope of log(error) against log(dt): the measured convergence order.
+pub fn fitted_order(dts: &[f64], errors: &[f64]) -> f64 {
+    let n = dts.len() as f64;
+    let xs: Vec<f64> = dts.iter().map(|d| d.ln()).collect();
+    let ys: Vec<f64> = errors.iter().map(|e| e.ln()).collect();
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}

@@ -12,6 +12,7 @@ use woodpile_sim::integrate::{
     Stepper, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+use woodpile_sim::testing::fitted_order;
 use woodpile_sim::SimError;
 
 /// A short chain (sites -20..20), defect eps = 3 at 0, impulse at -8, t in [0, 40]: the wave
@@ -75,18 +76,6 @@ fn reference() -> f64 {
     .0
 }
 
-fn slope(dts: &[f64], errs: &[f64]) -> f64 {
-    let n = dts.len() as f64;
-    let xs: Vec<f64> = dts.iter().map(|d| d.ln()).collect();
-    let ys: Vec<f64> = errs.iter().map(|e| e.ln()).collect();
-    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
-    xs.iter()
-        .zip(&ys)
-        .map(|(x, y)| (x - mx) * (y - my))
-        .sum::<f64>()
-        / xs.iter().map(|x| (x - mx) * (x - mx)).sum::<f64>()
-}
-
 /// Measured convergence orders of the state (max-norm error at t_end against a Yoshida-6 run at
 /// dt = 5e-4) on the chain: Verlet 2; RK4 and the compositions between 2 and 3, well below their
 /// classical 4 and 6, because of the contact singularity. A single scalar such as E_tr converges
@@ -116,7 +105,7 @@ fn convergence_orders_on_the_hertz_chain() {
                     .fold(0.0, f64::max)
             })
             .collect();
-        let p = slope(&dts, &errs);
+        let p = fitted_order(&dts, &errs);
         eprintln!("{}: measured order {p:.2} (errors {errs:?})", method.name());
         assert!(
             p > lo && p < hi,

@@ -9,7 +9,7 @@ use woodpile_sim::integrate::{
     YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::Model;
-use woodpile_sim::testing::{linear_oscillator, two_bead_collision};
+use woodpile_sim::testing::{fitted_order, linear_oscillator, two_bead_collision};
 
 fn fixed(t_end: f64, dt: f64) -> DriveConfig {
     DriveConfig {
@@ -28,17 +28,6 @@ fn fixed_steppers(model: &Model) -> Vec<(Box<dyn Stepper>, f64)> {
         (Box::new(SymplecticStepper::new(model, YOSHIDA4)), 4.0),
         (Box::new(SymplecticStepper::new(model, YOSHIDA6)), 6.0),
     ]
-}
-
-/// Least-squares slope of log(error) against log(dt).
-fn slope(dts: &[f64], errs: &[f64]) -> f64 {
-    let xs: Vec<f64> = dts.iter().map(|d| d.ln()).collect();
-    let ys: Vec<f64> = errs.iter().map(|e| e.ln()).collect();
-    let n = xs.len() as f64;
-    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
-    let sxy: f64 = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum();
-    let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
-    sxy / sxx
 }
 
 /// The relative coordinate v - u of a host–resonator pair oscillates as x0 cos(omega t),
@@ -61,7 +50,7 @@ fn linear_oscillator_convergence_orders_are_classical() {
             name = stepper.name();
         }
         let order = fixed_steppers(&model)[i].1;
-        let p = slope(&dts, &errs);
+        let p = fitted_order(&dts, &errs);
         assert!(
             (p - order).abs() < 0.3,
             "{name}: measured order {p:.2}, classical {order}; errors {errs:?}"
