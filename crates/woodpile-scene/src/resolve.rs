@@ -384,3 +384,71 @@ fn coupling(key: &str, value: &toml::Value) -> Result<Coupling, Invalid> {
         v => Ok(Coupling::Constant(non_negative(key, number(key, v)?)?)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::{parse, SceneError};
+
+    fn invalid_key(text: &str) -> String {
+        match parse(text, Path::new("s.toml")) {
+            Err(SceneError::Invalid { key, .. }) => key,
+            other => panic!("expected an invalid key, got {other:?}"),
+        }
+    }
+
+    /// Defaults of SPEC §2 and the paper numbering: site n is index n + N.
+    #[test]
+    fn defaults_and_numbering() {
+        let scene = parse("[[defect]]\nsite = 0\neps = 10.0\n", Path::new("s.toml")).unwrap();
+        let s = &scene.scenario;
+        assert_eq!(s.model.n_sites(), 201);
+        assert_eq!(s.impulse_site, 75);
+        assert_eq!(s.t_end, 150.0);
+        assert_eq!(s.model.resonators()[0].site, 100);
+        assert_eq!(scene.region_paper, [-1, 1]);
+        assert_eq!((s.region.lo(), s.region.hi()), (99, 101));
+    }
+
+    /// The default region spans the defects plus one site each side (paper Eqs. 10 and 11).
+    #[test]
+    fn default_region_spans_the_defects() {
+        let text = "[[defect]]\nsite = 20\neps = 1.0\n[[defect]]\nsite = 0\neps = 1.0\n";
+        assert_eq!(
+            parse(text, Path::new("s.toml")).unwrap().region_paper,
+            [-1, 21]
+        );
+    }
+
+    #[test]
+    fn physical_and_dimensionless_keys_do_not_mix() {
+        let physical = "[physical]\ncontact = 2.47e9\nmass = 1e-3\nvelocity = 2.0\n";
+        assert_eq!(
+            invalid_key(&format!("{physical}[[defect]]\nsite = 0\neps = 1.0\n")),
+            "defect[0].eps"
+        );
+        assert_eq!(
+            invalid_key("[[defect]]\nsite = 0\neps = 1.0\nstiffness = 5.0\n"),
+            "defect[0].stiffness"
+        );
+        assert_eq!(
+            invalid_key(&format!("{physical}[impulse]\nvelocity = 2.0\n")),
+            "impulse.velocity"
+        );
+    }
+
+    #[test]
+    fn dt_needs_a_fixed_step_method() {
+        assert_eq!(invalid_key("[run]\ndt = 0.01\n"), "run.dt");
+        assert_eq!(
+            invalid_key("[run]\nmethod = \"dop853\"\ndt = 0.01\n"),
+            "run.dt"
+        );
+        assert!(parse(
+            "[run]\nmethod = \"verlet\"\ndt = 0.01\n",
+            Path::new("s.toml")
+        )
+        .is_ok());
+    }
+}
