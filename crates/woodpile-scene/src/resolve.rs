@@ -151,19 +151,15 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         let p = p as u32;
         let (eps, coupling) = match scales {
             None => {
-                for k in ["mass", "resonator_mass", "stiffness"] {
-                    let given = match k {
-                        "mass" => d.mass.is_some(),
-                        "resonator_mass" => d.resonator_mass.is_some(),
-                        _ => d.stiffness.is_some(),
-                    };
-                    if given {
-                        return Err(invalid(
-                            key(k),
-                            "is only allowed in a scene with a [physical] table",
-                        ));
-                    }
-                }
+                reject_present(
+                    &key,
+                    &[
+                        ("mass", d.mass.is_some()),
+                        ("resonator_mass", d.resonator_mass.is_some()),
+                        ("stiffness", d.stiffness.is_some()),
+                    ],
+                    "is only allowed in a scene with a [physical] table",
+                )?;
                 let eps = positive(
                     &key("eps"),
                     d.eps.ok_or_else(|| invalid(key("eps"), "is required"))?,
@@ -175,14 +171,11 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
                 (eps, coupling)
             }
             Some(sc) => {
-                for (k, given) in [("eps", d.eps.is_some()), ("kappa", d.kappa.is_some())] {
-                    if given {
-                        return Err(invalid(
-                            key(k),
-                            "is derived in a [physical] scene: give resonator_mass (kg) and stiffness (N/m^p) instead",
-                        ));
-                    }
-                }
+                reject_present(
+                    &key,
+                    &[("eps", d.eps.is_some()), ("kappa", d.kappa.is_some())],
+                    "is derived in a [physical] scene: give resonator_mass (kg) and stiffness (N/m^p) instead",
+                )?;
                 let m = positive(
                     &key("resonator_mass"),
                     d.resonator_mass.ok_or_else(|| {
@@ -334,6 +327,18 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         region_paper,
         physical,
     })
+}
+
+/// Rejects the first of `keys` that is present: those keys do not belong in this kind of scene.
+fn reject_present(
+    key: &dyn Fn(&str) -> String,
+    keys: &[(&str, bool)],
+    reason: &str,
+) -> Result<(), Invalid> {
+    match keys.iter().find(|(_, present)| *present) {
+        Some((name, _)) => Err(invalid(key(name), reason)),
+        None => Ok(()),
+    }
 }
 
 /// SPEC §1: the region spans the defects and one neighbour on each side, [min - 1, max + 1]
