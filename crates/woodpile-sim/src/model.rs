@@ -184,8 +184,8 @@ impl Model {
         self.site_masses.as_ref().map_or(1.0, |m| m[site])
     }
 
-    /// 1/mass per degree of freedom; `None` when every site mass is 1 (resonator masses apply
-    /// regardless).
+    /// The per-site masses; `None` when every site mass is 1, so the force loop can skip the
+    /// division.
     pub(crate) fn site_masses(&self) -> Option<&[f64]> {
         self.site_masses.as_deref()
     }
