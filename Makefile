@@ -1,21 +1,39 @@
 # woodpile: every target calls the `woodpile` binary or cargo; `make help` lists them.
 CARGO ?= cargo
-WOODPILE = $(CARGO) run --quiet --release -p woodpile-cli --
+WOODPILE := target/release/woodpile
+# Regression check: recompute every stage from nothing into SCRATCH and compare with results/.
+SCRATCH := scratch/check
+CHECK_TOL := --abs 1e-9 --rel 1e-9
 
-.PHONY: help test figures bench scenes lint
+.PHONY: help build test figures stage status check read-check bench lint
 
 help: ## List the targets
-	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-10s %s\n", $$1, $$2}'
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
 
-test: ## Run the whole test suite (what CI runs)
-	$(CARGO) test --workspace
+build: ## Build the woodpile binary (release)
+	$(CARGO) build --release -p woodpile-cli
 
-figures: ## PLACEHOLDER until the pipeline lands (issue 3): simulates the example scenes
-	@echo "figures: PLACEHOLDER - the figure pipeline (issue 3) is not built yet."
-	@echo "Simulating the example scenes in scenes/ instead:"
-	@for f in scenes/*.toml; do echo "== $$f"; $(WOODPILE) simulate $$f || exit 1; done
+test: ## Run the whole test suite (what CI runs; release profile, shared with `figures`)
+	$(CARGO) test --workspace --release
 
-scenes: figures ## Alias of the placeholder `figures`
+figures: build ## Bring every stale stage up to date (nothing runs when all are fresh)
+	$(WOODPILE) run
+
+stage: build ## Re-run one stage and what it needs: make stage S=f4_fractions
+	@test -n "$(S)" || { echo "usage: make stage S=<stage name>  (see: make status)"; exit 2; }
+	$(WOODPILE) run $(S)
+
+status: build ## Each stage fresh, stale or missing, and why
+	$(WOODPILE) status
+
+check: build ## Recompute every stage into scratch/ and diff against the committed results/
+	$(WOODPILE) status --check
+	rm -rf $(SCRATCH)
+	$(WOODPILE) run --results $(SCRATCH)/results
+	$(WOODPILE) diff results $(SCRATCH)/results $(CHECK_TOL)
+
+read-check: ## Open every result table with pyarrow, pandas and polars
+	python3 scripts/read_results.py results
 
 bench: ## Error in E_tr against wall time for every method (README table)
 	$(CARGO) run --release -p woodpile-sim --example work_precision

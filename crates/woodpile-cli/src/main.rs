@@ -1,10 +1,13 @@
 //! `woodpile`: the command line. The only place that prints or picks exit codes.
 //!
-//! Exit codes: 0 success; 2 bad input (unreadable file, malformed or invalid scene, bad
-//! arguments); 3 the simulation failed (blow-up, energy drift, tolerance not reachable). Errors
+//! Exit codes: 0 success; 1 `diff` found differences beyond tolerance; 2 bad input (unreadable
+//! file, malformed or invalid scene or stage, bad arguments); 3 a computation failed (blow-up,
+//! energy drift, tolerance not reachable, a stage that cannot produce its output). Errors
 //! go to stderr as one `error: ...` line naming the file, key and reason.
 #![allow(clippy::print_stdout)]
 
+mod pipeline_cmd;
+mod progress;
 mod simulate;
 
 use std::process::ExitCode;
@@ -23,6 +26,12 @@ struct Cli {
 enum Command {
     /// Simulate one scene file and print its energy fractions as one JSON object.
     Simulate(simulate::Args),
+    /// Bring pipeline stages up to date: stale or missing ones only, upstream first.
+    Run(pipeline_cmd::RunArgs),
+    /// Show each stage as fresh, stale or missing, and why.
+    Status(pipeline_cmd::StatusArgs),
+    /// Compare two result files or trees; exit 1 when they differ beyond tolerance.
+    Diff(pipeline_cmd::DiffArgs),
 }
 
 /// A failure with the exit code it maps to.
@@ -32,6 +41,14 @@ pub(crate) struct Failure {
 }
 
 impl Failure {
+    /// A failure with its own exit code.
+    pub(crate) fn new(code: u8, error: impl Into<anyhow::Error>) -> Self {
+        Self {
+            code,
+            error: error.into(),
+        }
+    }
+
     /// Bad input: exit code 2.
     pub(crate) fn input(error: impl Into<anyhow::Error>) -> Self {
         Self {
@@ -53,6 +70,13 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(args) => simulate::run(&args),
+        Command::Run(args) => pipeline_cmd::run_command(&args),
+        Command::Status(args) => pipeline_cmd::status_command(&args),
+        Command::Diff(args) => match pipeline_cmd::diff_command(&args) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(1),
+            Err(f) => Err(f),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -59,6 +59,23 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         file: path.to_path_buf(),
         reason: e.to_string().trim_end().to_string(),
     })?;
+    validated(raw, path)
+}
+
+/// Validates a scene given as an already parsed TOML table (a pipeline sweep builds one per
+/// parameter point); `path` only names the source in errors.
+pub fn from_table(table: toml::Table, path: &Path) -> Result<Scene, SceneError> {
+    let raw: raw::SceneFile =
+        toml::Value::Table(table)
+            .try_into()
+            .map_err(|e: toml::de::Error| SceneError::Syntax {
+                file: path.to_path_buf(),
+                reason: e.to_string().trim_end().to_string(),
+            })?;
+    validated(raw, path)
+}
+
+fn validated(raw: raw::SceneFile, path: &Path) -> Result<Scene, SceneError> {
     resolve::resolve(raw).map_err(|(key, reason)| SceneError::Invalid {
         file: path.to_path_buf(),
         key,

@@ -1,0 +1,114 @@
+//! `woodpile run`, `status` and `diff` through the real binary: exit codes and the messages a
+//! user reads first.
+#![allow(clippy::unwrap_used)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const SWEEP: &str = r#"
+kind = "sweep"
+[axes]
+eps = [0.5, 1.0]
+[scene]
+chain = { n = 10 }
+impulse = { site = -5 }
+run = { t_end = 10.0, method = "rk4", dt = 0.02, sample_every = 5.0 }
+[[scene.defect]]
+site = 0
+eps = "$eps"
+"#;
+
+fn woodpile(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn project() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("pipeline")).unwrap();
+    std::fs::write(dir.path().join("pipeline/sweep.toml"), SWEEP).unwrap();
+    dir
+}
+
+#[test]
+fn run_status_and_diff_exit_codes() {
+    let dir = project();
+    let d = dir.path();
+    let dry = woodpile(d, &["run", "--dry-run"]);
+    assert!(dry.status.success());
+    assert!(
+        text(&dry.stdout).contains("would run sweep: missing"),
+        "{}",
+        text(&dry.stdout)
+    );
+    assert!(text(&dry.stdout).contains("2 scenes: 0 cached, 2 to simulate"));
+    assert_eq!(woodpile(d, &["status", "--check"]).status.code(), Some(1));
+
+    assert!(woodpile(d, &["run"]).status.success());
+    assert!(woodpile(d, &["run", "--results", "other"]).status.success());
+    assert_eq!(woodpile(d, &["status", "--check"]).status.code(), Some(0));
+    let same = woodpile(d, &["diff", "results", "other"]);
+    assert_eq!(same.status.code(), Some(0), "{}", text(&same.stdout));
+    assert!(text(&same.stdout).contains("AGREE"));
+
+    // An edit makes the stage stale, and status says which parameter changed.
+    std::fs::write(
+        d.join("pipeline/sweep.toml"),
+        SWEEP.replace("dt = 0.02", "dt = 0.04"),
+    )
+    .unwrap();
+    let status = woodpile(d, &["status"]);
+    assert!(
+        text(&status.stdout).contains("stale    parameter scene.run.dt: 0.02 -> 0.04"),
+        "{}",
+        text(&status.stdout)
+    );
+    assert!(woodpile(d, &["run", "--results", "other"]).status.success());
+    let differ = woodpile(d, &["diff", "results", "other"]);
+    assert_eq!(differ.status.code(), Some(1), "{}", text(&differ.stdout));
+    assert!(text(&differ.stdout).contains("DIFFER"));
+    let loose = woodpile(
+        d,
+        &[
+            "diff",
+            "results/sweep.parquet",
+            "other/sweep.parquet",
+            "--abs",
+            "1",
+            "--tol",
+            "scene_key=0",
+        ],
+    );
+    // Keys are strings: no numeric tolerance makes two different scenes equal.
+    assert_eq!(loose.status.code(), Some(1));
+}
+
+#[test]
+fn bad_stage_files_and_unknown_stages_exit_2_naming_file_and_key() {
+    let dir = project();
+    let d = dir.path();
+    let unknown = woodpile(d, &["run", "nope"]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(text(&unknown.stderr).contains("no stage named `nope`"));
+    std::fs::write(
+        d.join("pipeline/sweep.toml"),
+        SWEEP.replace("[axes]", "[axes]\nfoo = \"x\""),
+    )
+    .unwrap();
+    let bad = woodpile(d, &["status"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let err = text(&bad.stderr);
+    assert!(
+        err.contains("sweep.toml") && err.contains("axes.foo"),
+        "{err}"
+    );
+    let missing = woodpile(d, &["diff", "results", "nowhere"]);
+    assert_eq!(missing.status.code(), Some(2));
+}

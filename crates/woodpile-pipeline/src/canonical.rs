@@ -1,0 +1,213 @@
+//! Cache keys: a blake3 hash of a canonical JSON text, never `std::hash` (which may change
+//! between Rust versions and would silently invalidate, or worse alias, cached results).
+//!
+//! Canonical means: object keys sorted (serde_json's map is a `BTreeMap` here), numbers in
+//! their shortest round-trip form, no whitespace. Two descriptions that mean the same thing
+//! must hash the same, so scenes are hashed in their *resolved* form ([`scene_json`]): a sweep
+//! that spells out a default and one that omits it share their cached points.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use serde_json::{json, Map, Value};
+use woodpile_scene::Scene;
+use woodpile_sim::integrate::MethodChoice;
+use woodpile_sim::Boundary;
+
+/// The version every cache key includes. Bump [`NUMERICS_REVISION`] whenever a change can alter
+/// a computed number without changing a stage file: every cached result then goes stale.
+pub fn code_version() -> String {
+    format!(
+        "woodpile {} r{NUMERICS_REVISION}",
+        env!("CARGO_PKG_VERSION")
+    )
+}
+
+/// Revision of the numerics and reductions (see [`code_version`]).
+pub const NUMERICS_REVISION: u32 = 1;
+
+/// A 256-bit content hash, shown as 64 lowercase hex digits.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Key(String);
+
+impl Key {
+    /// The key of `value`'s canonical JSON text.
+    pub fn of(value: &Value) -> Key {
+        let text = value.to_string();
+        Key(blake3::hash(text.as_bytes()).to_hex().to_string())
+    }
+
+    /// Wraps a stored hex key (as read back from a manifest).
+    pub fn from_hex(hex: &str) -> Key {
+        Key(hex.to_string())
+    }
+
+    /// The hex digits.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+
+    /// The first 12 hex digits, for messages.
+    pub fn short(&self) -> &str {
+        &self.0[..12.min(self.0.len())]
+    }
+}
+
+impl fmt::Display for Key {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// A TOML value as JSON (for hashing and for manifests). TOML datetimes become strings.
+pub fn toml_to_json(value: &toml::Value) -> Value {
+    match value {
+        toml::Value::String(s) => Value::String(s.clone()),
+        toml::Value::Integer(i) => json!(i),
+        toml::Value::Float(x) => json!(x),
+        toml::Value::Boolean(b) => json!(b),
+        toml::Value::Datetime(d) => Value::String(d.to_string()),
+        toml::Value::Array(items) => Value::Array(items.iter().map(toml_to_json).collect()),
+        toml::Value::Table(table) => Value::Object(
+            table
+                .iter()
+                .map(|(k, v)| (k.clone(), toml_to_json(v)))
+                .collect::<Map<_, _>>(),
+        ),
+    }
+}
+
+/// Every leaf of `value` by dotted path (`scene.run.tolerance`, `axes.L[2]`), for saying which
+/// parameter changed between two versions of a stage.
+pub fn flatten(value: &Value) -> BTreeMap<String, String> {
+    fn walk(prefix: &str, value: &Value, out: &mut BTreeMap<String, String>) {
+        match value {
+            Value::Object(map) => {
+                for (k, v) in map {
+                    let path = if prefix.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    walk(&path, v, out);
+                }
+            }
+            Value::Array(items) => {
+                for (i, v) in items.iter().enumerate() {
+                    walk(&format!("{prefix}[{i}]"), v, out);
+                }
+            }
+            leaf => {
+                out.insert(prefix.to_string(), leaf.to_string());
+            }
+        }
+    }
+    let mut out = BTreeMap::new();
+    walk("", value, &mut out);
+    out
+}
+
+/// The dotted paths whose values differ between `old` and `new` (added, removed or changed),
+/// each as `path: old -> new`.
+pub fn changed_paths(old: &Value, new: &Value) -> Vec<String> {
+    let (a, b) = (flatten(old), flatten(new));
+    let mut paths: Vec<&String> = a.keys().chain(b.keys()).collect();
+    paths.sort();
+    paths.dedup();
+    paths
+        .into_iter()
+        .filter(|p| a.get(*p) != b.get(*p))
+        .map(|p| {
+            let show = |v: Option<&String>| v.cloned().unwrap_or_else(|| "(absent)".into());
+            format!("{p}: {} -> {}", show(a.get(p)), show(b.get(p)))
+        })
+        .collect()
+}
+
+/// The resolved scene as canonical JSON: everything that determines the simulated numbers and
+/// nothing else (no file names, no spelling of defaults).
+pub fn scene_json(scene: &Scene) -> Value {
+    let s = &scene.scenario;
+    let model = &s.model;
+    let masses: Vec<f64> = (0..model.n_sites()).map(|i| model.site_mass(i)).collect();
+    let unit_masses = masses.iter().all(|&m| m == 1.0);
+    let resonators: Vec<Value> = model
+        .resonators()
+        .iter()
+        .map(|r| {
+            let coupling = match r.coupling {
+                woodpile_sim::Coupling::Constant(k) => json!(k),
+                woodpile_sim::Coupling::Ramp { k1, k2, t0, tau } => {
+                    json!({"k1": k1, "k2": k2, "t0": t0, "tau": tau})
+                }
+            };
+            json!({"site": r.site, "eps": r.eps, "kappa": coupling, "p": r.p})
+        })
+        .collect();
+    let method = match s.method {
+        MethodChoice::Auto => "auto",
+        MethodChoice::Named(m) => m.name(),
+    };
+    json!({
+        "sites": model.n_sites(),
+        "boundary": match model.boundary() { Boundary::Fixed => "fixed", Boundary::Free => "free" },
+        "masses": if unit_masses { Value::Null } else { json!(masses) },
+        "resonators": resonators,
+        "impulse": {"site": s.impulse_site, "velocity": s.impulse_velocity},
+        "t_end": s.t_end,
+        "region": [s.region.lo(), s.region.hi()],
+        "method": method,
+        "tolerance": s.accuracy.tolerance,
+        "tolerance_explicit": s.accuracy.tolerance_explicit,
+        "dt": s.accuracy.dt,
+        "sample_every": s.sample_every,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn key_ignores_key_order_and_sees_every_value() {
+        let a: Value = serde_json::from_str(r#"{"b": 1, "a": [1.5, "x"]}"#).unwrap();
+        let b: Value = serde_json::from_str(r#"{"a": [1.5, "x"], "b": 1}"#).unwrap();
+        let c: Value = serde_json::from_str(r#"{"a": [1.5, "x"], "b": 2}"#).unwrap();
+        assert_eq!(Key::of(&a), Key::of(&b));
+        assert_ne!(Key::of(&a), Key::of(&c));
+        assert_eq!(Key::of(&a).as_str().len(), 64);
+    }
+
+    #[test]
+    fn changed_paths_names_each_difference() {
+        let old = json!({"axes": {"L": [0, 2]}, "scene": {"run": {"tolerance": 1e-6}}});
+        let new = json!({"axes": {"L": [0, 3]}, "scene": {"run": {"tolerance": 1e-6, "dt": 0.1}}});
+        assert_eq!(
+            changed_paths(&old, &new),
+            vec![
+                "axes.L[1]: 2 -> 3".to_string(),
+                "scene.run.dt: (absent) -> 0.1".to_string()
+            ]
+        );
+    }
+
+    #[test]
+    fn scenes_that_mean_the_same_hash_the_same() {
+        let path = std::path::Path::new("t.toml");
+        let explicit = woodpile_scene::parse(
+            "[chain]\nn = 100\nboundary = \"fixed\"\n[[defect]]\nsite = 0\neps = 10.0\n",
+            path,
+        )
+        .unwrap();
+        let implicit = woodpile_scene::parse("[[defect]]\nsite = 0\neps = 10.0\n", path).unwrap();
+        let other = woodpile_scene::parse("[[defect]]\nsite = 0\neps = 10.5\n", path).unwrap();
+        assert_eq!(
+            Key::of(&scene_json(&explicit)),
+            Key::of(&scene_json(&implicit))
+        );
+        assert_ne!(
+            Key::of(&scene_json(&explicit)),
+            Key::of(&scene_json(&other))
+        );
+    }
+}

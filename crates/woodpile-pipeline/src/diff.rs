@@ -1,0 +1,313 @@
+//! `woodpile diff A B`: two result files, or two result trees, compared column by column.
+//!
+//! A value pair passes when |a - b| <= abs + rel * max(|a|, |b|) (both nulls, or both NaN,
+//! are equal; one null is a difference). Strings must match exactly. Missing files, missing
+//! columns and row-count mismatches are structural problems and always fail.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::DataFrame;
+
+use crate::error::{PipelineError, Result};
+use crate::table::{f64_column, read, str_column};
+
+/// Absolute and relative tolerance of one column.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Tolerance {
+    /// Absolute part.
+    pub abs: f64,
+    /// Relative part.
+    pub rel: f64,
+}
+
+/// Tolerances: a default and per-column overrides.
+#[derive(Debug, Clone, Default)]
+pub struct DiffOptions {
+    /// For every column not named in `columns`.
+    pub default: Tolerance,
+    /// Per column name.
+    pub columns: BTreeMap<String, Tolerance>,
+}
+
+/// One compared value pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Difference {
+    /// File (relative to the compared trees).
+    pub file: String,
+    /// Column.
+    pub column: String,
+    /// Row.
+    pub row: usize,
+    /// Value in A, as text.
+    pub a: String,
+    /// Value in B, as text.
+    pub b: String,
+    /// |a - b| (infinite for a null against a value, or unequal strings).
+    pub abs: f64,
+    /// |a - b| / max(|a|, |b|).
+    pub rel: f64,
+    /// |a - b| over what the tolerance allows: > 1 fails.
+    pub excess: f64,
+}
+
+/// The comparison's outcome.
+#[derive(Debug, Clone, Default)]
+pub struct DiffReport {
+    /// Files compared.
+    pub files: usize,
+    /// Values compared.
+    pub values: u64,
+    /// Values beyond tolerance.
+    pub beyond: u64,
+    /// Structural problems (missing files or columns, different row counts).
+    pub problems: Vec<String>,
+    /// The largest differences, worst first (at most [`WORST`]), within tolerance or not.
+    pub worst: Vec<Difference>,
+}
+
+impl DiffReport {
+    /// Whether A and B agree within tolerance.
+    pub fn agrees(&self) -> bool {
+        self.beyond == 0 && self.problems.is_empty()
+    }
+}
+
+/// How many differences a report keeps.
+pub const WORST: usize = 10;
+
+/// Compares `a` and `b`: two parquet files, or two directories of them (the point cache
+/// under `points/` is skipped: it is an input to results, not a result).
+pub fn diff(a: &Path, b: &Path, options: &DiffOptions) -> Result<DiffReport> {
+    let mut report = DiffReport::default();
+    if a.is_dir() && b.is_dir() {
+        let (fa, fb) = (parquet_files(a)?, parquet_files(b)?);
+        for name in fa.keys().filter(|n| !fb.contains_key(*n)) {
+            report
+                .problems
+                .push(format!("{name}: only in {}", a.display()));
+        }
+        for name in fb.keys().filter(|n| !fa.contains_key(*n)) {
+            report
+                .problems
+                .push(format!("{name}: only in {}", b.display()));
+        }
+        for (name, pa) in &fa {
+            if let Some(pb) = fb.get(name) {
+                compare_files(name, pa, pb, options, &mut report)?;
+            }
+        }
+    } else if a.is_file() && b.is_file() {
+        let name = a
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        compare_files(&name, a, b, options, &mut report)?;
+    } else {
+        return Err(PipelineError::io(
+            if a.exists() { b } else { a },
+            "expected two files or two directories that exist",
+        ));
+    }
+    report.worst.sort_by(|x, y| y.excess.total_cmp(&x.excess));
+    report.worst.truncate(WORST);
+    Ok(report)
+}
+
+fn parquet_files(root: &Path) -> Result<BTreeMap<String, PathBuf>> {
+    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, PathBuf>) -> Result<()> {
+        let entries = std::fs::read_dir(dir).map_err(|e| PipelineError::io(dir, e))?;
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let rel = path
+                .strip_prefix(root)
+                .unwrap_or(&path)
+                .to_string_lossy()
+                .into_owned();
+            if path.is_dir() {
+                if rel != "points" {
+                    walk(root, &path, out)?;
+                }
+            } else if path.extension().is_some_and(|x| x == "parquet") {
+                out.insert(rel, path);
+            }
+        }
+        Ok(())
+    }
+    let mut out = BTreeMap::new();
+    walk(root, root, &mut out)?;
+    Ok(out)
+}
+
+fn compare_files(
+    name: &str,
+    a: &Path,
+    b: &Path,
+    options: &DiffOptions,
+    report: &mut DiffReport,
+) -> Result<()> {
+    let (fa, fb) = (read(a)?, read(b)?);
+    report.files += 1;
+    let names = |f: &DataFrame| {
+        f.get_column_names()
+            .iter()
+            .map(|n| n.to_string())
+            .collect::<Vec<_>>()
+    };
+    let (ca, cb) = (names(&fa), names(&fb));
+    for c in ca.iter().filter(|c| !cb.contains(c)) {
+        report
+            .problems
+            .push(format!("{name}: column `{c}` only in {}", a.display()));
+    }
+    for c in cb.iter().filter(|c| !ca.contains(c)) {
+        report
+            .problems
+            .push(format!("{name}: column `{c}` only in {}", b.display()));
+    }
+    if fa.height() != fb.height() {
+        report.problems.push(format!(
+            "{name}: {} rows against {}",
+            fa.height(),
+            fb.height()
+        ));
+        return Ok(());
+    }
+    for column in ca.iter().filter(|c| cb.contains(c)) {
+        let tol = options
+            .columns
+            .get(column)
+            .copied()
+            .unwrap_or(options.default);
+        let numeric = |f: &DataFrame| {
+            f.column(column)
+                .map(|c| c.dtype().is_primitive_numeric())
+                .unwrap_or(false)
+        };
+        let mut worst: Option<Difference> = None;
+        let mut consider = |d: Difference, report: &mut DiffReport| {
+            if d.excess > 1.0 {
+                report.beyond += 1;
+            }
+            if worst.as_ref().is_none_or(|w| d.excess > w.excess) {
+                worst = Some(d);
+            }
+        };
+        if numeric(&fa) && numeric(&fb) {
+            let (va, vb) = (f64_column(&fa, column)?, f64_column(&fb, column)?);
+            for (row, (x, y)) in va.iter().zip(&vb).enumerate() {
+                report.values += 1;
+                if let Some(d) = compare_numbers(*x, *y, tol) {
+                    consider(
+                        Difference {
+                            file: name.into(),
+                            column: column.clone(),
+                            row,
+                            ..d
+                        },
+                        report,
+                    );
+                }
+            }
+        } else {
+            let as_text = |f: &DataFrame| -> Result<Vec<Option<String>>> {
+                let c = f
+                    .column(column)
+                    .and_then(|c| c.cast(&polars::prelude::DataType::String))
+                    .map_err(|e| PipelineError::io(name, e))?;
+                str_column(
+                    &DataFrame::new_infer_height(vec![c])
+                        .map_err(|e| PipelineError::io(name, e))?,
+                    column,
+                )
+            };
+            let (va, vb) = (as_text(&fa)?, as_text(&fb)?);
+            for (row, (x, y)) in va.iter().zip(&vb).enumerate() {
+                report.values += 1;
+                if x != y {
+                    let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "null".into());
+                    consider(
+                        Difference {
+                            file: name.into(),
+                            column: column.clone(),
+                            row,
+                            a: show(x),
+                            b: show(y),
+                            abs: f64::INFINITY,
+                            rel: f64::INFINITY,
+                            excess: f64::INFINITY,
+                        },
+                        report,
+                    );
+                }
+            }
+        }
+        report.worst.extend(worst);
+    }
+    Ok(())
+}
+
+/// `None` when equal; otherwise the difference (file, column and row left blank).
+fn compare_numbers(x: Option<f64>, y: Option<f64>, tol: Tolerance) -> Option<Difference> {
+    let show = |v: Option<f64>| v.map_or("null".to_string(), |v| format!("{v:e}"));
+    let blank = |abs: f64, rel: f64, excess: f64| Difference {
+        file: String::new(),
+        column: String::new(),
+        row: 0,
+        a: show(x),
+        b: show(y),
+        abs,
+        rel,
+        excess,
+    };
+    match (x, y) {
+        (None, None) => None,
+        (Some(a), Some(b)) if a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()) => None,
+        (Some(a), Some(b)) => {
+            let abs = (a - b).abs();
+            let scale = a.abs().max(b.abs());
+            let rel = if scale > 0.0 { abs / scale } else { 0.0 };
+            let allowed = tol.abs + tol.rel * scale;
+            let excess = if allowed > 0.0 {
+                abs / allowed
+            } else if abs > 0.0 {
+                f64::INFINITY
+            } else {
+                0.0
+            };
+            let excess = if abs.is_nan() { f64::INFINITY } else { excess };
+            Some(blank(abs, rel, excess))
+        }
+        _ => Some(blank(f64::INFINITY, f64::INFINITY, f64::INFINITY)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tolerance_is_absolute_plus_relative() {
+        let tol = Tolerance {
+            abs: 1e-9,
+            rel: 1e-6,
+        };
+        assert!(compare_numbers(Some(1.0), Some(1.0), Tolerance::default()).is_none());
+        assert!(compare_numbers(None, None, Tolerance::default()).is_none());
+        assert!(compare_numbers(Some(f64::NAN), Some(f64::NAN), Tolerance::default()).is_none());
+        let within = compare_numbers(Some(1.0), Some(1.0 + 5e-7), tol).unwrap();
+        assert!(within.excess < 1.0);
+        let beyond = compare_numbers(Some(1.0), Some(1.0 + 5e-6), tol).unwrap();
+        assert!(beyond.excess > 1.0);
+        assert!(
+            compare_numbers(Some(0.0), Some(1e-300), Tolerance::default())
+                .unwrap()
+                .excess
+                > 1.0
+        );
+        assert_eq!(
+            compare_numbers(None, Some(0.0), tol).unwrap().excess,
+            f64::INFINITY
+        );
+    }
+}

@@ -1,0 +1,72 @@
+//! Everything that can stop the pipeline, each naming the file (and key) it concerns.
+
+use std::path::PathBuf;
+
+/// A pipeline failure.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// A stage file (or the pipeline directory as a whole) is not a valid definition.
+    #[error("{file}: key `{key}`: {reason}")]
+    Definition {
+        /// The stage file.
+        file: PathBuf,
+        /// Dotted key path, e.g. `axes.eps.step`.
+        key: String,
+        /// Why it is rejected.
+        reason: String,
+    },
+    /// A stage file could not be read or parsed as TOML.
+    #[error("{file}: {reason}")]
+    Syntax {
+        /// The stage file.
+        file: PathBuf,
+        /// The parser's or the OS's message.
+        reason: String,
+    },
+    /// A stage named on the command line does not exist.
+    #[error("no stage named `{name}` (stages: {known})")]
+    UnknownStage {
+        /// The name asked for.
+        name: String,
+        /// The names that exist, comma separated.
+        known: String,
+    },
+    /// A file could not be read or written.
+    #[error("{path}: {reason}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// A stage ran but cannot produce its output (bad data from upstream, impossible
+    /// reduction, ...).
+    #[error("stage `{stage}`: {reason}")]
+    Stage {
+        /// The stage.
+        stage: String,
+        /// Why it failed.
+        reason: String,
+    },
+}
+
+impl PipelineError {
+    /// An IO error on `path`.
+    pub fn io(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
+        Self::Io {
+            path: path.into(),
+            reason: e.to_string(),
+        }
+    }
+
+    /// A stage failure.
+    pub fn stage(stage: &str, reason: impl Into<String>) -> Self {
+        Self::Stage {
+            stage: stage.to_string(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Result alias of this crate.
+pub type Result<T, E = PipelineError> = std::result::Result<T, E>;

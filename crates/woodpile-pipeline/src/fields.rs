@@ -1,0 +1,162 @@
+//! Reading a stage file's TOML table key by key, so that every error names the exact key: a
+//! value of the wrong type, a missing required key, or a key nobody asked for (a typo must
+//! never be silently ignored).
+
+use std::path::Path;
+
+use crate::error::PipelineError;
+
+/// The keys of one TOML table not yet consumed.
+pub(crate) struct Fields<'a> {
+    file: &'a Path,
+    prefix: String,
+    table: toml::Table,
+}
+
+impl<'a> Fields<'a> {
+    /// `table`, found at dotted path `prefix` ("" for the file's top level) of `file`.
+    pub(crate) fn new(file: &'a Path, prefix: &str, table: toml::Table) -> Self {
+        Self {
+            file,
+            prefix: prefix.to_string(),
+            table,
+        }
+    }
+
+    /// The dotted path of `key` in this table.
+    pub(crate) fn path(&self, key: &str) -> String {
+        if self.prefix.is_empty() {
+            key.to_string()
+        } else {
+            format!("{}.{key}", self.prefix)
+        }
+    }
+
+    /// An error about `key` of this table.
+    pub(crate) fn error(&self, key: &str, reason: impl Into<String>) -> PipelineError {
+        PipelineError::Definition {
+            file: self.file.to_path_buf(),
+            key: self.path(key),
+            reason: reason.into(),
+        }
+    }
+
+    /// An error about this table as a whole.
+    pub(crate) fn error_here(&self, reason: impl Into<String>) -> PipelineError {
+        PipelineError::Definition {
+            file: self.file.to_path_buf(),
+            key: self.prefix.clone(),
+            reason: reason.into(),
+        }
+    }
+
+    /// `table`, found at `key` of this table, as its own [`Fields`].
+    pub(crate) fn nested(&self, key: &str, table: toml::Table) -> Fields<'a> {
+        Fields::new(self.file, &self.path(key), table)
+    }
+
+    /// The keys not yet consumed, sorted.
+    pub(crate) fn keys(&self) -> Vec<String> {
+        self.table.keys().cloned().collect()
+    }
+
+    /// The file these fields come from.
+    pub(crate) fn file(&self) -> &'a Path {
+        self.file
+    }
+
+    /// Removes and returns `key`'s raw value.
+    pub(crate) fn take(&mut self, key: &str) -> Option<toml::Value> {
+        self.table.remove(key)
+    }
+
+    /// A required value of type `T`.
+    pub(crate) fn required<T: FromToml>(&mut self, key: &str) -> Result<T, PipelineError> {
+        self.optional(key)?
+            .ok_or_else(|| self.error(key, format!("missing (expected {})", T::EXPECTED)))
+    }
+
+    /// An optional value of type `T`.
+    pub(crate) fn optional<T: FromToml>(&mut self, key: &str) -> Result<Option<T>, PipelineError> {
+        match self.table.remove(key) {
+            None => Ok(None),
+            Some(value) => T::from_toml(value)
+                .map(Some)
+                .ok_or_else(|| self.error(key, format!("expected {}", T::EXPECTED))),
+        }
+    }
+
+    /// Rejects every key left unconsumed.
+    pub(crate) fn finish(self) -> Result<(), PipelineError> {
+        match self.table.keys().next() {
+            None => Ok(()),
+            Some(key) => Err(self.error(key, "unknown key")),
+        }
+    }
+}
+
+/// A Rust type a TOML value converts to.
+pub(crate) trait FromToml: Sized {
+    /// What the error says was expected.
+    const EXPECTED: &'static str;
+    /// The conversion, or `None` for a value of the wrong type.
+    fn from_toml(value: toml::Value) -> Option<Self>;
+}
+
+impl FromToml for String {
+    const EXPECTED: &'static str = "a string";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        match value {
+            toml::Value::String(s) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+impl FromToml for f64 {
+    const EXPECTED: &'static str = "a number";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        match value {
+            toml::Value::Float(x) if x.is_finite() => Some(x),
+            toml::Value::Integer(i) => Some(i as f64),
+            _ => None,
+        }
+    }
+}
+
+impl FromToml for i64 {
+    const EXPECTED: &'static str = "an integer";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        match value {
+            toml::Value::Integer(i) => Some(i),
+            _ => None,
+        }
+    }
+}
+
+impl FromToml for Vec<String> {
+    const EXPECTED: &'static str = "an array of strings";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        match value {
+            toml::Value::Array(items) => items.into_iter().map(String::from_toml).collect(),
+            _ => None,
+        }
+    }
+}
+
+impl FromToml for toml::Table {
+    const EXPECTED: &'static str = "a table";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        match value {
+            toml::Value::Table(t) => Some(t),
+            _ => None,
+        }
+    }
+}
+
+impl FromToml for toml::Value {
+    const EXPECTED: &'static str = "a value";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        Some(value)
+    }
+}

@@ -1,0 +1,44 @@
+//! The figure pipeline: stages declared in TOML (`pipeline/*.toml`), forming a DAG, each
+//! writing one parquet table under `results/` whose metadata records its cache key and
+//! everything the key was computed from.
+//!
+//! - [`stage`], [`pipeline`]: parse stage files, check the DAG, compute the keys.
+//! - [`sweep`] (with [`grid`], [`template`], [`points`]): simulate parameter grids, cached
+//!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
+//! - [`reduce`]: read fractions at a time, maximise over axes.
+//! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
+//! - [`diff`]: compare two result trees with tolerances (CI's regression check).
+//! - [`table`], [`manifest`], [`atomic`], [`canonical`]: parquet IO, self-description, atomic
+//!   writes, blake3 keys of canonical JSON.
+//!
+//! Nothing here prints: progress goes to an [`events::Events`] implementation.
+#![warn(missing_docs)]
+
+pub mod atomic;
+pub mod canonical;
+pub mod diff;
+pub mod error;
+pub mod events;
+mod fields;
+pub mod grid;
+pub mod manifest;
+pub mod pipeline;
+pub mod points;
+pub mod reduce;
+pub mod run;
+pub mod stage;
+pub mod status;
+pub mod sweep;
+pub mod table;
+pub mod template;
+
+pub use error::{PipelineError, Result};
+pub use pipeline::Pipeline;
+
+/// What a stage computed, before it is written with its manifest.
+pub struct Output {
+    /// The table.
+    pub frame: polars::prelude::DataFrame,
+    /// Kind-specific facts for the manifest.
+    pub summary: serde_json::Value,
+}

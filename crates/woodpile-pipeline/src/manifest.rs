@@ -1,0 +1,41 @@
+//! What a stage output says about itself: the stage, its cache key, and everything the key was
+//! computed from, so that `woodpile status` can say *why* a result is stale.
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// The parquet metadata key holding the manifest.
+pub const METADATA_KEY: &str = "woodpile";
+
+/// A stage output's description of itself.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// The stage name.
+    pub stage: String,
+    /// Its kind (`sweep`, `reduce`, ...).
+    pub kind: String,
+    /// The cache key (hex blake3) of everything below.
+    pub key: String,
+    /// The code version the key includes.
+    pub code_version: String,
+    /// The stage's parameters: its file without `description`.
+    pub params: Value,
+    /// Upstream stage name to the key of the output this one was computed from.
+    pub inputs: BTreeMap<String, String>,
+    /// Kind-specific facts about the result (points, failures, method, tolerance, ...).
+    pub summary: Value,
+}
+
+impl Manifest {
+    /// The manifest as one line of JSON.
+    pub fn to_json_text(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// Parses [`Manifest::to_json_text`]'s output.
+    pub fn from_json_text(text: &str) -> Result<Self, serde_json::Error> {
+        serde_json::from_str(text)
+    }
+}

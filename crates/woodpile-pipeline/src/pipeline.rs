@@ -1,0 +1,268 @@
+//! The DAG of stages in a pipeline directory: every `*.toml` file is a stage named by its stem.
+//! Loading checks what no single file can: inputs that name no stage, inputs of the wrong kind,
+//! and cycles; then it orders the stages upstream first and computes every cache key.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+
+use serde_json::json;
+
+use crate::canonical::{code_version, Key};
+use crate::error::{PipelineError, Result};
+use crate::grid::Axis;
+use crate::stage::{Spec, Stage};
+
+/// A loaded, validated pipeline.
+#[derive(Debug, Clone)]
+pub struct Pipeline {
+    dir: PathBuf,
+    /// Upstream first.
+    stages: Vec<Stage>,
+    keys: Vec<Key>,
+    index: HashMap<String, usize>,
+}
+
+impl Pipeline {
+    /// Loads every stage file in `dir`.
+    pub fn load(dir: &Path) -> Result<Pipeline> {
+        let entries = std::fs::read_dir(dir).map_err(|e| PipelineError::io(dir, e))?;
+        let mut files: Vec<PathBuf> = entries
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        files.sort();
+        let stages = files
+            .iter()
+            .map(|f| Stage::load(f))
+            .collect::<Result<Vec<_>>>()?;
+        Pipeline::from_stages(dir, stages)
+    }
+
+    /// Validates and orders already parsed `stages`.
+    pub fn from_stages(dir: &Path, stages: Vec<Stage>) -> Result<Pipeline> {
+        let by_name: BTreeMap<&str, &Stage> = stages.iter().map(|s| (s.name.as_str(), s)).collect();
+        for stage in &stages {
+            check_names(stage, &by_name)?;
+        }
+        let order = topological_order(&stages)?;
+        for stage in &stages {
+            check_kinds(stage, &by_name)?;
+        }
+        let mut stages: Vec<Option<Stage>> = stages.into_iter().map(Some).collect();
+        let stages: Vec<Stage> = order.into_iter().filter_map(|i| stages[i].take()).collect();
+        let index: HashMap<String, usize> = stages
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (s.name.clone(), i))
+            .collect();
+        let mut keys: Vec<Key> = Vec::with_capacity(stages.len());
+        for stage in &stages {
+            let inputs: BTreeMap<&str, &str> = stage
+                .inputs
+                .iter()
+                .map(|name| (name.as_str(), keys[index[name]].as_str()))
+                .collect();
+            keys.push(Key::of(&json!({
+                "kind": stage.spec.kind(),
+                "params": stage.params,
+                "inputs": inputs,
+                "code": code_version(),
+            })));
+        }
+        Ok(Pipeline {
+            dir: dir.to_path_buf(),
+            stages,
+            keys,
+            index,
+        })
+    }
+
+    /// The directory the stages came from.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Every stage, upstream first.
+    pub fn stages(&self) -> &[Stage] {
+        &self.stages
+    }
+
+    /// The stage called `name`.
+    pub fn stage(&self, name: &str) -> Result<&Stage> {
+        self.index
+            .get(name)
+            .map(|&i| &self.stages[i])
+            .ok_or_else(|| PipelineError::UnknownStage {
+                name: name.to_string(),
+                known: self
+                    .stages
+                    .iter()
+                    .map(|s| s.name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            })
+    }
+
+    /// The current cache key of `name` (which must exist).
+    pub fn key(&self, name: &str) -> &Key {
+        &self.keys[self.index[name]]
+    }
+
+    /// The grid axes of sweep `name`, if it is one.
+    pub fn sweep_axes(&self, name: &str) -> Option<&[Axis]> {
+        match &self.stages[*self.index.get(name)?].spec {
+            Spec::Sweep(s) => Some(&s.axes),
+            _ => None,
+        }
+    }
+
+    /// `targets` and everything upstream of them, upstream first; every stage if `targets` is
+    /// empty.
+    pub fn selection(&self, targets: &[String]) -> Result<Vec<&Stage>> {
+        if targets.is_empty() {
+            return Ok(self.stages.iter().collect());
+        }
+        let mut wanted = vec![false; self.stages.len()];
+        let mut stack: Vec<usize> = Vec::new();
+        for t in targets {
+            self.stage(t)?;
+            stack.push(self.index[t]);
+        }
+        while let Some(i) = stack.pop() {
+            if !std::mem::replace(&mut wanted[i], true) {
+                stack.extend(self.stages[i].inputs.iter().map(|n| self.index[n]));
+            }
+        }
+        Ok(self
+            .stages
+            .iter()
+            .zip(wanted)
+            .filter(|(_, w)| *w)
+            .map(|(s, _)| s)
+            .collect())
+    }
+}
+
+fn definition_error(stage: &Stage, key: &str, reason: impl Into<String>) -> PipelineError {
+    PipelineError::Definition {
+        file: stage.file.clone(),
+        key: key.to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// Every input names a stage, once.
+fn check_names(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
+    for (i, input) in stage.inputs.iter().enumerate() {
+        if !by_name.contains_key(input.as_str()) {
+            let known: Vec<&str> = by_name.keys().copied().collect();
+            return Err(definition_error(
+                stage,
+                &format!("inputs[{i}]"),
+                format!("no stage named `{input}` (stages: {})", known.join(", ")),
+            ));
+        }
+        if stage.inputs[..i].contains(input) {
+            return Err(definition_error(
+                stage,
+                &format!("inputs[{i}]"),
+                format!("`{input}` is listed twice"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every input is of a kind the stage can read.
+fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
+    match &stage.spec {
+        Spec::Sweep(_) if !stage.inputs.is_empty() => Err(definition_error(
+            stage,
+            "inputs",
+            "a sweep reads no other stage",
+        )),
+        Spec::Reduce(reduce) => {
+            let [input] = stage.inputs.as_slice() else {
+                return Err(definition_error(
+                    stage,
+                    "inputs",
+                    "a reduce stage reads exactly one sweep",
+                ));
+            };
+            match &by_name[input.as_str()].spec {
+                Spec::Sweep(sweep) => reduce
+                    .check_axes(&sweep.axes)
+                    .map_err(|reason| definition_error(stage, "maximize.over", reason)),
+                other => Err(definition_error(
+                    stage,
+                    "inputs[0]",
+                    format!(
+                        "`{input}` is a {} stage; a reduce reads a sweep",
+                        other.kind()
+                    ),
+                )),
+            }
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Stage indices, every stage after its inputs; a cycle is an error naming its path.
+fn topological_order(stages: &[Stage]) -> Result<Vec<usize>> {
+    #[derive(Clone, Copy, PartialEq)]
+    enum Mark {
+        New,
+        Open,
+        Done,
+    }
+    let index: HashMap<&str, usize> = stages
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.name.as_str(), i))
+        .collect();
+    let mut marks = vec![Mark::New; stages.len()];
+    let mut order = Vec::with_capacity(stages.len());
+    let mut path: Vec<usize> = Vec::new();
+
+    fn visit(
+        i: usize,
+        stages: &[Stage],
+        index: &HashMap<&str, usize>,
+        marks: &mut [Mark],
+        path: &mut Vec<usize>,
+        order: &mut Vec<usize>,
+    ) -> Result<()> {
+        match marks[i] {
+            Mark::Done => return Ok(()),
+            Mark::Open => {
+                let start = path.iter().position(|&j| j == i).unwrap_or(0);
+                let mut names: Vec<&str> = path[start..]
+                    .iter()
+                    .map(|&j| stages[j].name.as_str())
+                    .collect();
+                names.push(&stages[i].name);
+                return Err(definition_error(
+                    &stages[i],
+                    "inputs",
+                    format!("cycle: {}", names.join(" -> ")),
+                ));
+            }
+            Mark::New => {}
+        }
+        marks[i] = Mark::Open;
+        path.push(i);
+        for input in &stages[i].inputs {
+            visit(index[input.as_str()], stages, index, marks, path, order)?;
+        }
+        path.pop();
+        marks[i] = Mark::Done;
+        order.push(i);
+        Ok(())
+    }
+
+    for i in 0..stages.len() {
+        visit(i, stages, &index, &mut marks, &mut path, &mut order)?;
+    }
+    Ok(order)
+}

@@ -1,0 +1,295 @@
+//! The per-point cache of a sweep: one small file per simulated scene, named by the scene's
+//! content key, shared by every stage (F4's points are found again by F5).
+//!
+//! A point is written atomically the moment it is finished, so a sweep stopped by Ctrl-C or
+//! `kill -9` resumes with every finished scene kept. Each file ends with a blake3 checksum of
+//! its contents: a file damaged after the fact (a full disk, a bad copy) reads as absent and is
+//! simply recomputed, never trusted.
+//!
+//! The format is private to this module (the stage outputs are the public parquet): magic
+//! `WPPT`, a format byte, the 64-hex key, the outcome, then the checksum. Floats are stored as
+//! their exact bits.
+
+use std::path::{Path, PathBuf};
+
+use woodpile_scene::Scene;
+use woodpile_sim::integrate::StepControl;
+use woodpile_sim::observe::FractionSeries;
+use woodpile_sim::run::simulate;
+
+use crate::atomic;
+use crate::canonical::Key;
+use crate::error::Result;
+
+const MAGIC: &[u8; 4] = b"WPPT";
+const FORMAT: u8 = 1;
+
+/// What simulating one scene gave: its fraction time series, or why it failed.
+pub type PointResult = std::result::Result<PointData, String>;
+
+/// A successful point: the sampled fractions and the facts that make them trustworthy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointData {
+    /// The method that produced the reported run.
+    pub method: String,
+    /// Its fixed step, if any.
+    pub dt: Option<f64>,
+    /// Steps of the reported run.
+    pub steps: u64,
+    /// Right-hand-side evaluations of every run made (auto's verification included).
+    pub rhs_evals: u64,
+    /// `auto`'s Richardson error estimate.
+    pub error_estimate: Option<f64>,
+    /// Largest relative energy drift (None where energy is not conserved).
+    pub energy_drift: Option<f64>,
+    /// E(0).
+    pub e_initial: f64,
+    /// E(t_end).
+    pub e_final: f64,
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// R(t).
+    pub reflected: Vec<f64>,
+    /// T(t).
+    pub transmitted: Vec<f64>,
+    /// E_tr(t).
+    pub trapped: Vec<f64>,
+    /// E(t).
+    pub energy: Vec<f64>,
+}
+
+/// Simulates `scene`, recording its fractions at every sample.
+pub fn simulate_point(scene: &Scene) -> PointResult {
+    let s = &scene.scenario;
+    let mut series = FractionSeries::new(&s.model, s.region);
+    let out = simulate(s, &mut series).map_err(|e| e.to_string())?;
+    Ok(PointData {
+        method: out.plan.method.name().to_string(),
+        dt: match out.plan.control {
+            StepControl::Fixed { dt } => Some(dt),
+            StepControl::Adaptive { .. } => None,
+        },
+        steps: out.stats.steps,
+        rhs_evals: out.total_rhs_evals,
+        error_estimate: out.error_estimate,
+        energy_drift: (!s.model.is_time_dependent()).then_some(out.stats.max_energy_drift),
+        e_initial: out.e_initial,
+        e_final: out.e_final,
+        t: series.t,
+        reflected: series.reflected,
+        transmitted: series.transmitted,
+        trapped: series.trapped,
+        energy: series.energy,
+    })
+}
+
+/// The directory of point files.
+#[derive(Debug, Clone)]
+pub struct PointStore {
+    dir: PathBuf,
+}
+
+impl PointStore {
+    /// A store rooted at `dir` (created on first write).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: dir.into() }
+    }
+
+    /// The root directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Where the point `key` lives: two-hex-digit fan-out keeps directories small.
+    pub fn path(&self, key: &Key) -> PathBuf {
+        self.dir
+            .join(&key.as_str()[..2])
+            .join(format!("{key}.wppt"))
+    }
+
+    /// The cached result of `key`, or `None` when absent or damaged.
+    pub fn load(&self, key: &Key) -> Option<PointResult> {
+        let bytes = std::fs::read(self.path(key)).ok()?;
+        decode(&bytes, key)
+    }
+
+    /// Stores `result` under `key`, atomically.
+    pub fn save(&self, key: &Key, result: &PointResult) -> Result<()> {
+        atomic::write(&self.path(key), &encode(key, result))
+    }
+
+    /// Removes leftovers of killed writers from the fan-out directory of `key`.
+    pub fn sweep_stale_temps(&self) -> usize {
+        let Ok(entries) = std::fs::read_dir(&self.dir) else {
+            return 0;
+        };
+        entries
+            .flatten()
+            .map(|e| atomic::sweep_stale_temps(&e.path()))
+            .sum()
+    }
+}
+
+fn encode(key: &Key, result: &PointResult) -> Vec<u8> {
+    let mut w = Vec::new();
+    w.extend_from_slice(MAGIC);
+    w.push(FORMAT);
+    put_str(&mut w, key.as_str());
+    match result {
+        Err(reason) => {
+            w.push(0);
+            put_str(&mut w, reason);
+        }
+        Ok(p) => {
+            w.push(1);
+            put_str(&mut w, &p.method);
+            for x in [p.dt, p.error_estimate, p.energy_drift] {
+                put_f64(&mut w, x.unwrap_or(f64::NAN));
+            }
+            w.extend_from_slice(&p.steps.to_le_bytes());
+            w.extend_from_slice(&p.rhs_evals.to_le_bytes());
+            put_f64(&mut w, p.e_initial);
+            put_f64(&mut w, p.e_final);
+            w.extend_from_slice(&(p.t.len() as u64).to_le_bytes());
+            for column in [&p.t, &p.reflected, &p.transmitted, &p.trapped, &p.energy] {
+                column.iter().for_each(|&x| put_f64(&mut w, x));
+            }
+        }
+    }
+    let checksum = blake3::hash(&w);
+    w.extend_from_slice(checksum.as_bytes());
+    w
+}
+
+fn put_str(w: &mut Vec<u8>, s: &str) {
+    w.extend_from_slice(&(s.len() as u64).to_le_bytes());
+    w.extend_from_slice(s.as_bytes());
+}
+
+fn put_f64(w: &mut Vec<u8>, x: f64) {
+    w.extend_from_slice(&x.to_bits().to_le_bytes());
+}
+
+fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
+    let (body, checksum) = bytes.split_at_checked(bytes.len().checked_sub(32)?)?;
+    if blake3::hash(body).as_bytes() != checksum {
+        return None;
+    }
+    let mut r = Reader { bytes: body };
+    if r.take(4)? != MAGIC || r.take(1)? != [FORMAT] || r.str()? != key.as_str() {
+        return None;
+    }
+    let result = match r.take(1)?[0] {
+        0 => Err(r.str()?),
+        1 => {
+            let method = r.str()?;
+            let optional = |x: f64| (!x.is_nan()).then_some(x);
+            let (dt, error_estimate, energy_drift) =
+                (optional(r.f64()?), optional(r.f64()?), optional(r.f64()?));
+            let (steps, rhs_evals) = (r.u64()?, r.u64()?);
+            let (e_initial, e_final) = (r.f64()?, r.f64()?);
+            let n = usize::try_from(r.u64()?).ok()?;
+            if r.bytes.len() != n.checked_mul(5 * 8)? {
+                return None;
+            }
+            let mut column = || (0..n).map(|_| r.f64()).collect::<Option<Vec<f64>>>();
+            Ok(PointData {
+                method,
+                dt,
+                steps,
+                rhs_evals,
+                error_estimate,
+                energy_drift,
+                e_initial,
+                e_final,
+                t: column()?,
+                reflected: column()?,
+                transmitted: column()?,
+                trapped: column()?,
+                energy: column()?,
+            })
+        }
+        _ => return None,
+    };
+    r.bytes.is_empty().then_some(result)
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let (head, tail) = self.bytes.split_at_checked(n)?;
+        self.bytes = tail;
+        Some(head)
+    }
+
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+
+    fn f64(&mut self) -> Option<f64> {
+        Some(f64::from_bits(self.u64()?))
+    }
+
+    fn str(&mut self) -> Option<String> {
+        let n = usize::try_from(self.u64()?).ok()?;
+        String::from_utf8(self.take(n)?.to_vec()).ok()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> PointData {
+        PointData {
+            method: "rk4".into(),
+            dt: Some(0.01),
+            steps: 15000,
+            rhs_evals: 90000,
+            error_estimate: Some(1.5e-9),
+            energy_drift: None,
+            e_initial: 0.5,
+            e_final: 0.5000000001,
+            t: vec![0.0, 1.0],
+            reflected: vec![0.0, 0.1],
+            transmitted: vec![0.0, 0.2],
+            trapped: vec![1.0, 0.7],
+            energy: vec![0.5, 0.5],
+        }
+    }
+
+    #[test]
+    fn points_round_trip_bit_for_bit() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = PointStore::new(dir.path());
+        let key = Key::of(&serde_json::json!(1));
+        assert_eq!(store.load(&key), None);
+        store.save(&key, &Ok(sample())).unwrap();
+        assert_eq!(store.load(&key), Some(Ok(sample())));
+        let failed = Key::of(&serde_json::json!(2));
+        store
+            .save(&failed, &Err("blew up at t = 3".into()))
+            .unwrap();
+        assert_eq!(store.load(&failed), Some(Err("blew up at t = 3".into())));
+    }
+
+    #[test]
+    fn damaged_or_misnamed_files_read_as_absent() {
+        let dir = tempfile::tempdir().unwrap();
+        let store = PointStore::new(dir.path());
+        let key = Key::of(&serde_json::json!("a"));
+        store.save(&key, &Ok(sample())).unwrap();
+        let path = store.path(&key);
+        let mut bytes = std::fs::read(&path).unwrap();
+        // Truncated (a torn copy) and bit-flipped files are both rejected.
+        assert_eq!(decode(&bytes[..bytes.len() - 1], &key), None);
+        bytes[40] ^= 1;
+        assert_eq!(decode(&bytes, &key), None);
+        // A valid file under another key's name is rejected too.
+        let good = std::fs::read(&path).unwrap();
+        assert_eq!(decode(&good, &Key::of(&serde_json::json!("b"))), None);
+    }
+}

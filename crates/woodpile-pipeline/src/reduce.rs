@@ -1,0 +1,292 @@
+//! `kind = "reduce"`: read a sweep's fractions at one time, one row per point, or the best
+//! point of each group.
+//!
+//! ```toml
+//! kind = "reduce"
+//! inputs = ["f4_sweep"]      # exactly one sweep
+//! at = 150.0                 # read-out time (a sample time of the sweep); default: t_end
+//! [maximize]                 # optional: keep, per value of the other axes, the point where
+//! column = "E_tr"            #   this column (E_tr, R or T) is largest
+//! over = ["eps"]             #   searching over these axes
+//! ```
+//!
+//! Because sweeps keep time series, changing `at` re-runs this stage only, never a simulation.
+
+use serde_json::json;
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::grid::Axis;
+use crate::table::{f64_column, str_column, Columns};
+use crate::Output;
+
+/// Columns a maximisation may target.
+pub const MAXIMIZABLE: &[&str] = &["E_tr", "R", "T"];
+
+/// A parsed reduce stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Reduce {
+    /// Read-out time; `None` means each point's last sample.
+    pub at: Option<f64>,
+    /// Optional maximisation.
+    pub maximize: Option<Maximize>,
+}
+
+/// Keep the best point per group.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Maximize {
+    /// The column maximised.
+    pub column: String,
+    /// The axes searched; the others form the groups.
+    pub over: Vec<String>,
+}
+
+impl Reduce {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Reduce> {
+        let at: Option<f64> = fields.optional("at")?;
+        if at.is_some_and(|t| t < 0.0) {
+            return Err(fields.error("at", "the read-out time must be >= 0"));
+        }
+        let maximize = match fields.optional::<toml::Table>("maximize")? {
+            None => None,
+            Some(table) => {
+                let mut m = fields.nested("maximize", table);
+                let column: String = m.optional("column")?.unwrap_or_else(|| "E_tr".into());
+                if !MAXIMIZABLE.contains(&column.as_str()) {
+                    return Err(m.error("column", format!("expected one of {MAXIMIZABLE:?}")));
+                }
+                let over: Vec<String> = m.required("over")?;
+                if over.is_empty() {
+                    return Err(m.error("over", "name at least one axis"));
+                }
+                m.finish()?;
+                Some(Maximize { column, over })
+            }
+        };
+        Ok(Reduce { at, maximize })
+    }
+
+    /// Checks the names in `maximize.over` against the input sweep's axes.
+    pub(crate) fn check_axes(&self, axes: &[Axis]) -> Result<(), String> {
+        for name in self.maximize.iter().flat_map(|m| &m.over) {
+            if !axes.iter().any(|a| &a.name == name) {
+                let known: Vec<&str> = axes.iter().map(|a| a.name.as_str()).collect();
+                return Err(format!(
+                    "`{name}` is not an axis of the input (axes: {known:?})"
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Reduces the sweep table `input`, whose grid axes are `axes`.
+    pub(crate) fn run(
+        &self,
+        stage: &str,
+        input: &polars::prelude::DataFrame,
+        axes: &[Axis],
+    ) -> Result<Output> {
+        let sweep = SweepRows::read(input, axes)?;
+        let picks = sweep
+            .read_out(self.at)
+            .map_err(|r| PipelineError::stage(stage, r))?;
+        let rows: Vec<Pick> = match &self.maximize {
+            None => picks,
+            Some(m) => maximize(&picks, axes, m),
+        };
+        let mut columns = Columns::new();
+        for (k, axis) in axes.iter().enumerate() {
+            let values = rows.iter().map(|p| Some(p.axes[k]));
+            if axis.is_integer() {
+                columns.i64(&axis.name, values.map(|v| v.map(|x| x as i64)).collect());
+            } else {
+                columns.f64(&axis.name, values.collect());
+            }
+        }
+        let col = |f: fn(&Pick) -> Option<f64>| rows.iter().map(f).collect::<Vec<_>>();
+        columns
+            .f64("t", col(|p| p.row.map(|r| r.t)))
+            .f64("R", col(|p| p.row.map(|r| r.r)))
+            .f64("T", col(|p| p.row.map(|r| r.tr)))
+            .f64("E_tr", col(|p| p.row.map(|r| r.e_tr)))
+            .f64("E", col(|p| p.row.map(|r| r.e)))
+            .f64(
+                "error_estimate",
+                col(|p| p.row.and_then(|r| r.error_estimate)),
+            )
+            .i64(
+                "points",
+                rows.iter().map(|p| Some(p.points as i64)).collect(),
+            )
+            .i64(
+                "failed",
+                rows.iter().map(|p| Some(p.failed as i64)).collect(),
+            )
+            .str("failure", rows.iter().map(|p| p.failure.clone()).collect());
+        let failed: usize = rows.iter().map(|p| p.failed).sum();
+        Ok(Output {
+            frame: columns.into_frame()?,
+            summary: json!({"rows": rows.len(), "failed_points": failed, "at": self.at}),
+        })
+    }
+}
+
+/// One sample row of a sweep.
+#[derive(Debug, Clone, Copy)]
+struct Row {
+    t: f64,
+    r: f64,
+    tr: f64,
+    e_tr: f64,
+    e: f64,
+    error_estimate: Option<f64>,
+}
+
+/// The chosen row of a point (or of a group, after maximisation).
+#[derive(Debug, Clone)]
+struct Pick {
+    axes: Vec<f64>,
+    row: Option<Row>,
+    points: usize,
+    failed: usize,
+    failure: Option<String>,
+}
+
+/// A sweep table as columns.
+struct SweepRows {
+    point: Vec<Option<f64>>,
+    axes: Vec<Vec<Option<f64>>>,
+    t: Vec<Option<f64>>,
+    r: Vec<Option<f64>>,
+    tr: Vec<Option<f64>>,
+    e_tr: Vec<Option<f64>>,
+    e: Vec<Option<f64>>,
+    error_estimate: Vec<Option<f64>>,
+    failure: Vec<Option<String>>,
+}
+
+impl SweepRows {
+    fn read(frame: &polars::prelude::DataFrame, axes: &[Axis]) -> Result<Self> {
+        Ok(Self {
+            point: f64_column(frame, "point")?,
+            axes: axes
+                .iter()
+                .map(|a| f64_column(frame, &a.name))
+                .collect::<Result<_>>()?,
+            t: f64_column(frame, "t")?,
+            r: f64_column(frame, "R")?,
+            tr: f64_column(frame, "T")?,
+            e_tr: f64_column(frame, "E_tr")?,
+            e: f64_column(frame, "E")?,
+            error_estimate: f64_column(frame, "error_estimate")?,
+            failure: str_column(frame, "failure")?,
+        })
+    }
+
+    fn row(&self, i: usize) -> Option<Row> {
+        Some(Row {
+            t: self.t[i]?,
+            r: self.r[i]?,
+            tr: self.tr[i]?,
+            e_tr: self.e_tr[i]?,
+            e: self.e[i]?,
+            error_estimate: self.error_estimate[i],
+        })
+    }
+
+    /// One pick per point: the sample at `at` (or the last one).
+    fn read_out(&self, at: Option<f64>) -> std::result::Result<Vec<Pick>, String> {
+        let mut picks = Vec::new();
+        let mut start = 0;
+        while start < self.point.len() {
+            let mut end = start + 1;
+            while end < self.point.len() && self.point[end] == self.point[start] {
+                end += 1;
+            }
+            let axes: Vec<f64> = self
+                .axes
+                .iter()
+                .map(|c| c[start].unwrap_or(f64::NAN))
+                .collect();
+            let pick = if let Some(reason) = &self.failure[start] {
+                Pick {
+                    axes,
+                    row: None,
+                    points: 1,
+                    failed: 1,
+                    failure: Some(reason.clone()),
+                }
+            } else {
+                let chosen = match at {
+                    None => Some(end - 1),
+                    Some(t) => (start..end).find(|&i| {
+                        self.t[i].is_some_and(|s| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
+                    }),
+                };
+                let Some(i) = chosen else {
+                    let (first, last) = (self.t[start], self.t[end - 1]);
+                    return Err(format!(
+                        "read-out time at = {} is not a sample time of the input (samples from {} to {}): pick a multiple of the sweep's run.sample_every",
+                        at.unwrap_or_default(),
+                        first.unwrap_or(f64::NAN),
+                        last.unwrap_or(f64::NAN)
+                    ));
+                };
+                Pick {
+                    axes,
+                    row: self.row(i),
+                    points: 1,
+                    failed: 0,
+                    failure: None,
+                }
+            };
+            picks.push(pick);
+            start = end;
+        }
+        Ok(picks)
+    }
+}
+
+/// The best pick per group (groups in order of first appearance, i.e. grid order).
+fn maximize(picks: &[Pick], axes: &[Axis], m: &Maximize) -> Vec<Pick> {
+    let grouping: Vec<usize> = (0..axes.len())
+        .filter(|&k| !m.over.contains(&axes[k].name))
+        .collect();
+    let group_of = |p: &Pick| {
+        grouping
+            .iter()
+            .map(|&k| p.axes[k].to_bits())
+            .collect::<Vec<u64>>()
+    };
+    let value = |p: &Pick| {
+        p.row.map(|r| match m.column.as_str() {
+            "R" => r.r,
+            "T" => r.tr,
+            _ => r.e_tr,
+        })
+    };
+    let mut order: Vec<Vec<u64>> = Vec::new();
+    let mut best: std::collections::HashMap<Vec<u64>, Pick> = std::collections::HashMap::new();
+    for p in picks {
+        let g = group_of(p);
+        match best.get_mut(&g) {
+            None => {
+                order.push(g.clone());
+                best.insert(g, p.clone());
+            }
+            Some(b) => {
+                let (points, failed) = (b.points + 1, b.failed + p.failed);
+                // Strictly greater: ties keep the first point in grid order.
+                if value(p).is_some_and(|v| value(b).is_none_or(|w| v > w)) {
+                    *b = p.clone();
+                }
+                b.points = points;
+                b.failed = failed;
+                if b.row.is_some() {
+                    b.failure = None;
+                }
+            }
+        }
+    }
+    order.into_iter().filter_map(|g| best.remove(&g)).collect()
+}

@@ -1,0 +1,135 @@
+//! Running stages: upstream first, only what is stale (or forced), each output written
+//! atomically with its manifest.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use crate::atomic;
+use crate::canonical::code_version;
+use crate::error::{PipelineError, Result};
+use crate::events::Events;
+use crate::manifest::Manifest;
+use crate::pipeline::Pipeline;
+use crate::points::PointStore;
+use crate::stage::{Spec, Stage};
+use crate::status::{output_path, state, State};
+use crate::sweep::points_dir;
+use crate::table;
+
+/// How to run.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Stages to run (with everything upstream); empty means all.
+    pub targets: Vec<String>,
+    /// Re-run the targets (all stages if no targets) even when fresh. Points stay cached:
+    /// they are content-addressed and checksummed, so re-simulating them would give the same
+    /// bits.
+    pub force: bool,
+    /// Only say what would run and why.
+    pub dry_run: bool,
+    /// The results tree (stage tables and the point cache).
+    pub results: PathBuf,
+}
+
+/// One stage's part in a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// The stage.
+    pub stage: String,
+    /// Whether it runs (or, in a dry run, would).
+    pub runs: bool,
+    /// Why it runs, or `fresh`.
+    pub why: String,
+    /// For sweeps that run: (points, of which cached).
+    pub points: Option<(usize, usize)>,
+}
+
+/// Runs (or plans) the pipeline; returns what each selected stage did.
+pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Result<Vec<Step>> {
+    let results = &options.results;
+    let store = PointStore::new(points_dir(results));
+    let mut steps = Vec::new();
+    for stage in pipeline.selection(&options.targets)? {
+        let forced =
+            options.force && (options.targets.is_empty() || options.targets.contains(&stage.name));
+        let current = state(pipeline, results, stage);
+        let why = match (&current, forced) {
+            (State::Fresh, false) => {
+                events.stage_skipped(&stage.name);
+                steps.push(Step {
+                    stage: stage.name.clone(),
+                    runs: false,
+                    why: "fresh".into(),
+                    points: None,
+                });
+                continue;
+            }
+            (State::Fresh, true) => "forced".to_string(),
+            (other, _) => format!("{}: {}", other.label(), other.why()),
+        };
+        let points = match &stage.spec {
+            Spec::Sweep(sweep) => Some((sweep.count(), sweep.cached(&store)?)),
+            _ => None,
+        };
+        steps.push(Step {
+            stage: stage.name.clone(),
+            runs: true,
+            why: why.clone(),
+            points,
+        });
+        if options.dry_run {
+            continue;
+        }
+        events.stage_started(&stage.name, &why);
+        let summary = execute(pipeline, stage, results, &store, events)?;
+        events.stage_finished(&stage.name, &summary);
+    }
+    Ok(steps)
+}
+
+fn execute(
+    pipeline: &Pipeline,
+    stage: &Stage,
+    results: &Path,
+    store: &PointStore,
+    events: &dyn Events,
+) -> Result<String> {
+    let removed = store.sweep_stale_temps() + atomic::sweep_stale_temps(results);
+    if removed > 0 {
+        events.warn(&format!(
+            "removed {removed} temporary file(s) left by an interrupted run"
+        ));
+    }
+    let output = match &stage.spec {
+        Spec::Sweep(sweep) => sweep.run(&stage.name, store, events)?,
+        Spec::Reduce(reduce) => {
+            let input = &stage.inputs[0];
+            let path = output_path(results, input);
+            let frame = table::read(&path)?;
+            let axes = pipeline.sweep_axes(input).ok_or_else(|| {
+                PipelineError::stage(&stage.name, format!("`{input}` is not a sweep"))
+            })?;
+            reduce.run(&stage.name, &frame, axes)?
+        }
+    };
+    let manifest = Manifest {
+        stage: stage.name.clone(),
+        kind: stage.spec.kind().to_string(),
+        key: pipeline.key(&stage.name).to_string(),
+        code_version: code_version(),
+        params: stage.params.clone(),
+        inputs: stage
+            .inputs
+            .iter()
+            .map(|i| (i.clone(), pipeline.key(i).to_string()))
+            .collect::<BTreeMap<_, _>>(),
+        summary: output.summary.clone(),
+    };
+    let rows = output.frame.height();
+    table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
+    let count = |k: &str| output.summary.get(k).and_then(|v| v.as_u64());
+    Ok(match (count("points"), count("failed")) {
+        (Some(points), Some(failed)) => format!("{rows} rows, {points} points, {failed} failed"),
+        _ => format!("{rows} rows"),
+    })
+}

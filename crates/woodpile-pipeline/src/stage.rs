@@ -1,0 +1,125 @@
+//! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
+//!
+//! ```toml
+//! kind = "sweep"               # sweep | reduce
+//! description = "F4: ..."      # free text, not part of the cache key
+//! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
+//! ```
+//!
+//! The remaining keys belong to the kind (see [`crate::sweep`], [`crate::reduce`]); unknown
+//! keys anywhere are errors naming the file and key.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use crate::canonical::toml_to_json;
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::reduce::Reduce;
+use crate::sweep::Sweep;
+
+/// The kinds of stage, in pipeline order.
+pub const KINDS: &[&str] = &["sweep", "reduce"];
+
+/// What a stage does, with its kind-specific parameters.
+#[derive(Debug, Clone)]
+pub enum Spec {
+    /// Simulate a grid of scenes; output their fraction time series.
+    Sweep(Sweep),
+    /// Read the fractions of a sweep at a time, optionally maximised over axes.
+    Reduce(Reduce),
+}
+
+impl Spec {
+    /// The kind's name.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Spec::Sweep(_) => "sweep",
+            Spec::Reduce(_) => "reduce",
+        }
+    }
+}
+
+/// A parsed stage file.
+#[derive(Debug, Clone)]
+pub struct Stage {
+    /// The name: the file stem.
+    pub name: String,
+    /// The file it came from.
+    pub file: PathBuf,
+    /// Free text for `woodpile status` and the README.
+    pub description: String,
+    /// Upstream stages, in the order given.
+    pub inputs: Vec<String>,
+    /// What it does.
+    pub spec: Spec,
+    /// The file's content without `description`, as canonical JSON: what the key hashes.
+    pub params: Value,
+}
+
+impl Stage {
+    /// Reads and parses the stage file at `file`.
+    pub fn load(file: &Path) -> Result<Stage> {
+        let text = std::fs::read_to_string(file).map_err(|e| PipelineError::Syntax {
+            file: file.to_path_buf(),
+            reason: format!("cannot read: {e}"),
+        })?;
+        Stage::parse(&text, file)
+    }
+
+    /// Parses stage TOML `text`; `file` names it (and gives the stage its name).
+    pub fn parse(text: &str, file: &Path) -> Result<Stage> {
+        let table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
+            file: file.to_path_buf(),
+            reason: e.to_string().trim_end().to_string(),
+        })?;
+        let name = stage_name(file)?;
+        let mut params = toml_to_json(&toml::Value::Table(table.clone()));
+        if let Value::Object(map) = &mut params {
+            map.remove("description");
+        }
+        let mut fields = Fields::new(file, "", table);
+        let kind: String = fields.required("kind")?;
+        let description: String = fields.optional("description")?.unwrap_or_default();
+        let inputs: Vec<String> = fields.optional("inputs")?.unwrap_or_default();
+        let spec = match kind.as_str() {
+            "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
+            "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
+            other => {
+                return Err(fields.error(
+                    "kind",
+                    format!("unknown kind `{other}` (kinds: {})", KINDS.join(", ")),
+                ))
+            }
+        };
+        fields.finish()?;
+        Ok(Stage {
+            name,
+            file: file.to_path_buf(),
+            description,
+            inputs,
+            spec,
+            params,
+        })
+    }
+}
+
+fn stage_name(file: &Path) -> Result<String> {
+    let name = file
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ok = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-');
+    if ok {
+        Ok(name)
+    } else {
+        Err(PipelineError::Syntax {
+            file: file.to_path_buf(),
+            reason: "a stage file's name must be lowercase letters, digits, `_` or `-`".into(),
+        })
+    }
+}

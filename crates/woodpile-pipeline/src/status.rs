@@ -1,0 +1,91 @@
+//! Is a stage's output fresh, stale or missing, and why: the stored manifest against the
+//! stage's current definition.
+
+use std::path::{Path, PathBuf};
+
+use crate::canonical::{changed_paths, code_version};
+use crate::pipeline::Pipeline;
+use crate::stage::Stage;
+use crate::table;
+
+/// Freshness of one stage output.
+#[derive(Debug, Clone, PartialEq)]
+pub enum State {
+    /// The output exists and was computed from exactly the current definition.
+    Fresh,
+    /// The output exists but something it was computed from changed: the reasons.
+    Stale(Vec<String>),
+    /// No output yet.
+    Missing,
+}
+
+impl State {
+    /// A short label: `fresh`, `stale`, `missing`.
+    pub fn label(&self) -> &'static str {
+        match self {
+            State::Fresh => "fresh",
+            State::Stale(_) => "stale",
+            State::Missing => "missing",
+        }
+    }
+
+    /// One line saying why the stage must run (empty when fresh).
+    pub fn why(&self) -> String {
+        match self {
+            State::Fresh => String::new(),
+            State::Missing => "no output yet".into(),
+            State::Stale(reasons) => reasons.join("; "),
+        }
+    }
+}
+
+/// Where stage `name`'s table lives in the results tree `results`.
+pub fn output_path(results: &Path, name: &str) -> PathBuf {
+    results.join(format!("{name}.parquet"))
+}
+
+/// The state of `stage` given the outputs under `results`.
+pub fn state(pipeline: &Pipeline, results: &Path, stage: &Stage) -> State {
+    let stored = match table::read_manifest(&output_path(results, &stage.name)) {
+        Ok(None) => return State::Missing,
+        Ok(Some(m)) => m,
+        Err(e) => return State::Stale(vec![format!("output unreadable ({e})")]),
+    };
+    let key = pipeline.key(&stage.name);
+    if stored.key == key.as_str() {
+        return State::Fresh;
+    }
+    let mut reasons = Vec::new();
+    let code = code_version();
+    if stored.code_version != code {
+        reasons.push(format!(
+            "code version changed: {} -> {code}",
+            stored.code_version
+        ));
+    }
+    for change in changed_paths(&stored.params, &stage.params) {
+        reasons.push(format!("parameter {change}"));
+    }
+    for input in &stage.inputs {
+        match stored.inputs.get(input) {
+            None => reasons.push(format!("new input `{input}`")),
+            Some(k) if k != pipeline.key(input).as_str() => {
+                reasons.push(format!("upstream `{input}` changed"))
+            }
+            Some(_) => {}
+        }
+    }
+    for old in stored.inputs.keys() {
+        if !stage.inputs.contains(old) {
+            reasons.push(format!("input `{old}` removed"));
+        }
+    }
+    if reasons.is_empty() {
+        reasons.push(format!(
+            "cache key changed: {} -> {}",
+            &stored.key[..12.min(stored.key.len())],
+            key.short()
+        ));
+    }
+    State::Stale(reasons)
+}

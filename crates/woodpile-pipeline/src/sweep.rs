@@ -1,0 +1,340 @@
+//! `kind = "sweep"`: simulate every scene of a parameter grid and output its fraction time
+//! series, one row per point and sample.
+//!
+//! ```toml
+//! kind = "sweep"
+//! [axes]                                   # optional: none means a single scene
+//! L = [0, 2, 5, 6]
+//! eps = { from = 0.1, to = 60.0, step = 0.1 }
+//! [scene]                                  # a scene file, with "$axis" placeholders
+//! run = { t_end = 150.0, method = "auto", tolerance = 1e-6, sample_every = 1.0 }
+//! [[scene.defect]]
+//! site = 0
+//! through = "$L"                           # defects on sites 0..=L
+//! eps = "$eps"
+//! ```
+//!
+//! Points are cached one by one in the [`PointStore`] under the key of their resolved scene,
+//! so a sweep resumes after a kill and sweeps that share scenes share the work. Points are
+//! simulated in parallel (rayon) and assembled in grid order: the output is bitwise the same
+//! for any number of threads. A point whose simulation fails gets one row with null fractions
+//! and the reason in `failure`: a failure is reported, never written as a number.
+
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+use serde_json::{json, Value};
+use woodpile_scene::{Scene, SceneError};
+use woodpile_sim::integrate::MethodChoice;
+
+use crate::canonical::{code_version, scene_json, Key};
+use crate::error::{PipelineError, Result};
+use crate::events::Events;
+use crate::fields::Fields;
+use crate::grid::{parse_axes, point, point_count, Axis, AxisValue};
+use crate::points::{simulate_point, PointResult, PointStore};
+use crate::table::Columns;
+use crate::template::Template;
+use crate::Output;
+
+/// A parsed sweep stage.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The grid axes, sorted by name (the last varies fastest).
+    pub axes: Vec<Axis>,
+    template: Template,
+    file: PathBuf,
+}
+
+impl Sweep {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Sweep> {
+        let axes = match fields.optional::<toml::Table>("axes")? {
+            Some(table) => parse_axes(fields.nested("axes", table))?,
+            None => Vec::new(),
+        };
+        let scene: toml::Table = fields.required("scene")?;
+        let template =
+            Template::new(scene, &axes).map_err(|(key, reason)| fields.error(&key, reason))?;
+        let sweep = Sweep {
+            axes,
+            template,
+            file: fields.file().to_path_buf(),
+        };
+        // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
+        // the grid exercise the extremes of every axis.
+        sweep.scene_at(0)?;
+        sweep.scene_at(sweep.count() - 1)?;
+        Ok(sweep)
+    }
+
+    /// Number of grid points.
+    pub fn count(&self) -> usize {
+        point_count(&self.axes)
+    }
+
+    /// The axis values of point `index`.
+    pub fn values(&self, index: usize) -> Vec<AxisValue> {
+        point(&self.axes, index)
+    }
+
+    /// The validated scene of point `index`.
+    pub fn scene_at(&self, index: usize) -> Result<Scene> {
+        let values = self.values(index);
+        let at = || {
+            let parts: Vec<String> = self
+                .axes
+                .iter()
+                .zip(&values)
+                .map(|(a, v)| format!("{} = {v}", a.name))
+                .collect();
+            if parts.is_empty() {
+                String::new()
+            } else {
+                format!(" (at {})", parts.join(", "))
+            }
+        };
+        let table = self
+            .template
+            .instantiate(&self.axes, &values)
+            .map_err(|(key, reason)| self.error(key, reason + &at()))?;
+        woodpile_scene::from_table(table, &self.file).map_err(|e| match e {
+            SceneError::Invalid { key, reason, .. } => {
+                self.error(format!("scene.{key}"), reason + &at())
+            }
+            SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
+                self.error("scene".into(), reason + &at())
+            }
+        })
+    }
+
+    fn error(&self, key: String, reason: String) -> PipelineError {
+        PipelineError::Definition {
+            file: self.file.clone(),
+            key,
+            reason,
+        }
+    }
+
+    /// Every point's scene and cache key, in grid order.
+    pub fn points(&self) -> Result<Vec<(Key, Scene)>> {
+        (0..self.count())
+            .into_par_iter()
+            .map(|i| {
+                let scene = self.scene_at(i)?;
+                Ok((point_key(&scene), scene))
+            })
+            .collect()
+    }
+
+    /// How many of the points are already in `store`.
+    pub fn cached(&self, store: &PointStore) -> Result<usize> {
+        let points = self.points()?;
+        Ok(points
+            .par_iter()
+            .filter(|(k, _)| store.path(k).exists())
+            .count())
+    }
+
+    /// Simulates what `store` lacks and assembles the output.
+    pub(crate) fn run(
+        &self,
+        stage: &str,
+        store: &PointStore,
+        events: &dyn Events,
+    ) -> Result<Output> {
+        let points = self.points()?;
+        let mut results: Vec<Option<PointResult>> =
+            points.par_iter().map(|(k, _)| store.load(k)).collect();
+        let todo: Vec<usize> = (0..points.len())
+            .filter(|&i| results[i].is_none())
+            .collect();
+        events.simulating(stage, todo.len(), points.len() - todo.len());
+        let computed: Vec<(usize, PointResult)> = todo
+            .par_iter()
+            .map(|&i| {
+                let (key, scene) = &points[i];
+                let result = simulate_point(scene);
+                store.save(key, &result)?;
+                events.point_done();
+                Ok((i, result))
+            })
+            .collect::<Result<_>>()?;
+        for (i, result) in computed {
+            results[i] = Some(result);
+        }
+        let results: Vec<PointResult> = results.into_iter().flatten().collect();
+        let failed = results.iter().filter(|r| r.is_err()).count();
+        if failed > 0 {
+            events.warn(&format!(
+                "stage `{stage}`: {failed} of {} points failed (null rows with the reason in `failure`)",
+                results.len()
+            ));
+        }
+        let frame = self.table(&points, &results)?.into_frame()?;
+        Ok(Output {
+            frame,
+            summary: self.summary(&points, &results),
+        })
+    }
+
+    fn table(&self, points: &[(Key, Scene)], results: &[PointResult]) -> Result<Columns> {
+        let rows: usize = results
+            .iter()
+            .map(|r| r.as_ref().map_or(1, |p| p.t.len()))
+            .sum();
+        let mut index = Vec::with_capacity(rows);
+        let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::with_capacity(rows); self.axes.len()];
+        let mut c = RowColumns::with_capacity(rows);
+        for (i, ((key, _), result)) in points.iter().zip(results).enumerate() {
+            let values = self.values(i);
+            let n = result.as_ref().map_or(1, |p| p.t.len());
+            for _ in 0..n {
+                index.push(Some(i as i64));
+                for (column, v) in axis_values.iter_mut().zip(&values) {
+                    column.push(*v);
+                }
+            }
+            c.push(key, result);
+        }
+        let mut columns = Columns::new();
+        columns.i64("point", index);
+        for (axis, values) in self.axes.iter().zip(axis_values) {
+            if axis.is_integer() {
+                let ints = values.iter().map(|v| match v {
+                    AxisValue::Int(i) => Some(*i),
+                    AxisValue::Float(x) => Some(*x as i64),
+                });
+                columns.i64(&axis.name, ints.collect());
+            } else {
+                columns.f64(
+                    &axis.name,
+                    values.iter().map(|v| Some(v.as_f64())).collect(),
+                );
+            }
+        }
+        c.append_to(&mut columns);
+        Ok(columns)
+    }
+
+    fn summary(&self, points: &[(Key, Scene)], results: &[PointResult]) -> Value {
+        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
+        let max = |f: &dyn Fn(&crate::points::PointData) -> Option<f64>| {
+            ok().filter_map(f)
+                .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))))
+        };
+        let first = &points[0].1.scenario;
+        json!({
+            "points": points.len(),
+            "failed": results.iter().filter(|r| r.is_err()).count(),
+            "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
+            "method": match first.method { MethodChoice::Auto => "auto", MethodChoice::Named(m) => m.name() },
+            "tolerance": first.accuracy.tolerance,
+            "dt": first.accuracy.dt,
+            "t_end": first.t_end,
+            "sample_every": first.sample_every,
+            "rhs_evals": ok().map(|p| p.rhs_evals).sum::<u64>(),
+            "max_error_estimate": max(&|p| p.error_estimate),
+            "max_energy_drift": max(&|p| p.energy_drift),
+        })
+    }
+}
+
+/// The cache key of one scene: its canonical form and the code version.
+pub fn point_key(scene: &Scene) -> Key {
+    Key::of(&json!({"scene": scene_json(scene), "code": code_version()}))
+}
+
+/// The per-row columns of a sweep output (everything but the point index and the axes).
+struct RowColumns {
+    t: Vec<Option<f64>>,
+    r: Vec<Option<f64>>,
+    tr: Vec<Option<f64>>,
+    e_tr: Vec<Option<f64>>,
+    e: Vec<Option<f64>>,
+    method: Vec<Option<String>>,
+    dt: Vec<Option<f64>>,
+    steps: Vec<Option<i64>>,
+    error_estimate: Vec<Option<f64>>,
+    energy_drift: Vec<Option<f64>>,
+    failure: Vec<Option<String>>,
+    scene_key: Vec<Option<String>>,
+}
+
+impl RowColumns {
+    fn with_capacity(n: usize) -> Self {
+        Self {
+            t: Vec::with_capacity(n),
+            r: Vec::with_capacity(n),
+            tr: Vec::with_capacity(n),
+            e_tr: Vec::with_capacity(n),
+            e: Vec::with_capacity(n),
+            method: Vec::with_capacity(n),
+            dt: Vec::with_capacity(n),
+            steps: Vec::with_capacity(n),
+            error_estimate: Vec::with_capacity(n),
+            energy_drift: Vec::with_capacity(n),
+            failure: Vec::with_capacity(n),
+            scene_key: Vec::with_capacity(n),
+        }
+    }
+
+    fn push(&mut self, key: &Key, result: &PointResult) {
+        match result {
+            Ok(p) => {
+                for k in 0..p.t.len() {
+                    self.t.push(Some(p.t[k]));
+                    self.r.push(Some(p.reflected[k]));
+                    self.tr.push(Some(p.transmitted[k]));
+                    self.e_tr.push(Some(p.trapped[k]));
+                    self.e.push(Some(p.energy[k]));
+                    self.method.push(Some(p.method.clone()));
+                    self.dt.push(p.dt);
+                    self.steps.push(Some(p.steps as i64));
+                    self.error_estimate.push(p.error_estimate);
+                    self.energy_drift.push(p.energy_drift);
+                    self.failure.push(None);
+                    self.scene_key.push(Some(key.to_string()));
+                }
+            }
+            Err(reason) => {
+                for v in [
+                    &mut self.t,
+                    &mut self.r,
+                    &mut self.tr,
+                    &mut self.e_tr,
+                    &mut self.e,
+                ] {
+                    v.push(None);
+                }
+                self.method.push(None);
+                self.dt.push(None);
+                self.steps.push(None);
+                self.error_estimate.push(None);
+                self.energy_drift.push(None);
+                self.failure.push(Some(reason.clone()));
+                self.scene_key.push(Some(key.to_string()));
+            }
+        }
+    }
+
+    fn append_to(self, columns: &mut Columns) {
+        columns
+            .f64("t", self.t)
+            .f64("R", self.r)
+            .f64("T", self.tr)
+            .f64("E_tr", self.e_tr)
+            .f64("E", self.e)
+            .str("method", self.method)
+            .f64("dt", self.dt)
+            .i64("steps", self.steps)
+            .f64("error_estimate", self.error_estimate)
+            .f64("energy_drift", self.energy_drift)
+            .str("failure", self.failure)
+            .str("scene_key", self.scene_key);
+    }
+}
+
+/// The directory a results tree keeps its point cache in.
+pub fn points_dir(results: &Path) -> PathBuf {
+    results.join("points")
+}

@@ -1,0 +1,425 @@
+//! The pipeline end to end on tiny chains (n = 12, t = 12): what runs, what is reused, what is
+//! reported, and that results do not depend on the thread count.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+
+use woodpile_pipeline::diff::{diff, DiffOptions, Tolerance};
+use woodpile_pipeline::events::Events;
+use woodpile_pipeline::points::PointStore;
+use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::status::{output_path, state, State};
+use woodpile_pipeline::sweep::points_dir;
+use woodpile_pipeline::{table, Pipeline, PipelineError};
+
+/// Counts what a run did.
+#[derive(Default)]
+struct Counter {
+    points: AtomicUsize,
+    started: Mutex<Vec<String>>,
+    warnings: Mutex<Vec<String>>,
+}
+
+impl Events for Counter {
+    fn stage_started(&self, stage: &str, _: &str) {
+        self.started.lock().unwrap().push(stage.to_string());
+    }
+    fn point_done(&self) {
+        self.points.fetch_add(1, Ordering::SeqCst);
+    }
+    fn warn(&self, message: &str) {
+        self.warnings.lock().unwrap().push(message.to_string());
+    }
+}
+
+const SWEEP: &str = r#"
+kind = "sweep"
+[axes]
+L = [0, 1]
+eps = { from = 0.5, to = 1.5, step = 0.5 }
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
+[[scene.defect]]
+site = 0
+through = "$L"
+eps = "$eps"
+"#;
+
+const REDUCE: &str = r#"
+kind = "reduce"
+inputs = ["sweep"]
+at = 12.0
+"#;
+
+const BEST: &str = r#"
+kind = "reduce"
+inputs = ["sweep"]
+[maximize]
+over = ["eps"]
+"#;
+
+struct Project {
+    _dir: tempfile::TempDir,
+    pipeline: PathBuf,
+    results: PathBuf,
+}
+
+impl Project {
+    fn new(stages: &[(&str, &str)]) -> Project {
+        let dir = tempfile::tempdir().unwrap();
+        let pipeline = dir.path().join("pipeline");
+        std::fs::create_dir_all(&pipeline).unwrap();
+        for (name, text) in stages {
+            std::fs::write(pipeline.join(format!("{name}.toml")), text).unwrap();
+        }
+        let results = dir.path().join("results");
+        Project {
+            _dir: dir,
+            pipeline,
+            results,
+        }
+    }
+
+    fn write(&self, name: &str, text: &str) {
+        std::fs::write(self.pipeline.join(format!("{name}.toml")), text).unwrap();
+    }
+
+    fn load(&self) -> Pipeline {
+        Pipeline::load(&self.pipeline).unwrap()
+    }
+
+    fn run(&self, targets: &[&str]) -> Counter {
+        self.run_with(targets, false)
+    }
+
+    fn run_with(&self, targets: &[&str], force: bool) -> Counter {
+        let events = Counter::default();
+        let options = RunOptions {
+            targets: targets.iter().map(|s| s.to_string()).collect(),
+            force,
+            dry_run: false,
+            results: self.results.clone(),
+        };
+        run(&self.load(), &options, &events).unwrap();
+        events
+    }
+
+    fn state(&self, name: &str) -> State {
+        let p = self.load();
+        state(&p, &self.results, p.stage(name).unwrap())
+    }
+
+    fn output(&self, name: &str) -> PathBuf {
+        output_path(&self.results, name)
+    }
+}
+
+fn load_error(stages: &[(&str, &str)]) -> String {
+    let project = Project::new(stages);
+    Pipeline::load(&project.pipeline).unwrap_err().to_string()
+}
+
+#[test]
+fn definition_errors_name_the_file_and_key() {
+    let with = |extra: &str| format!("{SWEEP}\n{extra}");
+    let e = load_error(&[(
+        "sweep",
+        &SWEEP.replace("kind = \"sweep\"", "kind = \"sweep\"\ncolour = 1"),
+    )]);
+    assert!(
+        e.contains("sweep.toml") && e.contains("`colour`") && e.contains("unknown key"),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("r", &REDUCE.replace("\"sweep\"", "\"swep\"")),
+    ]);
+    assert!(
+        e.contains("r.toml") && e.contains("inputs[0]") && e.contains("swep"),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("a", "kind = \"reduce\"\ninputs = [\"b\"]"),
+        ("b", "kind = \"reduce\"\ninputs = [\"a\"]"),
+    ]);
+    assert!(
+        e.contains("inputs") && (e.contains("a -> b -> a") || e.contains("b -> a -> b")),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("r", REDUCE),
+        ("rr", &REDUCE.replace("\"sweep\"", "\"r\"")),
+    ]);
+    assert!(
+        e.contains("rr.toml") && e.contains("reduce reads a sweep"),
+        "{e}"
+    );
+    let e = load_error(&[("sweep", &SWEEP.replace("\"$eps\"", "\"$epsilon\""))]);
+    assert!(
+        e.contains("scene.defect[0].eps") && e.contains("$epsilon"),
+        "{e}"
+    );
+    let e = load_error(&[(
+        "sweep",
+        &SWEEP.replace("impulse = { site = -6 }", "impulse = { site = -60 }"),
+    )]);
+    assert!(
+        e.contains("sweep.toml") && e.contains("scene.impulse.site"),
+        "{e}"
+    );
+    let e = load_error(&[("sweep", &with("[scene.chain2]\nn = 3"))]);
+    assert!(e.contains("sweep.toml") && e.contains("chain2"), "{e}");
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("b", &BEST.replace("[\"eps\"]", "[\"kappa\"]")),
+    ]);
+    assert!(
+        e.contains("b.toml") && e.contains("maximize.over") && e.contains("kappa"),
+        "{e}"
+    );
+    let e = load_error(&[(
+        "sweep",
+        &SWEEP.replace("kind = \"sweep\"", "kind = \"plot\""),
+    )]);
+    assert!(e.contains("key `kind`") && e.contains("plot"), "{e}");
+}
+
+#[test]
+fn a_second_run_does_nothing_and_an_edit_reruns_exactly_its_dependents() {
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("best", BEST)]);
+    let first = p.run(&[]);
+    assert_eq!(first.points.load(Ordering::SeqCst), 6);
+    assert_eq!(first.started.lock().unwrap().len(), 3);
+
+    let second = p.run(&[]);
+    assert_eq!(second.points.load(Ordering::SeqCst), 0);
+    assert!(second.started.lock().unwrap().is_empty());
+
+    // A read-out time is a reduction parameter: one stage re-runs, nothing is simulated.
+    p.write("at_end", &REDUCE.replace("at = 12.0", "at = 10.0"));
+    match p.state("at_end") {
+        State::Stale(why) => assert_eq!(why, vec!["parameter at: 12.0 -> 10.0".to_string()]),
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(p.state("best"), State::Fresh);
+    let third = p.run(&[]);
+    assert_eq!(*third.started.lock().unwrap(), vec!["at_end".to_string()]);
+    assert_eq!(third.points.load(Ordering::SeqCst), 0);
+
+    // A sweep parameter re-runs the sweep and everything downstream of it.
+    p.write("sweep", &SWEEP.replace("dt = 0.02", "dt = 0.01"));
+    match p.state("best") {
+        State::Stale(why) => assert_eq!(why, vec!["upstream `sweep` changed".to_string()]),
+        other => panic!("{other:?}"),
+    }
+    let fourth = p.run(&[]);
+    assert_eq!(fourth.started.lock().unwrap().len(), 3);
+    assert_eq!(fourth.points.load(Ordering::SeqCst), 6);
+}
+
+#[test]
+fn overlapping_sweeps_share_points() {
+    let wider = SWEEP.replace("L = [0, 1]", "L = [0, 1, 2]");
+    let p = Project::new(&[("sweep", SWEEP), ("wider", &wider)]);
+    let first = p.run(&["sweep"]);
+    assert_eq!(first.points.load(Ordering::SeqCst), 6);
+    let second = p.run(&["wider"]);
+    assert_eq!(second.points.load(Ordering::SeqCst), 3, "only L = 2 is new");
+    // --force re-runs the stage but reuses the content-addressed points.
+    let forced = p.run_with(&["wider"], true);
+    assert_eq!(*forced.started.lock().unwrap(), vec!["wider".to_string()]);
+    assert_eq!(forced.points.load(Ordering::SeqCst), 0);
+}
+
+#[test]
+fn an_interrupted_sweep_resumes_without_repeating_finished_points() {
+    let p = Project::new(&[("sweep", SWEEP)]);
+    p.run(&[]);
+    let reference = std::fs::read(p.output("sweep")).unwrap();
+    // What a kill -9 leaves: some points finished, no stage output, a temporary of a dead
+    // writer (pid 0), and (worse than a kill can do) one damaged point file.
+    std::fs::remove_file(p.output("sweep")).unwrap();
+    let store = PointStore::new(points_dir(&p.results));
+    let pipeline = p.load();
+    let woodpile_pipeline::stage::Spec::Sweep(sweep) = &pipeline.stage("sweep").unwrap().spec
+    else {
+        panic!()
+    };
+    let points = sweep.points().unwrap();
+    std::fs::remove_file(store.path(&points[1].0)).unwrap();
+    std::fs::remove_file(store.path(&points[4].0)).unwrap();
+    std::fs::write(store.path(&points[2].0), b"WPPT garbage").unwrap();
+    let temp = store.path(&points[0].0).with_file_name(".x.wppt.0.tmp");
+    std::fs::write(&temp, b"half").unwrap();
+
+    let resumed = p.run(&[]);
+    assert_eq!(resumed.points.load(Ordering::SeqCst), 3);
+    assert!(!temp.exists());
+    assert_eq!(std::fs::read(p.output("sweep")).unwrap(), reference);
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let outputs: Vec<Vec<u8>> = [1, 2, 3]
+        .into_iter()
+        .map(|threads| {
+            let p = Project::new(&[("sweep", SWEEP), ("best", BEST)]);
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| p.run(&[]));
+            [
+                std::fs::read(p.output("sweep")).unwrap(),
+                std::fs::read(p.output("best")).unwrap(),
+            ]
+            .concat()
+        })
+        .collect();
+    assert_eq!(outputs[0], outputs[1]);
+    assert_eq!(outputs[0], outputs[2]);
+}
+
+#[test]
+fn outputs_explain_themselves_and_reductions_read_the_series() {
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("best", BEST)]);
+    p.run(&[]);
+    let manifest = table::read_manifest(&p.output("at_end")).unwrap().unwrap();
+    assert_eq!(manifest.kind, "reduce");
+    assert_eq!(manifest.key, p.load().key("at_end").as_str());
+    assert_eq!(manifest.inputs["sweep"], p.load().key("sweep").as_str());
+    let sweep = table::read_manifest(&p.output("sweep")).unwrap().unwrap();
+    assert_eq!(sweep.summary["method"], "rk4");
+    assert_eq!(sweep.summary["points"], 6);
+
+    let series = table::read(&p.output("sweep")).unwrap();
+    assert_eq!(series.height(), 6 * 7, "samples at t = 0, 2, ..., 12");
+    let at_end = table::read(&p.output("at_end")).unwrap();
+    let best = table::read(&p.output("best")).unwrap();
+    let e_tr = table::f64_column(&at_end, "E_tr").unwrap();
+    let best_e = table::f64_column(&best, "E_tr").unwrap();
+    // best = max over the three eps of each L, in grid order.
+    for (l, best) in best_e.iter().enumerate() {
+        let max = e_tr[3 * l..3 * l + 3]
+            .iter()
+            .map(|x| x.unwrap())
+            .fold(f64::MIN, f64::max);
+        assert_eq!(best.unwrap(), max);
+    }
+    // Fractions partition the energy at every row.
+    let (r, t) = (
+        table::f64_column(&at_end, "R").unwrap(),
+        table::f64_column(&at_end, "T").unwrap(),
+    );
+    for i in 0..6 {
+        assert!((r[i].unwrap() + t[i].unwrap() + e_tr[i].unwrap() - 1.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn a_read_out_time_between_samples_is_a_clear_stage_error() {
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("at_end", &REDUCE.replace("at = 12.0", "at = 11.0")),
+    ]);
+    let err = run(
+        &p.load(),
+        &RunOptions {
+            results: p.results.clone(),
+            ..Default::default()
+        },
+        &Counter::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(err, PipelineError::Stage { .. }));
+    assert!(err.to_string().contains("at = 11"), "{err}");
+    assert!(!p.output("at_end").exists());
+}
+
+#[test]
+fn failed_points_are_reported_never_written_as_numbers() {
+    // RK4 at dt = 3 on a stiff resonator (eps = 1e-3) blows up.
+    let stiff = SWEEP
+        .replace(
+            "eps = { from = 0.5, to = 1.5, step = 0.5 }",
+            "eps = [0.001, 1.0]",
+        )
+        .replace("dt = 0.02", "dt = 1.0");
+    let p = Project::new(&[("sweep", &stiff), ("best", BEST)]);
+    let events = p.run(&[]);
+    assert!(events
+        .warnings
+        .lock()
+        .unwrap()
+        .iter()
+        .any(|w| w.contains("failed")));
+    let frame = table::read(&p.output("sweep")).unwrap();
+    let failure = table::str_column(&frame, "failure").unwrap();
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    let failed_rows: Vec<usize> = (0..failure.len())
+        .filter(|&i| failure[i].is_some())
+        .collect();
+    assert!(!failed_rows.is_empty());
+    assert!(failed_rows.iter().all(|&i| e_tr[i].is_none()));
+    // A group whose every point failed reports the failure, not a number.
+    let best = table::read(&p.output("best")).unwrap();
+    let (e_tr, failed, points, failure) = (
+        table::f64_column(&best, "E_tr").unwrap(),
+        table::f64_column(&best, "failed").unwrap(),
+        table::f64_column(&best, "points").unwrap(),
+        table::str_column(&best, "failure").unwrap(),
+    );
+    for i in 0..e_tr.len() {
+        if failed[i] == points[i] {
+            assert!(e_tr[i].is_none() && failure[i].is_some());
+        } else {
+            assert!(e_tr[i].is_some_and(f64::is_finite) && failure[i].is_none());
+        }
+    }
+}
+
+#[test]
+fn diff_agrees_on_identical_trees_and_catches_a_perturbed_value() {
+    let a = Project::new(&[("sweep", SWEEP), ("best", BEST)]);
+    let b = Project::new(&[("sweep", SWEEP), ("best", BEST)]);
+    a.run(&[]);
+    b.run(&[]);
+    let exact = DiffOptions::default();
+    let report = diff(&a.results, &b.results, &exact).unwrap();
+    assert!(report.agrees(), "{report:?}");
+    assert_eq!(report.files, 2);
+
+    perturb(&b.output("best"), "E_tr", 1e-6);
+    let report = diff(&a.results, &b.results, &exact).unwrap();
+    assert!(!report.agrees());
+    assert_eq!(report.worst[0].column, "E_tr");
+    let loose = DiffOptions {
+        default: Tolerance {
+            abs: 1e-5,
+            rel: 0.0,
+        },
+        ..Default::default()
+    };
+    assert!(diff(&a.results, &b.results, &loose).unwrap().agrees());
+
+    std::fs::remove_file(b.output("sweep")).unwrap();
+    let report = diff(&a.results, &b.results, &loose).unwrap();
+    assert!(report.problems.iter().any(|p| p.contains("sweep.parquet")));
+}
+
+/// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.
+fn perturb(path: &Path, column: &str, delta: f64) {
+    let manifest = table::read_manifest(path).unwrap().unwrap();
+    let mut frame = table::read(path).unwrap();
+    let mut values = table::f64_column(&frame, column).unwrap();
+    values[0] = values[0].map(|v| v + delta);
+    frame
+        .with_column(polars::prelude::Column::new(column.into(), values))
+        .unwrap();
+    table::write(path, frame, &manifest).unwrap();
+}
