@@ -149,7 +149,7 @@ fn range(mut fields: Fields<'_>) -> Result<Vec<AxisValue>, PipelineError> {
         }
     };
     let (from, to, step) = (num(0, "from")?, num(1, "to")?, num(2, "step")?);
-    if !(step > 0.0) || to < from {
+    if step <= 0.0 || to < from {
         return Err(fields.error("step", "need step > 0 and to >= from"));
     }
     let n = ((to - from) / step).round();
