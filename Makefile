@@ -1,6 +1,6 @@
 # woodpile: every target calls the `woodpile` binary or cargo; `make help` lists them.
 CARGO ?= cargo
-WOODPILE := target/release/woodpile
+WOODPILE := $(or $(CARGO_TARGET_DIR),target)/release/woodpile
 # Regression check: recompute every stage from nothing into SCRATCH and compare with results/.
 SCRATCH := scratch/check
 CHECK_TOL := --abs 1e-9 --rel 1e-9
