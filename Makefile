@@ -5,7 +5,7 @@ WOODPILE := $(or $(CARGO_TARGET_DIR),target)/release/woodpile
 SCRATCH := scratch/check
 CHECK_TOL := --abs 1e-9 --rel 1e-9
 
-.PHONY: help build test figures stage status check read-check bench lint
+.PHONY: help build test figures stage status check read-check bench lint slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -41,3 +41,6 @@ bench: ## Error in E_tr against wall time for every method (README table)
 lint: ## rustfmt check and clippy with warnings as errors
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+slurm-test: build ## Sharded sweep on a real one-node SLURM cluster (installs slurm-wlm, munge), diffed against a local run
+	bash scripts/slurm-test/run.sh

@@ -30,6 +30,10 @@ enum Command {
     Run(pipeline_cmd::RunArgs),
     /// Show each stage as fresh, stale or missing, and why.
     Status(pipeline_cmd::StatusArgs),
+    /// Join the parts of a sharded sweep (`run STAGE --shard I/N`) into its result.
+    Merge(pipeline_cmd::MergeArgs),
+    /// Write SLURM scripts for a sharded sweep: an array job and a merge job after it.
+    Slurm(pipeline_cmd::SlurmArgs),
     /// Compare two result files or trees; exit 1 when they differ beyond tolerance.
     Diff(pipeline_cmd::DiffArgs),
 }
@@ -72,6 +76,8 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Run(args) => pipeline_cmd::run_command(&args),
         Command::Status(args) => pipeline_cmd::status_command(&args),
+        Command::Merge(args) => pipeline_cmd::merge_command(&args),
+        Command::Slurm(args) => pipeline_cmd::slurm_command(&args),
         Command::Diff(args) => match pipeline_cmd::diff_command(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),

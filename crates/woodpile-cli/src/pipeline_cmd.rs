@@ -2,8 +2,12 @@
 
 use std::path::PathBuf;
 
+use woodpile_pipeline::atomic;
 use woodpile_pipeline::diff::{diff, DiffOptions, DiffReport, Tolerance};
 use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::shard::{merge, run_shard, Shard};
+use woodpile_pipeline::slurm::SlurmJob;
+use woodpile_pipeline::status::output_path;
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::{Pipeline, PipelineError};
 
@@ -32,6 +36,43 @@ pub(crate) struct RunArgs {
     /// List what would run and why; run nothing.
     #[arg(long)]
     dry_run: bool,
+    /// Compute only shard I of N of one sweep into a part file (see `woodpile merge`). Inside
+    /// a SLURM array job the shard comes from SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT.
+    #[arg(long, value_name = "I/N")]
+    shard: Option<String>,
+    #[command(flatten)]
+    at: Locations,
+}
+
+/// Arguments of `woodpile merge`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct MergeArgs {
+    /// The sharded sweep.
+    stage: String,
+    #[command(flatten)]
+    at: Locations,
+}
+
+/// Arguments of `woodpile slurm`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct SlurmArgs {
+    /// The sweep to shard.
+    stage: String,
+    /// Array tasks (shards).
+    #[arg(long)]
+    tasks: usize,
+    /// SLURM partition.
+    #[arg(long)]
+    partition: Option<String>,
+    /// Time limit per task, SLURM syntax (e.g. 01:00:00).
+    #[arg(long)]
+    time: Option<String>,
+    /// CPUs per task (rayon uses them all).
+    #[arg(long, default_value_t = 1)]
+    cpus: usize,
+    /// Where to write the scripts (and, under logs/, the jobs' output).
+    #[arg(long, default_value = "slurm")]
+    out: PathBuf,
     #[command(flatten)]
     at: Locations,
 }
@@ -77,8 +118,50 @@ fn stage_failure(e: PipelineError) -> Failure {
     }
 }
 
+/// The shard asked for: `--shard`, else a SLURM array task's variables when exactly one
+/// stage is named.
+fn requested_shard(args: &RunArgs) -> Result<Option<Shard>, Failure> {
+    let bad = |reason: String| Failure::input(anyhow::anyhow!("--shard: {reason}"));
+    let shard = match &args.shard {
+        Some(text) => Some(Shard::parse(text).map_err(bad)?),
+        None if args.stages.len() == 1 => {
+            Shard::from_slurm(|k| std::env::var(k).ok()).map_err(bad)?
+        }
+        None => None,
+    };
+    if shard.is_some() && (args.stages.len() != 1 || args.force || args.dry_run) {
+        return Err(bad(
+            "name exactly one sweep stage, without --force or --dry-run".into(),
+        ));
+    }
+    Ok(shard)
+}
+
 pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let pipeline = load(&args.at)?;
+    if let Some(shard) = requested_shard(args)? {
+        let progress = Progress::new();
+        let done = run_shard(
+            &pipeline,
+            &args.stages[0],
+            shard,
+            &args.at.results,
+            &progress,
+        )
+        .map_err(stage_failure)?;
+        let what = if done.already_done {
+            "already done"
+        } else {
+            "written"
+        };
+        eprintln!(
+            "shard {shard} of `{}` ({} points): {what}: {}",
+            args.stages[0],
+            done.points,
+            done.part.display()
+        );
+        return Ok(());
+    }
     let options = RunOptions {
         targets: args.stages.clone(),
         force: args.force,
@@ -99,6 +182,69 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
             println!("{verb} {}: {}{points}", step.stage, step.why);
         }
     }
+    Ok(())
+}
+
+pub(crate) fn merge_command(args: &MergeArgs) -> Result<(), Failure> {
+    let pipeline = load(&args.at)?;
+    let parts = merge(&pipeline, &args.stage, &args.at.results).map_err(stage_failure)?;
+    eprintln!(
+        "merged {parts} parts of `{}` into {}",
+        args.stage,
+        output_path(&args.at.results, &args.stage).display()
+    );
+    Ok(())
+}
+
+pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
+    let pipeline = load(&args.at)?;
+    let stage = pipeline.stage(&args.stage).map_err(Failure::input)?;
+    if pipeline.sweep_axes(&stage.name).is_none() {
+        return Err(Failure::input(anyhow::anyhow!(
+            "`{}` is a {} stage: only sweeps are sharded",
+            stage.name,
+            stage.spec.kind()
+        )));
+    }
+    if args.tasks == 0 || args.cpus == 0 {
+        return Err(Failure::input(anyhow::anyhow!(
+            "--tasks and --cpus must be at least 1"
+        )));
+    }
+    let absolute = |p: &PathBuf| -> Result<PathBuf, Failure> {
+        std::path::absolute(p).map_err(|e| Failure::input(anyhow::anyhow!("{}: {e}", p.display())))
+    };
+    let binary = std::env::current_exe()
+        .map_err(|e| Failure::input(anyhow::anyhow!("cannot locate the woodpile binary: {e}")))?;
+    let workdir = absolute(&PathBuf::from("."))?;
+    let out = absolute(&args.out)?;
+    let logs = out.join("logs");
+    let job = SlurmJob {
+        stage: &stage.name,
+        tasks: args.tasks,
+        partition: args.partition.as_deref(),
+        time: args.time.as_deref(),
+        cpus: args.cpus,
+        binary: &binary,
+        workdir: &workdir,
+        pipeline: &absolute(&args.at.pipeline)?,
+        results: &absolute(&args.at.results)?,
+        logs: &logs,
+    };
+    let array = out.join(format!("{}.array.sbatch", stage.name));
+    let merge = out.join(format!("{}.merge.sbatch", stage.name));
+    let submit = out.join(format!("{}.submit.sh", stage.name));
+    let write =
+        |path: &PathBuf, text: String| atomic::write(path, text.as_bytes()).map_err(Failure::input);
+    write(&array, job.array_script())?;
+    write(&merge, job.merge_script())?;
+    write(&submit, job.submit_script(&array, &merge))?;
+    std::fs::create_dir_all(&logs)
+        .map_err(|e| Failure::input(anyhow::anyhow!("{}: {e}", logs.display())))?;
+    println!("{}", array.display());
+    println!("{}", merge.display());
+    println!("{}", submit.display());
+    eprintln!("submit with: bash {}", submit.display());
     Ok(())
 }
 

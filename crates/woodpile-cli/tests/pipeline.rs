@@ -112,3 +112,66 @@ fn bad_stage_files_and_unknown_stages_exit_2_naming_file_and_key() {
     let missing = woodpile(d, &["diff", "results", "nowhere"]);
     assert_eq!(missing.status.code(), Some(2));
 }
+
+#[test]
+fn shards_from_flags_and_slurm_variables_merge_to_the_local_result() {
+    let dir = project();
+    let d = dir.path();
+    assert!(woodpile(d, &["run", "--results", "local"]).status.success());
+    let early = woodpile(d, &["merge", "sweep", "--results", "cluster"]);
+    assert_eq!(early.status.code(), Some(3));
+    assert!(
+        text(&early.stderr).contains("no parts"),
+        "{}",
+        text(&early.stderr)
+    );
+    assert!(woodpile(
+        d,
+        &["run", "sweep", "--shard", "0/2", "--results", "cluster"]
+    )
+    .status
+    .success());
+    let incomplete = woodpile(d, &["merge", "sweep", "--results", "cluster"]);
+    assert!(
+        text(&incomplete.stderr).contains("missing shard(s) 1 of 2"),
+        "{}",
+        text(&incomplete.stderr)
+    );
+    // Shard 1 from a SLURM array task's environment.
+    let task = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .current_dir(d)
+        .args(["run", "sweep", "--results", "cluster"])
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "2")
+        .output()
+        .unwrap();
+    assert!(task.status.success());
+    assert!(
+        text(&task.stderr).contains("shard 1/2"),
+        "{}",
+        text(&task.stderr)
+    );
+    assert!(woodpile(d, &["merge", "sweep", "--results", "cluster"])
+        .status
+        .success());
+    assert_eq!(
+        woodpile(d, &["diff", "local", "cluster"]).status.code(),
+        Some(0)
+    );
+    assert_eq!(
+        woodpile(d, &["run", "sweep", "--shard", "2/2"])
+            .status
+            .code(),
+        Some(2)
+    );
+
+    let scripts = woodpile(
+        d,
+        &["slurm", "sweep", "--tasks", "3", "--partition", "short"],
+    );
+    assert!(scripts.status.success(), "{}", text(&scripts.stderr));
+    let array = std::fs::read_to_string(d.join("slurm/sweep.array.sbatch")).unwrap();
+    assert!(array.contains("#SBATCH --array=0-2") && array.contains("#SBATCH --partition=short"));
+    let submit = std::fs::read_to_string(d.join("slurm/sweep.submit.sh")).unwrap();
+    assert!(submit.contains("--dependency=afterok"));
+}

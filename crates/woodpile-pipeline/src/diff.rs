@@ -77,7 +77,8 @@ impl DiffReport {
 pub const WORST: usize = 10;
 
 /// Compares `a` and `b`: two parquet files, or two directories of them (the point cache
-/// under `points/` is skipped: it is an input to results, not a result).
+/// under `points/` and shard parts under `parts/` are skipped: they are inputs to results, not
+/// results).
 pub fn diff(a: &Path, b: &Path, options: &DiffOptions) -> Result<DiffReport> {
     let mut report = DiffReport::default();
     if a.is_dir() && b.is_dir() {
@@ -125,7 +126,7 @@ fn parquet_files(root: &Path) -> Result<BTreeMap<String, PathBuf>> {
                 .to_string_lossy()
                 .into_owned();
             if path.is_dir() {
-                if rel != "points" {
+                if rel != "points" && rel != "parts" {
                     walk(root, &path, out)?;
                 }
             } else if path.extension().is_some_and(|x| x == "parquet") {

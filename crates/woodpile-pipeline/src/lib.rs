@@ -26,6 +26,8 @@ pub mod pipeline;
 pub mod points;
 pub mod reduce;
 pub mod run;
+pub mod shard;
+pub mod slurm;
 pub mod stage;
 pub mod status;
 pub mod sweep;

@@ -112,7 +112,23 @@ fn execute(
             reduce.run(&stage.name, &frame, axes)?
         }
     };
-    let manifest = Manifest {
+    let manifest = manifest_for(pipeline, stage, output.summary.clone());
+    let rows = output.frame.height();
+    table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
+    let count = |k: &str| output.summary.get(k).and_then(|v| v.as_u64());
+    Ok(match (count("points"), count("failed")) {
+        (Some(points), Some(failed)) => format!("{rows} rows, {points} points, {failed} failed"),
+        _ => format!("{rows} rows"),
+    })
+}
+
+/// The manifest of `stage`'s output as computed from the current definitions.
+pub(crate) fn manifest_for(
+    pipeline: &Pipeline,
+    stage: &Stage,
+    summary: serde_json::Value,
+) -> Manifest {
+    Manifest {
         stage: stage.name.clone(),
         kind: stage.spec.kind().to_string(),
         key: pipeline.key(&stage.name).to_string(),
@@ -123,13 +139,6 @@ fn execute(
             .iter()
             .map(|i| (i.clone(), pipeline.key(i).to_string()))
             .collect::<BTreeMap<_, _>>(),
-        summary: output.summary.clone(),
-    };
-    let rows = output.frame.height();
-    table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
-    let count = |k: &str| output.summary.get(k).and_then(|v| v.as_u64());
-    Ok(match (count("points"), count("failed")) {
-        (Some(points), Some(failed)) => format!("{rows} rows, {points} points, {failed} failed"),
-        _ => format!("{rows} rows"),
-    })
+        summary,
+    }
 }

@@ -22,6 +22,7 @@
 
 use std::path::{Path, PathBuf};
 
+use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use woodpile_scene::{Scene, SceneError};
@@ -117,9 +118,15 @@ impl Sweep {
 
     /// Every point's scene and cache key, in grid order.
     pub fn points(&self) -> Result<Vec<(Key, Scene)>> {
-        (0..self.count())
-            .into_par_iter()
-            .map(|i| {
+        let all: Vec<usize> = (0..self.count()).collect();
+        self.points_at(&all)
+    }
+
+    /// The scenes and cache keys of the points `indices`.
+    pub fn points_at(&self, indices: &[usize]) -> Result<Vec<(Key, Scene)>> {
+        indices
+            .par_iter()
+            .map(|&i| {
                 let scene = self.scene_at(i)?;
                 Ok((point_key(&scene), scene))
             })
@@ -135,14 +142,31 @@ impl Sweep {
             .count())
     }
 
-    /// Simulates what `store` lacks and assembles the output.
+    /// Simulates what `store` lacks and assembles the whole output.
     pub(crate) fn run(
         &self,
         stage: &str,
         store: &PointStore,
         events: &dyn Events,
     ) -> Result<Output> {
-        let points = self.points()?;
+        let all: Vec<usize> = (0..self.count()).collect();
+        let (frame, stats) = self.run_points(stage, store, events, &all)?;
+        Ok(Output {
+            frame,
+            summary: self.summary(&stats)?,
+        })
+    }
+
+    /// Simulates what `store` lacks among the points `indices` (increasing) and assembles
+    /// their rows: the whole output, or one shard's part of it.
+    pub(crate) fn run_points(
+        &self,
+        stage: &str,
+        store: &PointStore,
+        events: &dyn Events,
+        indices: &[usize],
+    ) -> Result<(DataFrame, SweepStats)> {
+        let points = self.points_at(indices)?;
         let mut results: Vec<Option<PointResult>> =
             points.par_iter().map(|(k, _)| store.load(k)).collect();
         let todo: Vec<usize> = (0..points.len())
@@ -163,21 +187,23 @@ impl Sweep {
             results[i] = Some(result);
         }
         let results: Vec<PointResult> = results.into_iter().flatten().collect();
-        let failed = results.iter().filter(|r| r.is_err()).count();
-        if failed > 0 {
+        let stats = SweepStats::of(&results);
+        if stats.failed > 0 {
             events.warn(&format!(
-                "stage `{stage}`: {failed} of {} points failed (null rows with the reason in `failure`)",
-                results.len()
+                "stage `{stage}`: {} of {} points failed (null rows with the reason in `failure`)",
+                stats.failed, stats.points
             ));
         }
-        let frame = self.table(&points, &results)?.into_frame()?;
-        Ok(Output {
-            frame,
-            summary: self.summary(&points, &results),
-        })
+        let frame = self.table(indices, &points, &results)?.into_frame()?;
+        Ok((frame, stats))
     }
 
-    fn table(&self, points: &[(Key, Scene)], results: &[PointResult]) -> Result<Columns> {
+    fn table(
+        &self,
+        indices: &[usize],
+        points: &[(Key, Scene)],
+        results: &[PointResult],
+    ) -> Result<Columns> {
         let rows: usize = results
             .iter()
             .map(|r| r.as_ref().map_or(1, |p| p.t.len()))
@@ -185,7 +211,7 @@ impl Sweep {
         let mut index = Vec::with_capacity(rows);
         let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::with_capacity(rows); self.axes.len()];
         let mut c = RowColumns::with_capacity(rows);
-        for (i, ((key, _), result)) in points.iter().zip(results).enumerate() {
+        for ((&i, (key, _)), result) in indices.iter().zip(points).zip(results) {
             let values = self.values(i);
             let n = result.as_ref().map_or(1, |p| p.t.len());
             for _ in 0..n {
@@ -216,26 +242,68 @@ impl Sweep {
         Ok(columns)
     }
 
-    fn summary(&self, points: &[(Key, Scene)], results: &[PointResult]) -> Value {
-        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
-        let max = |f: &dyn Fn(&crate::points::PointData) -> Option<f64>| {
-            ok().filter_map(f)
-                .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))))
-        };
-        let first = &points[0].1.scenario;
-        json!({
-            "points": points.len(),
-            "failed": results.iter().filter(|r| r.is_err()).count(),
+    /// The manifest summary of a whole sweep with statistics `stats`.
+    pub(crate) fn summary(&self, stats: &SweepStats) -> Result<Value> {
+        let first = self.scene_at(0)?.scenario;
+        Ok(json!({
+            "points": stats.points,
+            "failed": stats.failed,
             "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
             "method": match first.method { MethodChoice::Auto => "auto", MethodChoice::Named(m) => m.name() },
             "tolerance": first.accuracy.tolerance,
             "dt": first.accuracy.dt,
             "t_end": first.t_end,
             "sample_every": first.sample_every,
-            "rhs_evals": ok().map(|p| p.rhs_evals).sum::<u64>(),
-            "max_error_estimate": max(&|p| p.error_estimate),
-            "max_energy_drift": max(&|p| p.energy_drift),
-        })
+            "rhs_evals": stats.rhs_evals,
+            "max_error_estimate": stats.max_error_estimate,
+            "max_energy_drift": stats.max_energy_drift,
+        }))
+    }
+}
+
+/// Facts about a set of simulated points that combine exactly across shards (counts, sums of
+/// integers, maxima), so a merged sweep reports what a single run would.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SweepStats {
+    /// Points.
+    pub points: usize,
+    /// Of which failed.
+    pub failed: usize,
+    /// Right-hand-side evaluations of all successful points.
+    pub rhs_evals: u64,
+    /// Largest `auto` error estimate.
+    pub max_error_estimate: Option<f64>,
+    /// Largest relative energy drift.
+    pub max_energy_drift: Option<f64>,
+}
+
+impl SweepStats {
+    fn of(results: &[PointResult]) -> Self {
+        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
+        let max =
+            |f: fn(&crate::points::PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
+        Self {
+            points: results.len(),
+            failed: results.iter().filter(|r| r.is_err()).count(),
+            rhs_evals: ok().map(|p| p.rhs_evals).sum(),
+            max_error_estimate: max(|p| p.error_estimate),
+            max_energy_drift: max(|p| p.energy_drift),
+        }
+    }
+
+    /// The statistics of the union of two disjoint point sets.
+    pub fn merge(self, other: SweepStats) -> SweepStats {
+        let max = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(x), Some(y)) => Some(x.max(y)),
+            (x, y) => x.or(y),
+        };
+        SweepStats {
+            points: self.points + other.points,
+            failed: self.failed + other.failed,
+            rhs_evals: self.rhs_evals + other.rhs_evals,
+            max_error_estimate: max(self.max_error_estimate, other.max_error_estimate),
+            max_energy_drift: max(self.max_energy_drift, other.max_energy_drift),
+        }
     }
 }
 

@@ -412,6 +412,89 @@ fn diff_agrees_on_identical_trees_and_catches_a_perturbed_value() {
     assert!(report.problems.iter().any(|p| p.contains("sweep.parquet")));
 }
 
+#[test]
+fn sharded_runs_merge_into_the_single_machine_result() {
+    use woodpile_pipeline::shard::{merge, run_shard, Shard};
+    let single = Project::new(&[("sweep", SWEEP)]);
+    single.run(&[]);
+    let sharded = Project::new(&[("sweep", SWEEP)]);
+    let pipeline = sharded.load();
+    let events = Counter::default();
+    for i in [0, 2] {
+        run_shard(
+            &pipeline,
+            "sweep",
+            Shard::new(i, 4).unwrap(),
+            &sharded.results,
+            &events,
+        )
+        .unwrap();
+    }
+    // Incomplete: the error names the missing shards, and nothing is written.
+    let err = merge(&pipeline, "sweep", &sharded.results)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("missing shard(s) 1, 3 of 4"), "{err}");
+    assert!(!sharded.output("sweep").exists());
+    // A part made with another N is a mismatch, not a silent mix.
+    run_shard(
+        &pipeline,
+        "sweep",
+        Shard::new(0, 3).unwrap(),
+        &sharded.results,
+        &events,
+    )
+    .unwrap();
+    let err = merge(&pipeline, "sweep", &sharded.results)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("different shard counts"), "{err}");
+    std::fs::remove_dir_all(sharded.results.join("parts")).unwrap();
+
+    for i in 0..4 {
+        run_shard(
+            &pipeline,
+            "sweep",
+            Shard::new(i, 4).unwrap(),
+            &sharded.results,
+            &events,
+        )
+        .unwrap();
+    }
+    // A shard re-run finds its part done and simulates nothing.
+    let again = Counter::default();
+    let rerun = run_shard(
+        &pipeline,
+        "sweep",
+        Shard::new(1, 4).unwrap(),
+        &sharded.results,
+        &again,
+    )
+    .unwrap();
+    assert!(rerun.already_done);
+    assert_eq!(again.points.load(Ordering::SeqCst), 0);
+    assert_eq!(merge(&pipeline, "sweep", &sharded.results).unwrap(), 4);
+    let report = diff(&single.results, &sharded.results, &DiffOptions::default()).unwrap();
+    assert!(report.agrees(), "{report:?}");
+    let (a, b) = (
+        table::read_manifest(&single.output("sweep"))
+            .unwrap()
+            .unwrap(),
+        table::read_manifest(&sharded.output("sweep"))
+            .unwrap()
+            .unwrap(),
+    );
+    assert_eq!(a, b, "the merged manifest is the single run's");
+    assert_eq!(
+        state(
+            &pipeline,
+            &sharded.results,
+            pipeline.stage("sweep").unwrap()
+        ),
+        State::Fresh
+    );
+}
+
 /// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.
 fn perturb(path: &Path, column: &str, delta: f64) {
     let manifest = table::read_manifest(path).unwrap().unwrap();

@@ -1,0 +1,355 @@
+//! Splitting a sweep across machines: `woodpile run STAGE --shard I/N` computes shard I of N
+//! (points with index ≡ I mod N, so every shard gets a fair mix of cheap and expensive scenes)
+//! into a part file; `woodpile merge STAGE` joins a complete set of parts into the stage's
+//! output, identical to what one machine would have written.
+//!
+//! Parts live in `results/parts/<stage>/<key>.shard-<I>-of-<N>.parquet`. The key in the name
+//! ties a part to one definition of the stage: editing the stage orphans old parts instead of
+//! mixing them in. Points go through the shared [`PointStore`], so a shard re-run after a crash
+//! skips every point it had finished.
+
+use std::path::{Path, PathBuf};
+
+use polars::prelude::{DataFrame, IdxCa, IdxSize};
+use serde_json::json;
+
+use crate::error::{PipelineError, Result};
+use crate::events::Events;
+use crate::manifest::Manifest;
+use crate::pipeline::Pipeline;
+use crate::points::PointStore;
+use crate::run::manifest_for;
+use crate::stage::{Spec, Stage};
+use crate::status::output_path;
+use crate::sweep::{points_dir, Sweep, SweepStats};
+use crate::table::{self, f64_column};
+
+/// Shard `index` of `count` (0 <= index < count).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// Which shard, from 0.
+    pub index: usize,
+    /// How many shards.
+    pub count: usize,
+}
+
+impl Shard {
+    /// Parses `I/N`.
+    pub fn parse(text: &str) -> std::result::Result<Shard, String> {
+        let (i, n) = text.split_once('/').ok_or("expected I/N, e.g. 0/4")?;
+        let number = |s: &str| {
+            s.trim()
+                .parse::<usize>()
+                .map_err(|_| format!("`{s}` is not a whole number"))
+        };
+        Shard::new(number(i)?, number(n)?)
+    }
+
+    /// Checks `index < count`.
+    pub fn new(index: usize, count: usize) -> std::result::Result<Shard, String> {
+        if count == 0 || index >= count {
+            return Err(format!("shard {index}/{count}: need 0 <= I < N"));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The shard of a SLURM array task, from `SLURM_ARRAY_TASK_ID`, `SLURM_ARRAY_TASK_COUNT`
+    /// and (when the array does not start at 0) `SLURM_ARRAY_TASK_MIN`; `None` outside an
+    /// array job. `get` reads a variable (the environment, or a map in tests).
+    pub fn from_slurm(
+        get: impl Fn(&str) -> Option<String>,
+    ) -> std::result::Result<Option<Shard>, String> {
+        let (Some(id), Some(count)) = (get("SLURM_ARRAY_TASK_ID"), get("SLURM_ARRAY_TASK_COUNT"))
+        else {
+            return Ok(None);
+        };
+        let number = |name: &str, s: &str| {
+            s.trim()
+                .parse::<usize>()
+                .map_err(|_| format!("{name}=`{s}` is not a whole number"))
+        };
+        let id = number("SLURM_ARRAY_TASK_ID", &id)?;
+        let count = number("SLURM_ARRAY_TASK_COUNT", &count)?;
+        let min = match get("SLURM_ARRAY_TASK_MIN") {
+            Some(m) => number("SLURM_ARRAY_TASK_MIN", &m)?,
+            None => 0,
+        };
+        let index = id
+            .checked_sub(min)
+            .ok_or("SLURM_ARRAY_TASK_ID below SLURM_ARRAY_TASK_MIN")?;
+        Shard::new(index, count).map(Some)
+    }
+
+    /// The points of a sweep of `total` points that belong to this shard.
+    pub fn points(&self, total: usize) -> Vec<usize> {
+        (self.index..total).step_by(self.count).collect()
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// The directory of `stage`'s parts.
+pub fn parts_dir(results: &Path, stage: &str) -> PathBuf {
+    results.join("parts").join(stage)
+}
+
+fn part_path(results: &Path, stage: &str, key: &str, shard: Shard) -> PathBuf {
+    parts_dir(results, stage).join(format!(
+        "{key}.shard-{}-of-{}.parquet",
+        shard.index, shard.count
+    ))
+}
+
+/// `(key, shard)` from a part file name.
+fn parse_part_name(name: &str) -> Option<(String, Shard)> {
+    let stem = name.strip_suffix(".parquet")?;
+    let (key, rest) = stem.split_once(".shard-")?;
+    let (i, n) = rest.split_once("-of-")?;
+    Some((
+        key.to_string(),
+        Shard::new(i.parse().ok()?, n.parse().ok()?).ok()?,
+    ))
+}
+
+fn sweep_of<'p>(pipeline: &'p Pipeline, name: &str) -> Result<(&'p Stage, &'p Sweep)> {
+    let stage = pipeline.stage(name)?;
+    match &stage.spec {
+        Spec::Sweep(sweep) => Ok((stage, sweep)),
+        other => Err(PipelineError::stage(
+            name,
+            format!(
+                "only sweeps are sharded; `{name}` is a {} stage (run it after `woodpile merge`)",
+                other.kind()
+            ),
+        )),
+    }
+}
+
+/// What a shard run did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShardRun {
+    /// The part file.
+    pub part: PathBuf,
+    /// Points in the shard.
+    pub points: usize,
+    /// Whether the part already existed for this definition (nothing ran).
+    pub already_done: bool,
+}
+
+/// Computes shard `shard` of sweep `name` into its part file.
+pub fn run_shard(
+    pipeline: &Pipeline,
+    name: &str,
+    shard: Shard,
+    results: &Path,
+    events: &dyn Events,
+) -> Result<ShardRun> {
+    let (stage, sweep) = sweep_of(pipeline, name)?;
+    let key = pipeline.key(name).to_string();
+    let part = part_path(results, name, &key, shard);
+    let indices = shard.points(sweep.count());
+    if matches!(table::read_manifest(&part), Ok(Some(m)) if m.key == key) {
+        return Ok(ShardRun {
+            part,
+            points: indices.len(),
+            already_done: true,
+        });
+    }
+    let store = PointStore::new(points_dir(results));
+    store.sweep_stale_temps();
+    crate::atomic::sweep_stale_temps(&parts_dir(results, name));
+    events.stage_started(name, &format!("shard {shard}"));
+    let (frame, stats) = sweep.run_points(name, &store, events, &indices)?;
+    let manifest = manifest_for(
+        pipeline,
+        stage,
+        json!({"shard": shard.index, "shards": shard.count, "stats": stats}),
+    );
+    table::write(&part, frame, &manifest)?;
+    events.stage_finished(name, &format!("shard {shard}: {} points", indices.len()));
+    Ok(ShardRun {
+        part,
+        points: indices.len(),
+        already_done: false,
+    })
+}
+
+/// Joins the complete set of parts of sweep `name` (for its current definition) into
+/// `results/<name>.parquet`. Returns the number of parts merged.
+pub fn merge(pipeline: &Pipeline, name: &str, results: &Path) -> Result<usize> {
+    let (stage, sweep) = sweep_of(pipeline, name)?;
+    let key = pipeline.key(name).to_string();
+    let dir = parts_dir(results, name);
+    let mut current: Vec<(Shard, PathBuf)> = Vec::new();
+    let mut orphans = 0;
+    if let Ok(entries) = std::fs::read_dir(&dir) {
+        for entry in entries.flatten() {
+            let file = entry.file_name().to_string_lossy().into_owned();
+            match parse_part_name(&file) {
+                Some((k, shard)) if k == key => current.push((shard, entry.path())),
+                Some(_) => orphans += 1,
+                None => {}
+            }
+        }
+    }
+    let orphan_note = if orphans > 0 {
+        format!(" ({orphans} part(s) of an older definition of the stage are ignored)")
+    } else {
+        String::new()
+    };
+    let fail = |reason: String| Err(PipelineError::stage(name, reason + &orphan_note));
+    if current.is_empty() {
+        return fail(format!(
+            "no parts for the current definition (key {}) in {}: run `woodpile run {name} --shard I/N` for every I first",
+            &key[..12],
+            dir.display()
+        ));
+    }
+    let mut counts: Vec<usize> = current.iter().map(|(s, _)| s.count).collect();
+    counts.sort_unstable();
+    counts.dedup();
+    if counts.len() > 1 {
+        return fail(format!(
+            "parts were made with different shard counts {counts:?}: re-run them with one N"
+        ));
+    }
+    let n = counts[0];
+    current.sort_by_key(|(s, _)| s.index);
+    let missing: Vec<String> = (0..n)
+        .filter(|i| !current.iter().any(|(s, _)| s.index == *i))
+        .map(|i| i.to_string())
+        .collect();
+    if !missing.is_empty() {
+        return fail(format!(
+            "incomplete: missing shard(s) {} of {n} (run `woodpile run {name} --shard I/{n}` for each)",
+            missing.join(", ")
+        ));
+    }
+    let mut frame: Option<DataFrame> = None;
+    let mut stats = SweepStats::default();
+    for (shard, path) in &current {
+        let manifest: Manifest = table::read_manifest(path)?
+            .ok_or_else(|| PipelineError::io(path, "part vanished while merging"))?;
+        if manifest.key != key {
+            return fail(format!(
+                "{} was computed for another definition",
+                path.display()
+            ));
+        }
+        let part_stats: SweepStats = serde_json::from_value(manifest.summary["stats"].clone())
+            .map_err(|e| PipelineError::io(path, format!("bad shard statistics: {e}")))?;
+        if part_stats.points != shard.points(sweep.count()).len() {
+            return fail(format!(
+                "{} holds {} points, shard {shard} has {}",
+                path.display(),
+                part_stats.points,
+                shard.points(sweep.count()).len()
+            ));
+        }
+        stats = stats.merge(part_stats);
+        let part = table::read(path)?;
+        frame = Some(match frame {
+            None => part,
+            Some(f) => f.vstack(&part).map_err(|e| PipelineError::io(path, e))?,
+        });
+    }
+    let Some(frame) = frame else {
+        return fail("no parts".into());
+    };
+    let frame = in_point_order(frame, sweep.count())
+        .map_err(|reason| PipelineError::stage(name, reason))?;
+    let manifest = manifest_for(pipeline, stage, sweep.summary(&stats)?);
+    table::write(&output_path(results, name), frame, &manifest)?;
+    Ok(current.len())
+}
+
+/// Rows reordered by point (stable, so each point's samples keep their time order); every
+/// point 0..total must appear.
+fn in_point_order(frame: DataFrame, total: usize) -> std::result::Result<DataFrame, String> {
+    let point = f64_column(&frame, "point").map_err(|e| e.to_string())?;
+    let mut order: Vec<(usize, IdxSize)> = Vec::with_capacity(point.len());
+    for (row, p) in point.iter().enumerate() {
+        let p = p.ok_or("a part has a row without a point index")? as usize;
+        order.push((p, row as IdxSize));
+    }
+    order.sort_by_key(|&(p, _)| p);
+    let mut seen = vec![false; total];
+    for &(p, _) in &order {
+        *seen
+            .get_mut(p)
+            .ok_or(format!("point {p} is outside the sweep's {total} points"))? = true;
+    }
+    if let Some(p) = seen.iter().position(|s| !s) {
+        return Err(format!("point {p} is in no part"));
+    }
+    let idx = IdxCa::from_vec("idx".into(), order.into_iter().map(|(_, r)| r).collect());
+    let mut out = frame.take(&idx).map_err(|e| e.to_string())?;
+    out.rechunk_mut();
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_partition_the_points() {
+        assert_eq!(Shard::parse("1/4"), Ok(Shard { index: 1, count: 4 }));
+        assert!(Shard::parse("4/4").is_err());
+        assert!(Shard::parse("x/4").is_err());
+        assert!(Shard::parse("3").is_err());
+        let mut all: Vec<usize> = (0..3)
+            .flat_map(|i| Shard::new(i, 3).unwrap().points(10))
+            .collect();
+        all.sort_unstable();
+        assert_eq!(all, (0..10).collect::<Vec<_>>());
+        // More shards than points: some shards are empty, none overlap.
+        assert!(Shard::new(7, 8).unwrap().points(5).is_empty());
+    }
+
+    #[test]
+    fn slurm_variables_give_the_shard() {
+        let env = |pairs: &'static [(&'static str, &'static str)]| {
+            move |k: &str| {
+                pairs
+                    .iter()
+                    .find(|(n, _)| *n == k)
+                    .map(|(_, v)| v.to_string())
+            }
+        };
+        assert_eq!(Shard::from_slurm(env(&[])), Ok(None));
+        assert_eq!(
+            Shard::from_slurm(env(&[
+                ("SLURM_ARRAY_TASK_ID", "2"),
+                ("SLURM_ARRAY_TASK_COUNT", "4")
+            ])),
+            Ok(Some(Shard { index: 2, count: 4 }))
+        );
+        assert_eq!(
+            Shard::from_slurm(env(&[
+                ("SLURM_ARRAY_TASK_ID", "3"),
+                ("SLURM_ARRAY_TASK_COUNT", "4"),
+                ("SLURM_ARRAY_TASK_MIN", "1")
+            ])),
+            Ok(Some(Shard { index: 2, count: 4 }))
+        );
+        assert!(Shard::from_slurm(env(&[
+            ("SLURM_ARRAY_TASK_ID", "x"),
+            ("SLURM_ARRAY_TASK_COUNT", "4")
+        ]))
+        .is_err());
+    }
+
+    #[test]
+    fn part_names_round_trip() {
+        let shard = Shard::new(3, 8).unwrap();
+        let path = part_path(Path::new("r"), "s", "abc", shard);
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert_eq!(parse_part_name(&name), Some(("abc".to_string(), shard)));
+        assert_eq!(parse_part_name("abc.parquet"), None);
+    }
+}

@@ -1,0 +1,155 @@
+//! SLURM job scripts for a sharded sweep: an array job whose task I runs shard I/N, and a merge
+//! job that starts only if every array task succeeded (`--dependency=afterok`). Pure text
+//! generation; the CLI writes the files and the user (or `make slurm-test`) submits them.
+
+use std::path::Path;
+
+/// What the scripts need to know.
+#[derive(Debug, Clone)]
+pub struct SlurmJob<'a> {
+    /// The sweep stage.
+    pub stage: &'a str,
+    /// Array tasks (= shards).
+    pub tasks: usize,
+    /// `--partition`, if any.
+    pub partition: Option<&'a str>,
+    /// `--time` limit per task, if any (SLURM syntax, e.g. `01:00:00`).
+    pub time: Option<&'a str>,
+    /// CPUs per task; rayon uses them all.
+    pub cpus: usize,
+    /// The `woodpile` binary (absolute: jobs start in another shell).
+    pub binary: &'a Path,
+    /// The project directory the jobs `cd` into (absolute).
+    pub workdir: &'a Path,
+    /// `--pipeline` (relative to `workdir`, or absolute).
+    pub pipeline: &'a Path,
+    /// `--results` (shared by every task; relative to `workdir`, or absolute).
+    pub results: &'a Path,
+    /// Directory of the jobs' log files.
+    pub logs: &'a Path,
+}
+
+fn quote(path: &Path) -> String {
+    format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
+}
+
+impl SlurmJob<'_> {
+    fn header(&self, name: &str, log: &str) -> String {
+        let mut h = format!(
+            "#!/bin/bash\n#SBATCH --job-name={name}\n#SBATCH --output={}/{log}\n#SBATCH --cpus-per-task={}\n",
+            self.logs.display(),
+            self.cpus
+        );
+        if let Some(p) = self.partition {
+            h += &format!("#SBATCH --partition={p}\n");
+        }
+        if let Some(t) = self.time {
+            h += &format!("#SBATCH --time={t}\n");
+        }
+        h
+    }
+
+    fn common(&self) -> String {
+        format!(
+            "set -euo pipefail\ncd {}\nexport RAYON_NUM_THREADS=\"${{SLURM_CPUS_PER_TASK:-{}}}\"\n",
+            quote(self.workdir),
+            self.cpus
+        )
+    }
+
+    fn locations(&self) -> String {
+        format!(
+            "--pipeline {} --results {}",
+            quote(self.pipeline),
+            quote(self.results)
+        )
+    }
+
+    /// The array job: task I computes shard I/N.
+    pub fn array_script(&self) -> String {
+        let mut s = self.header(
+            &format!("woodpile-{}", self.stage),
+            &format!("{}-%A_%a.out", self.stage),
+        );
+        s += &format!("#SBATCH --array=0-{}\n", self.tasks.saturating_sub(1));
+        s += &format!(
+            "# Shard I of {} of sweep `{}`; re-running a task skips its finished points.\n",
+            self.tasks, self.stage
+        );
+        s += &self.common();
+        s += &format!(
+            "exec {} run {} --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\" {}\n",
+            quote(self.binary),
+            self.stage,
+            self.tasks,
+            self.locations()
+        );
+        s
+    }
+
+    /// The merge job (submitted with `--dependency=afterok:<array job id>`).
+    pub fn merge_script(&self) -> String {
+        let mut s = self.header(
+            &format!("woodpile-{}-merge", self.stage),
+            &format!("{}-merge-%j.out", self.stage),
+        );
+        s += &format!(
+            "# Joins the {} parts of `{}` into its result; refuses an incomplete set.\n",
+            self.tasks, self.stage
+        );
+        s += &self.common();
+        s += &format!(
+            "exec {} merge {} {}\n",
+            quote(self.binary),
+            self.stage,
+            self.locations()
+        );
+        s
+    }
+
+    /// Submits both, chained: prints the two job ids. `sbatch_flags` (e.g. `--wait`) go to the
+    /// merge job's submission.
+    pub fn submit_script(&self, array: &Path, merge: &Path) -> String {
+        format!(
+            "#!/bin/bash\n# Submit the `{stage}` array, then its merge job once every task succeeded.\n\
+             # Extra arguments (e.g. --wait) are passed to the merge job's sbatch.\n\
+             set -euo pipefail\nmkdir -p {logs}\n\
+             array=$(sbatch --parsable {array})\n\
+             merge=$(sbatch --parsable --dependency=afterok:\"${{array%%;*}}\" \"$@\" {merge})\n\
+             echo \"array job $array, merge job $merge\"\n",
+            stage = self.stage,
+            logs = quote(self.logs),
+            array = quote(array),
+            merge = quote(merge),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scripts_shard_by_array_index_and_chain_the_merge() {
+        let job = SlurmJob {
+            stage: "f7_coarse",
+            tasks: 16,
+            partition: Some("short"),
+            time: Some("00:30:00"),
+            cpus: 4,
+            binary: Path::new("/opt/wp/woodpile"),
+            workdir: Path::new("/home/me/woodpile"),
+            pipeline: Path::new("pipeline"),
+            results: Path::new("results"),
+            logs: Path::new("/home/me/woodpile/slurm/logs"),
+        };
+        let array = job.array_script();
+        assert!(array.contains("#SBATCH --array=0-15\n"));
+        assert!(array.contains("#SBATCH --partition=short\n#SBATCH --time=00:30:00\n"));
+        assert!(array.contains("run f7_coarse --shard \"${SLURM_ARRAY_TASK_ID}/16\""));
+        let merge = job.merge_script();
+        assert!(merge.contains("merge f7_coarse --pipeline 'pipeline' --results 'results'"));
+        let submit = job.submit_script(Path::new("a.sbatch"), Path::new("m.sbatch"));
+        assert!(submit.contains("--dependency=afterok:"));
+    }
+}
