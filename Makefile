@@ -29,7 +29,7 @@ status: build ## Each stage fresh, stale or missing, and why
 check: build ## Recompute every stage into scratch/ and diff against the committed results/
 	$(WOODPILE) status --check
 	rm -rf $(SCRATCH)
-	$(WOODPILE) run --results $(SCRATCH)/results
+	$(WOODPILE) run --results $(SCRATCH)/results --figures $(SCRATCH)/figures
 	$(WOODPILE) diff results $(SCRATCH)/results $(CHECK_TOL)
 
 read-check: ## Open every result table with pyarrow, pandas and polars

@@ -23,6 +23,9 @@ pub(crate) struct Locations {
     /// Results tree: stage tables and the point cache.
     #[arg(long, default_value = "results")]
     results: PathBuf,
+    /// Where render stages write their PNG and SVG figures.
+    #[arg(long, default_value = "figures")]
+    figures: PathBuf,
 }
 
 /// Arguments of `woodpile run`.
@@ -167,6 +170,7 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         force: args.force,
         dry_run: args.dry_run,
         results: args.at.results.clone(),
+        figures: args.at.figures.clone(),
     };
     let progress = Progress::new();
     let steps = run(&pipeline, &options, &progress).map_err(stage_failure)?;
@@ -259,7 +263,7 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
     println!("{:width$}  {:7}  {:7}  why", "stage", "kind", "state");
     let mut not_fresh = 0;
     for stage in pipeline.stages() {
-        let st = state(&pipeline, &args.at.results, stage);
+        let st = state(&pipeline, &args.at.results, &args.at.figures, stage);
         not_fresh += usize::from(st != State::Fresh);
         println!(
             "{:width$}  {:7}  {:7}  {}",

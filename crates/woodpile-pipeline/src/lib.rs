@@ -6,6 +6,7 @@
 //! - [`sweep`] (with [`grid`], [`template`], [`points`]): simulate parameter grids, cached
 //!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
 //! - [`reduce`]: read fractions at a time, maximise over axes.
+//! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
 //! - [`table`], [`manifest`], [`atomic`], [`canonical`]: parquet IO, self-description, atomic
@@ -25,6 +26,7 @@ pub mod manifest;
 pub mod pipeline;
 pub mod points;
 pub mod reduce;
+pub mod render;
 pub mod run;
 pub mod shard;
 pub mod slurm;

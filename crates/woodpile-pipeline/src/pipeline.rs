@@ -204,6 +204,23 @@ fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
                 )),
             }
         }
+        Spec::Render(_) => {
+            let [input] = stage.inputs.as_slice() else {
+                return Err(definition_error(
+                    stage,
+                    "inputs",
+                    "a render stage draws exactly one table",
+                ));
+            };
+            match &by_name[input.as_str()].spec {
+                Spec::Render(_) => Err(definition_error(
+                    stage,
+                    "inputs[0]",
+                    format!("`{input}` is a render stage: draw a data table"),
+                )),
+                _ => Ok(()),
+            }
+        }
         _ => Ok(()),
     }
 }

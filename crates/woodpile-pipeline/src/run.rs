@@ -2,7 +2,7 @@
 //! atomically with its manifest.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use crate::atomic;
 use crate::canonical::code_version;
@@ -29,6 +29,8 @@ pub struct RunOptions {
     pub dry_run: bool,
     /// The results tree (stage tables and the point cache).
     pub results: PathBuf,
+    /// Where render stages put their PNG and SVG files.
+    pub figures: PathBuf,
 }
 
 /// One stage's part in a run.
@@ -52,7 +54,7 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
     for stage in pipeline.selection(&options.targets)? {
         let forced =
             options.force && (options.targets.is_empty() || options.targets.contains(&stage.name));
-        let current = state(pipeline, results, stage);
+        let current = state(pipeline, results, &options.figures, stage);
         let why = match (&current, forced) {
             (State::Fresh, false) => {
                 events.stage_skipped(&stage.name);
@@ -81,7 +83,7 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
             continue;
         }
         events.stage_started(&stage.name, &why);
-        let summary = execute(pipeline, stage, results, &store, events)?;
+        let summary = execute(pipeline, stage, options, &store, events)?;
         events.stage_finished(&stage.name, &summary);
     }
     Ok(steps)
@@ -90,10 +92,11 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
 fn execute(
     pipeline: &Pipeline,
     stage: &Stage,
-    results: &Path,
+    options: &RunOptions,
     store: &PointStore,
     events: &dyn Events,
 ) -> Result<String> {
+    let results = &options.results;
     let removed = store.sweep_stale_temps() + atomic::sweep_stale_temps(results);
     if removed > 0 {
         events.warn(&format!(
@@ -110,6 +113,10 @@ fn execute(
                 PipelineError::stage(&stage.name, format!("`{input}` is not a sweep"))
             })?;
             reduce.run(&stage.name, &frame, axes)?
+        }
+        Spec::Render(render) => {
+            let frame = table::read(&output_path(results, &stage.inputs[0]))?;
+            render.run(&stage.name, &frame, &options.figures)?
         }
     };
     let manifest = manifest_for(pipeline, stage, output.summary.clone());

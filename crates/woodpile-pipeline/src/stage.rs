@@ -1,7 +1,7 @@
 //! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # sweep | reduce
+//! kind = "sweep"               # sweep | reduce | render
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
@@ -17,10 +17,11 @@ use crate::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::reduce::Reduce;
+use crate::render::Render;
 use crate::sweep::Sweep;
 
 /// The kinds of stage, in pipeline order.
-pub const KINDS: &[&str] = &["sweep", "reduce"];
+pub const KINDS: &[&str] = &["sweep", "reduce", "render"];
 
 /// What a stage does, with its kind-specific parameters.
 #[derive(Debug, Clone)]
@@ -29,6 +30,8 @@ pub enum Spec {
     Sweep(Sweep),
     /// Read the fractions of a sweep at a time, optionally maximised over axes.
     Reduce(Reduce),
+    /// Draw a table as a figure.
+    Render(Render),
 }
 
 impl Spec {
@@ -37,6 +40,7 @@ impl Spec {
         match self {
             Spec::Sweep(_) => "sweep",
             Spec::Reduce(_) => "reduce",
+            Spec::Render(_) => "render",
         }
     }
 }
@@ -86,6 +90,7 @@ impl Stage {
         let spec = match kind.as_str() {
             "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
             "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
+            "render" => Spec::Render(Render::parse(&mut fields)?),
             other => {
                 return Err(fields.error(
                     "kind",

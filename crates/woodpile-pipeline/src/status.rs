@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use crate::canonical::{changed_paths, code_version};
 use crate::pipeline::Pipeline;
-use crate::stage::Stage;
+use crate::render::Render;
+use crate::stage::{Spec, Stage};
 use crate::table;
 
 /// Freshness of one stage output.
@@ -44,8 +45,9 @@ pub fn output_path(results: &Path, name: &str) -> PathBuf {
     results.join(format!("{name}.parquet"))
 }
 
-/// The state of `stage` given the outputs under `results`.
-pub fn state(pipeline: &Pipeline, results: &Path, stage: &Stage) -> State {
+/// The state of `stage` given the outputs under `results` (and, for render stages, the figure
+/// files under `figures`).
+pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage) -> State {
     let stored = match table::read_manifest(&output_path(results, &stage.name)) {
         Ok(None) => return State::Missing,
         Ok(Some(m)) => m,
@@ -53,6 +55,16 @@ pub fn state(pipeline: &Pipeline, results: &Path, stage: &Stage) -> State {
     };
     let key = pipeline.key(&stage.name);
     if stored.key == key.as_str() {
+        if let Spec::Render(_) = stage.spec {
+            let missing: Vec<String> = Render::files(figures, &stage.name)
+                .iter()
+                .filter(|f| !f.exists())
+                .map(|f| format!("figure {} missing", f.display()))
+                .collect();
+            if !missing.is_empty() {
+                return State::Stale(missing);
+            }
+        }
         return State::Fresh;
     }
     let mut reasons = Vec::new();

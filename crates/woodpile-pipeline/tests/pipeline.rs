@@ -103,6 +103,7 @@ impl Project {
             force,
             dry_run: false,
             results: self.results.clone(),
+            figures: self.results.join("figures"),
         };
         run(&self.load(), &options, &events).unwrap();
         events
@@ -110,7 +111,12 @@ impl Project {
 
     fn state(&self, name: &str) -> State {
         let p = self.load();
-        state(&p, &self.results, p.stage(name).unwrap())
+        state(
+            &p,
+            &self.results,
+            &self.results.join("figures"),
+            p.stage(name).unwrap(),
+        )
     }
 
     fn output(&self, name: &str) -> PathBuf {
@@ -489,10 +495,67 @@ fn sharded_runs_merge_into_the_single_machine_result() {
         state(
             &pipeline,
             &sharded.results,
+            &sharded.results,
             pipeline.stage("sweep").unwrap()
         ),
         State::Fresh
     );
+}
+
+#[test]
+fn render_stages_draw_figures_and_keep_the_plotted_numbers() {
+    let figure = r#"
+kind = "render"
+inputs = ["at_end"]
+title = "test figure"
+[lines]
+x = "eps"
+y = ["R", "E_tr"]
+panels = "L"
+x_label = "eps"
+y_label = "fraction"
+"#;
+    let heat = r#"
+kind = "render"
+inputs = ["at_end"]
+title = "test map"
+[heatmap]
+x = "eps"
+y = "L"
+z = "E_tr"
+x_label = "eps"
+y_label = "L"
+z_label = "E_tr"
+mark_max = true
+"#;
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("figure", figure),
+        ("map", heat),
+    ]);
+    p.run(&[]);
+    let figures = p.results.join("figures");
+    for name in ["figure.png", "figure.svg", "map.png", "map.svg"] {
+        assert!(figures.join(name).exists(), "{name}");
+    }
+    let plotted = table::read(&p.output("figure")).unwrap();
+    let names: Vec<String> = plotted
+        .get_column_names()
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    assert_eq!(names, ["L", "eps", "R", "E_tr"]);
+    // A deleted figure makes its stage stale, and only that stage re-runs.
+    std::fs::remove_file(figures.join("map.svg")).unwrap();
+    assert!(matches!(p.state("map"), State::Stale(why) if why[0].contains("map.svg")));
+    assert_eq!(*p.run(&[]).started.lock().unwrap(), vec!["map".to_string()]);
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("f", &figure.replace("[lines]", "[bars]")),
+    ]);
+    assert!(e.contains("f.toml") && e.contains("bars"), "{e}");
 }
 
 /// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.

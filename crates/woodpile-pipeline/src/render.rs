@@ -1,0 +1,301 @@
+//! `kind = "render"`: draw one input table as a figure (PNG and SVG under `figures/`), and keep
+//! exactly the plotted numbers as the stage's parquet table.
+//!
+//! ```toml
+//! kind = "render"
+//! inputs = ["f4_fractions"]
+//! title = "Fig. 4: energy fractions against the mass ratio"
+//! columns = 2                     # panels per row
+//! [lines]                         # or [heatmap]
+//! x = "eps"
+//! y = ["R", "T", "E_tr"]          # one curve each
+//! panels = "L"                    # optional: one panel per value of this column
+//! x_label = "ε"
+//! y_label = "energy fraction at t = 150"
+//! ```
+//!
+//! `[heatmap]` takes `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`,
+//! optionally `panels` and `mark_max = true` (circle and label the largest z).
+
+use std::path::{Path, PathBuf};
+
+use polars::prelude::DataFrame;
+use serde_json::json;
+use woodpile_plot::{Figure, HeatPanel, LinePanel, Panel, Series};
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::table::{f64_column, Columns};
+use crate::Output;
+
+/// A parsed render stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Render {
+    /// Figure title.
+    pub title: String,
+    /// Panels per row.
+    pub columns: usize,
+    /// What to draw.
+    pub plot: Plot,
+}
+
+/// The plot types.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Plot {
+    /// Curves y(x).
+    Lines {
+        /// x column.
+        x: String,
+        /// y columns, one curve each.
+        y: Vec<String>,
+        /// Optional panel column.
+        panels: Option<String>,
+        /// Axis labels.
+        x_label: String,
+        /// Axis labels.
+        y_label: String,
+    },
+    /// z over an (x, y) grid.
+    Heatmap {
+        /// x column.
+        x: String,
+        /// y column.
+        y: String,
+        /// z column.
+        z: String,
+        /// Optional panel column.
+        panels: Option<String>,
+        /// Axis labels.
+        x_label: String,
+        /// Axis labels.
+        y_label: String,
+        /// Colour-bar label.
+        z_label: String,
+        /// Mark the maximum.
+        mark_max: bool,
+    },
+}
+
+impl Render {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Render> {
+        let title: String = fields.required("title")?;
+        let columns = fields.optional::<i64>("columns")?.unwrap_or(1);
+        if !(1..=8).contains(&columns) {
+            return Err(fields.error("columns", "expected 1 to 8 panels per row"));
+        }
+        let lines = fields.optional::<toml::Table>("lines")?;
+        let heat = fields.optional::<toml::Table>("heatmap")?;
+        let plot = match (lines, heat) {
+            (Some(t), None) => {
+                let mut f = fields.nested("lines", t);
+                let plot = Plot::Lines {
+                    x: f.required("x")?,
+                    y: f.required("y")?,
+                    panels: f.optional("panels")?,
+                    x_label: f.required("x_label")?,
+                    y_label: f.required("y_label")?,
+                };
+                f.finish()?;
+                plot
+            }
+            (None, Some(t)) => {
+                let mut f = fields.nested("heatmap", t);
+                let mark_max = match f.take("mark_max") {
+                    None => false,
+                    Some(toml::Value::Boolean(b)) => b,
+                    Some(_) => return Err(f.error("mark_max", "expected true or false")),
+                };
+                let plot = Plot::Heatmap {
+                    x: f.required("x")?,
+                    y: f.required("y")?,
+                    z: f.required("z")?,
+                    panels: f.optional("panels")?,
+                    x_label: f.required("x_label")?,
+                    y_label: f.required("y_label")?,
+                    z_label: f.required("z_label")?,
+                    mark_max,
+                };
+                f.finish()?;
+                plot
+            }
+            _ => {
+                let others = fields.keys();
+                let reason = if others.is_empty() {
+                    "give exactly one of [lines] or [heatmap]".to_string()
+                } else {
+                    format!(
+                        "give exactly one of [lines] or [heatmap] (unknown keys: {})",
+                        others.join(", ")
+                    )
+                };
+                return Err(fields.error("lines", reason));
+            }
+        };
+        Ok(Render {
+            title,
+            columns: columns as usize,
+            plot,
+        })
+    }
+
+    /// The figure files of stage `name` under `figures`.
+    pub fn files(figures: &Path, name: &str) -> [PathBuf; 2] {
+        [
+            figures.join(format!("{name}.png")),
+            figures.join(format!("{name}.svg")),
+        ]
+    }
+
+    /// Draws `input` and returns the plotted numbers.
+    pub(crate) fn run(&self, stage: &str, input: &DataFrame, figures: &Path) -> Result<Output> {
+        let fail = |e: PipelineError| PipelineError::stage(stage, e.to_string());
+        let column = |name: &str| f64_column(input, name).map_err(fail);
+        let (panel_name, mut used): (Option<&String>, Vec<&String>) = match &self.plot {
+            Plot::Lines { x, y, panels, .. } => {
+                (panels.as_ref(), std::iter::once(x).chain(y).collect())
+            }
+            Plot::Heatmap {
+                x, y, z, panels, ..
+            } => (panels.as_ref(), vec![x, y, z]),
+        };
+        let panel_values = match panel_name {
+            Some(p) => column(p)?,
+            None => vec![Some(0.0); input.height()],
+        };
+        let mut keys: Vec<f64> = panel_values.iter().flatten().copied().collect();
+        keys.sort_by(f64::total_cmp);
+        keys.dedup();
+        let data: Vec<Vec<Option<f64>>> = used.iter().map(|c| column(c)).collect::<Result<_>>()?;
+        let panel_values = &panel_values;
+        let height = input.height();
+        let rows_of = move |key: f64| -> Vec<usize> {
+            (0..height)
+                .filter(|&r| panel_values[r] == Some(key))
+                .collect()
+        };
+        let title_of = |key: f64| {
+            panel_name
+                .map(|p| format!("{p} = {key}"))
+                .unwrap_or_default()
+        };
+        let panels: Vec<Panel> = keys
+            .iter()
+            .map(|&key| match &self.plot {
+                Plot::Lines {
+                    y,
+                    x_label,
+                    y_label,
+                    ..
+                } => Panel::Lines(LinePanel {
+                    title: title_of(key),
+                    x_label: x_label.clone(),
+                    y_label: y_label.clone(),
+                    series: y
+                        .iter()
+                        .enumerate()
+                        .map(|(k, name)| Series {
+                            label: name.clone(),
+                            points: rows_of(key)
+                                .into_iter()
+                                .map(|r| {
+                                    (
+                                        data[0][r].unwrap_or(f64::NAN),
+                                        data[k + 1][r].unwrap_or(f64::NAN),
+                                    )
+                                })
+                                .collect(),
+                        })
+                        .collect(),
+                }),
+                Plot::Heatmap {
+                    x_label,
+                    y_label,
+                    z_label,
+                    mark_max,
+                    ..
+                } => {
+                    let rows = rows_of(key);
+                    heat_panel(
+                        &data,
+                        &rows,
+                        title_of(key),
+                        x_label,
+                        y_label,
+                        z_label,
+                        *mark_max,
+                    )
+                }
+            })
+            .collect();
+        let figure = Figure {
+            title: self.title.clone(),
+            panels,
+            columns: self.columns,
+            panel_size: match self.plot {
+                Plot::Lines { .. } => (560, 400),
+                Plot::Heatmap { .. } => (620, 500),
+            },
+        };
+        let [png, svg] = Render::files(figures, stage);
+        figure
+            .render(&png, &svg)
+            .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
+        // The stage's table: exactly the plotted columns.
+        if let Some(p) = panel_name {
+            used.insert(0, p);
+        }
+        let mut columns = Columns::new();
+        for name in used {
+            columns.f64(name, column(name)?);
+        }
+        Ok(Output {
+            frame: columns.into_frame()?,
+            summary: json!({"figures": [format!("{stage}.png"), format!("{stage}.svg")], "panels": keys.len()}),
+        })
+    }
+}
+
+fn heat_panel(
+    data: &[Vec<Option<f64>>],
+    rows: &[usize],
+    title: String,
+    x_label: &str,
+    y_label: &str,
+    z_label: &str,
+    mark_max: bool,
+) -> Panel {
+    let unique = |k: usize| {
+        let mut v: Vec<f64> = rows.iter().filter_map(|&r| data[k][r]).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    };
+    let (xs, ys) = (unique(0), unique(1));
+    let mut z = vec![None; xs.len() * ys.len()];
+    let mut best: Option<(f64, f64, f64)> = None;
+    for &r in rows {
+        let (Some(x), Some(y)) = (data[0][r], data[1][r]) else {
+            continue;
+        };
+        let i = xs.partition_point(|&v| v < x);
+        let j = ys.partition_point(|&v| v < y);
+        z[j * xs.len() + i] = data[2][r];
+        if let Some(v) = data[2][r].filter(|v| v.is_finite()) {
+            if best.is_none_or(|(_, _, b)| v > b) {
+                best = Some((x, y, v));
+            }
+        }
+    }
+    Panel::Heat(HeatPanel {
+        title,
+        x_label: x_label.into(),
+        y_label: y_label.into(),
+        z_label: z_label.into(),
+        xs,
+        ys,
+        z,
+        marker: best
+            .filter(|_| mark_max)
+            .map(|(x, y, v)| (x, y, format!("max {v:.4} at ({x}, {y})"))),
+    })
+}
