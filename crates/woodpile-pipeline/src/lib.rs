@@ -6,6 +6,7 @@
 //! - [`sweep`] (with [`grid`], [`template`], [`points`]): simulate parameter grids, cached
 //!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
 //! - [`reduce`]: read fractions at a time, maximise over axes.
+//! - [`fit`] (with [`lm`]): Levenberg–Marquardt fits of the paper's power and tanh forms.
 //! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
@@ -21,7 +22,9 @@ pub mod diff;
 pub mod error;
 pub mod events;
 mod fields;
+pub mod fit;
 pub mod grid;
+pub mod lm;
 pub mod manifest;
 pub mod pipeline;
 pub mod points;

@@ -114,6 +114,10 @@ fn execute(
             })?;
             reduce.run(&stage.name, &frame, axes)?
         }
+        Spec::Fit(fit) => {
+            let frame = table::read(&output_path(results, &stage.inputs[0]))?;
+            fit.run(&stage.name, &frame)?
+        }
         Spec::Render(render) => {
             let frame = table::read(&output_path(results, &stage.inputs[0]))?;
             render.run(&stage.name, &frame, &options.figures)?

@@ -1,7 +1,7 @@
 //! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # sweep | reduce | render
+//! kind = "sweep"               # sweep | reduce | fit | render
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
@@ -16,12 +16,13 @@ use serde_json::Value;
 use crate::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::fit::FitStage;
 use crate::reduce::Reduce;
 use crate::render::Render;
 use crate::sweep::Sweep;
 
 /// The kinds of stage, in pipeline order.
-pub const KINDS: &[&str] = &["sweep", "reduce", "render"];
+pub const KINDS: &[&str] = &["sweep", "reduce", "fit", "render"];
 
 /// What a stage does, with its kind-specific parameters.
 #[derive(Debug, Clone)]
@@ -30,6 +31,8 @@ pub enum Spec {
     Sweep(Sweep),
     /// Read the fractions of a sweep at a time, optionally maximised over axes.
     Reduce(Reduce),
+    /// Fit the paper's forms to columns of a table.
+    Fit(FitStage),
     /// Draw a table as a figure.
     Render(Render),
 }
@@ -40,6 +43,7 @@ impl Spec {
         match self {
             Spec::Sweep(_) => "sweep",
             Spec::Reduce(_) => "reduce",
+            Spec::Fit(_) => "fit",
             Spec::Render(_) => "render",
         }
     }
@@ -90,6 +94,7 @@ impl Stage {
         let spec = match kind.as_str() {
             "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
             "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
+            "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
             "render" => Spec::Render(Render::parse(&mut fields)?),
             other => {
                 return Err(fields.error(

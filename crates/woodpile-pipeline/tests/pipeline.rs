@@ -558,6 +558,56 @@ mark_max = true
     assert!(e.contains("f.toml") && e.contains("bars"), "{e}");
 }
 
+#[test]
+fn fit_stages_fit_the_forms_and_report_the_papers_coefficients_on_our_data() {
+    let fit = r#"
+kind = "fit"
+inputs = ["at_end"]
+x = "eps"
+where = { L = 1 }
+[[model]]
+name = "R"
+y = "R"
+form = "tanh"
+start = [0.5, 0.5, 0.0]
+paper = [0.5491, 0.0830, 0.0760]
+"#;
+    let wide = SWEEP.replace(
+        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
+        "eps = { from = 0.5, to = 4.0, step = 0.5 }",
+    );
+    let p = Project::new(&[("sweep", &wide), ("at_end", REDUCE), ("fit", fit)]);
+    p.run(&[]);
+    let out = table::read(&p.output("fit")).unwrap();
+    let col = |c: &str| table::f64_column(&out, c).unwrap()[0].unwrap();
+    assert_eq!(col("n"), 8.0, "only the L = 1 rows");
+    // The fitted curve reproduces the data it was fitted to: recompute its residual here.
+    let data = table::read(&p.output("at_end")).unwrap();
+    let (l, eps, r) = (
+        table::f64_column(&data, "L").unwrap(),
+        table::f64_column(&data, "eps").unwrap(),
+        table::f64_column(&data, "R").unwrap(),
+    );
+    let (a, b, c) = (col("A"), col("B"), col("C"));
+    let (mut ssr, mut norm) = (0.0, 0.0);
+    for i in (0..l.len()).filter(|&i| l[i] == Some(1.0)) {
+        ssr += (a * (b * eps[i].unwrap()).tanh() + c - r[i].unwrap()).powi(2);
+        norm += r[i].unwrap().powi(2);
+    }
+    assert!((col("relative_error") - (ssr / norm).sqrt()).abs() < 1e-12);
+    assert!(
+        col("relative_error") <= col("paper_relative_error"),
+        "LM beats any other coefficients"
+    );
+    assert!(col("se_A") > 0.0);
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("fit", &fit.replace("\"tanh\"", "\"cubic\"")),
+    ]);
+    assert!(e.contains("model[0].form") && e.contains("cubic"), "{e}");
+}
+
 /// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.
 fn perturb(path: &Path, column: &str, delta: f64) {
     let manifest = table::read_manifest(path).unwrap().unwrap();

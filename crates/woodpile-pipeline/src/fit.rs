@@ -1,0 +1,207 @@
+//! `kind = "fit"`: Levenberg–Marquardt fits of the paper's forms to columns of one table.
+//!
+//! ```toml
+//! kind = "fit"
+//! inputs = ["f4_fractions"]
+//! x = "eps"
+//! where = { L = 0 }                        # optional: keep rows where these columns equal these values
+//! [[model]]
+//! name = "T1"
+//! y = "T"
+//! form = "power"                           # A x^B + C, or "tanh": A tanh(B x) + C
+//! start = [0.5, -0.05, 0.3]
+//! paper = [0.5630, -0.0110, 0.3345]        # optional: the paper's coefficients, for comparison
+//! ```
+//!
+//! One output row per model: A, B, C with standard errors, the relative error
+//! ‖y − f‖/‖y‖, and, when given, the paper's coefficients and *their* relative error on our
+//! data, so the two fits can be judged on the same numbers.
+
+use polars::prelude::DataFrame;
+use serde_json::json;
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::lm::{fit, Form};
+use crate::table::{f64_column, Columns};
+use crate::Output;
+
+/// A parsed fit stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitStage {
+    /// The x column.
+    pub x: String,
+    /// Row filter: column = value.
+    pub filter: Vec<(String, f64)>,
+    /// The models.
+    pub models: Vec<Model>,
+}
+
+/// One fitted model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    /// Its name in the output.
+    pub name: String,
+    /// The y column.
+    pub y: String,
+    /// The form.
+    pub form: Form,
+    /// Starting A, B, C.
+    pub start: [f64; 3],
+    /// The paper's A, B, C.
+    pub paper: Option<[f64; 3]>,
+}
+
+fn triple(fields: &Fields<'_>, key: &str, value: Option<toml::Value>) -> Result<Option<[f64; 3]>> {
+    let Some(value) = value else { return Ok(None) };
+    let numbers: Option<Vec<f64>> = value.as_array().map(|a| {
+        a.iter()
+            .filter_map(|v| v.as_float().or_else(|| v.as_integer().map(|i| i as f64)))
+            .collect()
+    });
+    match numbers.as_deref() {
+        Some(&[a, b, c]) if value.as_array().is_some_and(|v| v.len() == 3) => Ok(Some([a, b, c])),
+        _ => Err(fields.error(key, "expected three numbers [A, B, C]")),
+    }
+}
+
+impl FitStage {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<FitStage> {
+        let x: String = fields.required("x")?;
+        let filter = match fields.optional::<toml::Table>("where")? {
+            None => Vec::new(),
+            Some(table) => {
+                let mut f = fields.nested("where", table);
+                let mut out = Vec::new();
+                for key in f.keys() {
+                    out.push((key.clone(), f.required::<f64>(&key)?));
+                }
+                out
+            }
+        };
+        let raw = fields.take("model");
+        let Some(toml::Value::Array(entries)) = raw else {
+            return Err(fields.error("model", "expected one or more [[model]] tables"));
+        };
+        let mut models = Vec::new();
+        for (i, entry) in entries.into_iter().enumerate() {
+            let toml::Value::Table(table) = entry else {
+                return Err(fields.error(&format!("model[{i}]"), "expected a table"));
+            };
+            let mut f = fields.nested(&format!("model[{i}]"), table);
+            let name: String = f.required("name")?;
+            let y: String = f.required("y")?;
+            let form_name: String = f.required("form")?;
+            let form = Form::from_name(&form_name).ok_or_else(|| {
+                f.error(
+                    "form",
+                    format!("unknown form `{form_name}` (forms: power, tanh)"),
+                )
+            })?;
+            let start = f.take("start");
+            let start = triple(&f, "start", start)?
+                .ok_or_else(|| f.error("start", "missing (expected [A, B, C])"))?;
+            let paper = f.take("paper");
+            let paper = triple(&f, "paper", paper)?;
+            f.finish()?;
+            models.push(Model {
+                name,
+                y,
+                form,
+                start,
+                paper,
+            });
+        }
+        if models.is_empty() {
+            return Err(fields.error("model", "expected one or more [[model]] tables"));
+        }
+        Ok(FitStage { x, filter, models })
+    }
+
+    pub(crate) fn run(&self, stage: &str, input: &DataFrame) -> Result<Output> {
+        let fail = |reason: String| PipelineError::stage(stage, reason);
+        let column = |name: &str| f64_column(input, name).map_err(|e| fail(e.to_string()));
+        let filters: Vec<(Vec<Option<f64>>, f64)> = self
+            .filter
+            .iter()
+            .map(|(c, v)| Ok((column(c)?, *v)))
+            .collect::<Result<_>>()?;
+        let keep: Vec<usize> = (0..input.height())
+            .filter(|&r| filters.iter().all(|(col, v)| col[r] == Some(*v)))
+            .collect();
+        let xs = column(&self.x)?;
+        let mut out = Rows::default();
+        for m in &self.models {
+            let ys = column(&m.y)?;
+            let (x, y): (Vec<f64>, Vec<f64>) = keep
+                .iter()
+                .filter_map(|&r| Some((xs[r]?, ys[r]?)))
+                .filter(|(a, b)| a.is_finite() && b.is_finite())
+                .unzip();
+            let result = fit(m.form, &x, &y, m.start)
+                .map_err(|e| fail(format!("model `{}`: {e}", m.name)))?;
+            let paper_error = m.paper.map(|p| {
+                let ssr: f64 = x
+                    .iter()
+                    .zip(&y)
+                    .map(|(&a, &b)| (m.form.eval(p, a) - b).powi(2))
+                    .sum();
+                ssr.sqrt() / y.iter().map(|v| v * v).sum::<f64>().sqrt()
+            });
+            out.push(m, &result, x.len(), paper_error);
+        }
+        let rows = out.name.len();
+        Ok(Output {
+            frame: out.into_columns().into_frame()?,
+            summary: json!({"models": rows, "rows_used": keep.len()}),
+        })
+    }
+}
+
+#[derive(Default)]
+struct Rows {
+    name: Vec<Option<String>>,
+    form: Vec<Option<String>>,
+    y: Vec<Option<String>>,
+    params: [Vec<Option<f64>>; 3],
+    errors: [Vec<Option<f64>>; 3],
+    relative_error: Vec<Option<f64>>,
+    n: Vec<Option<i64>>,
+    iterations: Vec<Option<i64>>,
+    paper: [Vec<Option<f64>>; 3],
+    paper_relative_error: Vec<Option<f64>>,
+}
+
+impl Rows {
+    fn push(&mut self, m: &Model, f: &crate::lm::Fit, n: usize, paper_error: Option<f64>) {
+        self.name.push(Some(m.name.clone()));
+        self.form.push(Some(m.form.name().to_string()));
+        self.y.push(Some(m.y.clone()));
+        for k in 0..3 {
+            self.params[k].push(Some(f.params[k]));
+            self.errors[k].push(Some(f.std_errors[k]));
+            self.paper[k].push(m.paper.map(|p| p[k]));
+        }
+        self.relative_error.push(Some(f.relative_error));
+        self.n.push(Some(n as i64));
+        self.iterations.push(Some(f.iterations as i64));
+        self.paper_relative_error.push(paper_error);
+    }
+
+    fn into_columns(self) -> Columns {
+        let mut c = Columns::new();
+        c.str("model", self.name)
+            .str("form", self.form)
+            .str("y", self.y);
+        let [a, b, cc] = self.params;
+        let [sa, sb, sc] = self.errors;
+        let [pa, pb, pc] = self.paper;
+        c.f64("A", a).f64("B", b).f64("C", cc);
+        c.f64("se_A", sa).f64("se_B", sb).f64("se_C", sc);
+        c.f64("relative_error", self.relative_error);
+        c.i64("n", self.n).i64("iterations", self.iterations);
+        c.f64("paper_A", pa).f64("paper_B", pb).f64("paper_C", pc);
+        c.f64("paper_relative_error", self.paper_relative_error);
+        c
+    }
+}
