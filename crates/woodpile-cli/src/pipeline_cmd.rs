@@ -260,13 +260,13 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
         .map(|s| s.name.len())
         .max()
         .unwrap_or(5);
-    println!("{:width$}  {:7}  {:7}  why", "stage", "kind", "state");
+    println!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
     let mut not_fresh = 0;
     for stage in pipeline.stages() {
         let st = state(&pipeline, &args.at.results, &args.at.figures, stage);
         not_fresh += usize::from(st != State::Fresh);
         println!(
-            "{:width$}  {:7}  {:7}  {}",
+            "{:width$}  {:11}  {:7}  {}",
             stage.name,
             stage.spec.kind(),
             st.label(),

@@ -7,6 +7,7 @@
 //!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
 //! - [`reduce`]: read fractions at a time, maximise over axes.
 //! - [`fit`] (with [`lm`]): Levenberg–Marquardt fits of the paper's power and tanh forms.
+//! - [`approximate`]: the product approximation of two-defect trapping (paper Fig. 9).
 //! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
@@ -16,6 +17,7 @@
 //! Nothing here prints: progress goes to an [`events::Events`] implementation.
 #![warn(missing_docs)]
 
+pub mod approximate;
 pub mod atomic;
 pub mod canonical;
 pub mod diff;

@@ -5,6 +5,9 @@
 //! Three parameters need no linear-algebra crate: the normal equations are solved by Gaussian
 //! elimination with partial pivoting.
 
+// 3x3 linear algebra reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 /// A fitted form.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Form {

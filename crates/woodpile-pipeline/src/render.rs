@@ -14,6 +14,7 @@
 //! y_label = "energy fraction at t = 150"
 //! ```
 //!
+//! An optional `where = { column = value }` draws only the matching rows.
 //! `[heatmap]` takes `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`,
 //! optionally `panels` and `mark_max = true` (circle and label the largest z).
 
@@ -35,6 +36,8 @@ pub struct Render {
     pub title: String,
     /// Panels per row.
     pub columns: usize,
+    /// Row filter: draw only rows where these columns equal these values.
+    pub filter: Vec<(String, f64)>,
     /// What to draw.
     pub plot: Plot,
 }
@@ -83,6 +86,17 @@ impl Render {
         if !(1..=8).contains(&columns) {
             return Err(fields.error("columns", "expected 1 to 8 panels per row"));
         }
+        let filter = match fields.optional::<toml::Table>("where")? {
+            None => Vec::new(),
+            Some(table) => {
+                let mut f = fields.nested("where", table);
+                let mut out = Vec::new();
+                for key in f.keys() {
+                    out.push((key.clone(), f.required::<f64>(&key)?));
+                }
+                out
+            }
+        };
         let lines = fields.optional::<toml::Table>("lines")?;
         let heat = fields.optional::<toml::Table>("heatmap")?;
         let plot = match (lines, heat) {
@@ -134,6 +148,7 @@ impl Render {
         Ok(Render {
             title,
             columns: columns as usize,
+            filter,
             plot,
         })
     }
@@ -149,7 +164,19 @@ impl Render {
     /// Draws `input` and returns the plotted numbers.
     pub(crate) fn run(&self, stage: &str, input: &DataFrame, figures: &Path) -> Result<Output> {
         let fail = |e: PipelineError| PipelineError::stage(stage, e.to_string());
-        let column = |name: &str| f64_column(input, name).map_err(fail);
+        let all = |name: &str| f64_column(input, name).map_err(fail);
+        let filters: Vec<(Vec<Option<f64>>, f64)> = self
+            .filter
+            .iter()
+            .map(|(c, v)| Ok((all(c)?, *v)))
+            .collect::<Result<_>>()?;
+        let keep: Vec<usize> = (0..input.height())
+            .filter(|&r| filters.iter().all(|(col, v)| col[r] == Some(*v)))
+            .collect();
+        let column = |name: &str| -> Result<Vec<Option<f64>>> {
+            let values = all(name)?;
+            Ok(keep.iter().map(|&r| values[r]).collect())
+        };
         let (panel_name, mut used): (Option<&String>, Vec<&String>) = match &self.plot {
             Plot::Lines { x, y, panels, .. } => {
                 (panels.as_ref(), std::iter::once(x).chain(y).collect())
@@ -160,14 +187,14 @@ impl Render {
         };
         let panel_values = match panel_name {
             Some(p) => column(p)?,
-            None => vec![Some(0.0); input.height()],
+            None => vec![Some(0.0); keep.len()],
         };
         let mut keys: Vec<f64> = panel_values.iter().flatten().copied().collect();
         keys.sort_by(f64::total_cmp);
         keys.dedup();
         let data: Vec<Vec<Option<f64>>> = used.iter().map(|c| column(c)).collect::<Result<_>>()?;
         let panel_values = &panel_values;
-        let height = input.height();
+        let height = keep.len();
         let rows_of = move |key: f64| -> Vec<usize> {
             (0..height)
                 .filter(|&r| panel_values[r] == Some(key))
@@ -296,6 +323,6 @@ fn heat_panel(
         z,
         marker: best
             .filter(|_| mark_max)
-            .map(|(x, y, v)| (x, y, format!("max {v:.4} at ({x}, {y})"))),
+            .map(|(x, y, v)| (x, y, format!("max {v:.4}"))),
     })
 }

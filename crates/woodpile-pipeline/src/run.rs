@@ -118,6 +118,11 @@ fn execute(
             let frame = table::read(&output_path(results, &stage.inputs[0]))?;
             fit.run(&stage.name, &frame)?
         }
+        Spec::Approximate(approximate) => {
+            let fits = table::read(&output_path(results, &stage.inputs[0]))?;
+            let data = table::read(&output_path(results, &stage.inputs[1]))?;
+            approximate.run(&stage.name, &fits, &data)?
+        }
         Spec::Render(render) => {
             let frame = table::read(&output_path(results, &stage.inputs[0]))?;
             render.run(&stage.name, &frame, &options.figures)?

@@ -1,7 +1,7 @@
 //! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # sweep | reduce | fit | render
+//! kind = "sweep"               # sweep | reduce | fit | approximate | render
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::Value;
 
+use crate::approximate::Approximate;
 use crate::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
@@ -22,7 +23,7 @@ use crate::render::Render;
 use crate::sweep::Sweep;
 
 /// The kinds of stage, in pipeline order.
-pub const KINDS: &[&str] = &["sweep", "reduce", "fit", "render"];
+pub const KINDS: &[&str] = &["sweep", "reduce", "fit", "approximate", "render"];
 
 /// What a stage does, with its kind-specific parameters.
 #[derive(Debug, Clone)]
@@ -33,6 +34,8 @@ pub enum Spec {
     Reduce(Reduce),
     /// Fit the paper's forms to columns of a table.
     Fit(FitStage),
+    /// The product approximation of two-defect trapping from single-defect fits.
+    Approximate(Approximate),
     /// Draw a table as a figure.
     Render(Render),
 }
@@ -44,6 +47,7 @@ impl Spec {
             Spec::Sweep(_) => "sweep",
             Spec::Reduce(_) => "reduce",
             Spec::Fit(_) => "fit",
+            Spec::Approximate(_) => "approximate",
             Spec::Render(_) => "render",
         }
     }
@@ -95,6 +99,7 @@ impl Stage {
             "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
             "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
             "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
+            "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),
             "render" => Spec::Render(Render::parse(&mut fields)?),
             other => {
                 return Err(fields.error(

@@ -608,6 +608,87 @@ paper = [0.5491, 0.0830, 0.0760]
     assert!(e.contains("model[0].form") && e.contains("cubic"), "{e}");
 }
 
+#[test]
+fn the_product_approximation_evaluates_the_fitted_forms() {
+    let single = SWEEP.replace("L = [0, 1]", "L = [0]").replace(
+        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
+        "eps = { from = 0.5, to = 4.0, step = 0.5 }",
+    );
+    let fits = r#"
+kind = "fit"
+inputs = ["single_at_end"]
+x = "eps"
+[[model]]
+name = "T1"
+y = "T"
+form = "power"
+start = [0.5, -0.3, 0.2]
+[[model]]
+name = "R"
+y = "R"
+form = "tanh"
+start = [0.5, 0.5, 0.0]
+"#;
+    let pair = r#"
+kind = "sweep"
+[axes]
+eps1 = [1.0, 2.0]
+eps2 = [1.0, 2.0]
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
+[[scene.defect]]
+site = 0
+eps = "$eps1"
+[[scene.defect]]
+site = 3
+eps = "$eps2"
+"#;
+    let approx = r#"
+kind = "approximate"
+inputs = ["fits", "pair_at_end"]
+transmission = "T1"
+reflection = "R"
+"#;
+    let p = Project::new(&[
+        ("single", &single),
+        ("single_at_end", &REDUCE.replace("\"sweep\"", "\"single\"")),
+        ("fits", fits),
+        ("pair", pair),
+        ("pair_at_end", &REDUCE.replace("\"sweep\"", "\"pair\"")),
+        ("approx", approx),
+    ]);
+    p.run(&[]);
+    let f = table::read(&p.output("fits")).unwrap();
+    let coef = |c: &str, row: usize| table::f64_column(&f, c).unwrap()[row].unwrap();
+    let t1 = |x: f64| coef("A", 0) * x.powf(coef("B", 0)) + coef("C", 0);
+    let r = |x: f64| coef("A", 1) * (coef("B", 1) * x).tanh() + coef("C", 1);
+    let out = table::read(&p.output("approx")).unwrap();
+    let col = |c: &str| table::f64_column(&out, c).unwrap();
+    let (e1, e2, values, diag) = (col("eps1"), col("eps2"), col("approx"), col("on_diagonal"));
+    assert_eq!(values.len(), 4);
+    for i in 0..4 {
+        let (a, b) = (e1[i].unwrap(), e2[i].unwrap());
+        assert!((values[i].unwrap() - t1(a) * r(b) * r(a) * r(b)).abs() < 1e-14);
+        assert_eq!(diag[i], Some(if a == b { 1.0 } else { 0.0 }));
+    }
+    assert!(
+        col("approx_paper").iter().all(Option::is_none),
+        "no paper coefficients given"
+    );
+    let manifest = table::read_manifest(&p.output("approx")).unwrap().unwrap();
+    assert!(manifest.summary["relative_error"].as_f64().unwrap() > 0.0);
+    let e = load_error(&[
+        ("single", &single),
+        (
+            "approx",
+            &approx.replace("\"fits\", \"pair_at_end\"", "\"single\", \"single\""),
+        ),
+    ]);
+    assert!(e.contains("listed twice") || e.contains("fit stage"), "{e}");
+}
+
 /// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.
 fn perturb(path: &Path, column: &str, delta: f64) {
     let manifest = table::read_manifest(path).unwrap().unwrap();

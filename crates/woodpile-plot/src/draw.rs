@@ -30,10 +30,14 @@ pub(crate) fn figure<DB: DrawingBackend>(
 ) -> Result<(), String> {
     root.fill(&WHITE).map_err(text)?;
     let (top, body) = root.split_vertically(TITLE_HEIGHT);
+    // Shrink a long title to the width rather than cut it (DejaVu Sans averages ~0.55 em).
+    let width = root.dim_in_pixel().0 as f64;
+    let chars = fig.title.chars().count().max(1) as f64;
+    let size = (width - 20.0) / (0.55 * chars);
     top.draw(&Text::new(
         fig.title.clone(),
         (10, 8),
-        (FONT, 20).into_font().color(&BLACK),
+        (FONT, size.clamp(10.0, 20.0)).into_font().color(&BLACK),
     ))
     .map_err(text)?;
     let columns = fig.columns.max(1);

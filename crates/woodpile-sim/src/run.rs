@@ -100,7 +100,16 @@ fn verified<O: Observer + ?Sized>(
     let mut estimate = f64::INFINITY;
     for _ in 0..=MAX_HALVINGS {
         observer.reset();
-        let fine = run_plan(scenario, &guarded.with_dt(dt), observer)?;
+        let fine = match run_plan(scenario, &guarded.with_dt(dt), observer) {
+            Ok(out) => out,
+            // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
+            Err(SimError::NonFinite { .. } | SimError::EnergyDrift { .. }) => {
+                coarse = None;
+                dt *= 0.5;
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         spent += fine.stats.rhs_evals;
         estimate = coarse.as_ref().map_or(f64::INFINITY, |c| {
             largest_change(&c.fractions, &fine.fractions) / RICHARDSON

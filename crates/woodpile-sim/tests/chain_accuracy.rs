@@ -287,3 +287,32 @@ fn free_chain_conserves_momentum() {
     .unwrap();
     assert!((woodpile_sim::energy::total_momentum(&model, &y) - p0).abs() < 1e-12);
 }
+
+/// A stiff nonlinear resonator (p = 13, eps = 0.01) whose calibrated first step drifts past
+/// the blow-up guard: `auto` must treat that as "halve the step", not as a failed scene, and
+/// its answer must agree with an independent tighter Yoshida-6 run.
+#[test]
+fn auto_halves_past_a_first_step_that_drifts() {
+    use woodpile_sim::integrate::MethodChoice;
+    use woodpile_sim::run::simulate;
+    use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
+    let defect = PaperDefect {
+        p: 13,
+        ..PaperDefect::linear(0, 0.01, 1.0)
+    };
+    let auto = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-6));
+    let out = simulate(&auto, &mut ()).expect("auto converges by halving");
+    assert!(out.error_estimate.unwrap() <= 0.5e-6);
+    let reference = paper_scene(
+        &[defect],
+        MethodChoice::Named(Method::Yoshida6),
+        fixed_dt(5e-4),
+    );
+    let exact = simulate(&reference, &mut ()).unwrap();
+    assert!(
+        (out.fractions.trapped - exact.fractions.trapped).abs() < 2e-6,
+        "auto {} vs yoshida6 {}",
+        out.fractions.trapped,
+        exact.fractions.trapped
+    );
+}

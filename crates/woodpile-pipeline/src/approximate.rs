@@ -1,0 +1,138 @@
+//! `kind = "approximate"`: the paper's product approximation of the energy trapped between two
+//! separated defects (Section V, Fig. 9),
+//!
+//!   E_tr(eps1, eps2) ≈ T1(eps1) R(eps2) R(eps1) R(eps2),
+//!
+//! with T1 and R the single-defect fits of a `fit` stage, evaluated against the two-defect
+//! numerics of a `reduce` stage. Both our fitted coefficients and the paper's are scored.
+//!
+//! ```toml
+//! kind = "approximate"
+//! inputs = ["f9_fits", "f7_fine"]     # the fits, then the numerics
+//! transmission = "T1"                 # model names in the fit table
+//! reflection = "R"
+//! ```
+
+use polars::prelude::DataFrame;
+use serde_json::json;
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::lm::Form;
+use crate::table::{f64_column, str_column, Columns};
+use crate::Output;
+
+/// A parsed approximate stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Approximate {
+    /// Model name of T1 in the fit table.
+    pub transmission: String,
+    /// Model name of R in the fit table.
+    pub reflection: String,
+}
+
+/// A fitted form with our and the paper's coefficients.
+struct Fitted {
+    form: Form,
+    ours: [f64; 3],
+    paper: Option<[f64; 3]>,
+}
+
+impl Approximate {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Approximate> {
+        Ok(Approximate {
+            transmission: fields.required("transmission")?,
+            reflection: fields.required("reflection")?,
+        })
+    }
+
+    pub(crate) fn run(&self, stage: &str, fits: &DataFrame, data: &DataFrame) -> Result<Output> {
+        let fail = |reason: String| PipelineError::stage(stage, reason);
+        let t1 = fitted(fits, &self.transmission).map_err(&fail)?;
+        let r = fitted(fits, &self.reflection).map_err(&fail)?;
+        let col = |name: &str| f64_column(data, name).map_err(|e| fail(e.to_string()));
+        let (e1, e2, e_tr) = (col("eps1")?, col("eps2")?, col("E_tr")?);
+        let product = |p_t: [f64; 3], p_r: [f64; 3], a: f64, b: f64| {
+            t1.form.eval(p_t, a) * r.form.eval(p_r, b) * r.form.eval(p_r, a) * r.form.eval(p_r, b)
+        };
+        let n = data.height();
+        let mut ours = Vec::with_capacity(n);
+        let mut paper = Vec::with_capacity(n);
+        let mut diagonal = Vec::with_capacity(n);
+        for i in 0..n {
+            let (Some(a), Some(b)) = (e1[i], e2[i]) else {
+                return Err(fail(format!("row {i} lacks eps1 or eps2")));
+            };
+            ours.push(Some(product(t1.ours, r.ours, a, b)));
+            paper.push(match (t1.paper, r.paper) {
+                (Some(pt), Some(pr)) => Some(product(pt, pr, a, b)),
+                _ => None,
+            });
+            diagonal.push(Some(if a == b { 1 } else { 0 }));
+        }
+        let rel = |approx: &[Option<f64>], keep: &dyn Fn(usize) -> bool| -> Option<f64> {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in (0..n).filter(|&i| keep(i)) {
+                let (Some(y), Some(f)) = (e_tr[i], approx[i]) else {
+                    continue;
+                };
+                num += (f - y) * (f - y);
+                den += y * y;
+            }
+            (den > 0.0).then(|| (num / den).sqrt())
+        };
+        let all = |_: usize| true;
+        let diag = |i: usize| diagonal[i] == Some(1);
+        let summary = json!({
+            "rows": n,
+            "relative_error": rel(&ours, &all),
+            "relative_error_diagonal": rel(&ours, &diag),
+            "paper_relative_error": rel(&paper, &all),
+            "paper_relative_error_diagonal": rel(&paper, &diag),
+        });
+        let error: Vec<Option<f64>> = (0..n).map(|i| Some(ours[i]? - e_tr[i]?)).collect();
+        let mut columns = Columns::new();
+        columns
+            .f64("eps1", e1)
+            .f64("eps2", e2)
+            .f64("E_tr", e_tr)
+            .f64("approx", ours)
+            .f64("approx_paper", paper)
+            .f64("error", error)
+            .i64("on_diagonal", diagonal);
+        Ok(Output {
+            frame: columns.into_frame()?,
+            summary,
+        })
+    }
+}
+
+fn fitted(fits: &DataFrame, name: &str) -> std::result::Result<Fitted, String> {
+    let names = str_column(fits, "model").map_err(|e| e.to_string())?;
+    let row = names
+        .iter()
+        .position(|n| n.as_deref() == Some(name))
+        .ok_or_else(|| format!("no model `{name}` in the fit table"))?;
+    let form = str_column(fits, "form").map_err(|e| e.to_string())?[row]
+        .as_deref()
+        .and_then(Form::from_name)
+        .ok_or_else(|| format!("model `{name}` has no known form"))?;
+    let get = |c: &str| {
+        f64_column(fits, c)
+            .map(|v| v[row])
+            .map_err(|e| e.to_string())
+    };
+    let ours = [get("A")?, get("B")?, get("C")?];
+    let paper = [get("paper_A")?, get("paper_B")?, get("paper_C")?];
+    let [Some(a), Some(b), Some(c)] = ours else {
+        return Err(format!("model `{name}` has no coefficients"));
+    };
+    Ok(Fitted {
+        form,
+        ours: [a, b, c],
+        paper: match paper {
+            [Some(a), Some(b), Some(c)] => Some([a, b, c]),
+            _ => None,
+        },
+    })
+}
