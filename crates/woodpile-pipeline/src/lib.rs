@@ -5,6 +5,7 @@
 //! - [`stage`], [`pipeline`]: parse stage files, check the DAG, compute the keys.
 //! - [`sweep`] (with [`grid`], [`template`], [`points`]): simulate parameter grids, cached
 //!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
+//! - [`spacetime`]: site velocities over time for space-time maps (paper Figs. 3, 8).
 //! - [`reduce`]: read fractions at a time, maximise over axes.
 //! - [`fit`] (with [`lm`]): Levenberg–Marquardt fits of the paper's power and tanh forms.
 //! - [`approximate`]: the product approximation of two-defect trapping (paper Fig. 9).
@@ -35,6 +36,7 @@ pub mod render;
 pub mod run;
 pub mod shard;
 pub mod slurm;
+pub mod spacetime;
 pub mod stage;
 pub mod status;
 pub mod sweep;

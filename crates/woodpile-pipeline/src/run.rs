@@ -105,6 +105,7 @@ fn execute(
     }
     let output = match &stage.spec {
         Spec::Sweep(sweep) => sweep.run(&stage.name, store, events)?,
+        Spec::SpaceTime(field) => field.run(&stage.name)?,
         Spec::Reduce(reduce) => {
             let input = &stage.inputs[0];
             let path = output_path(results, input);

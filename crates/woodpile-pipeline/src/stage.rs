@@ -1,7 +1,7 @@
 //! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # sweep | reduce | fit | approximate | render
+//! kind = "sweep"               # sweep | spacetime | reduce | fit | approximate | render
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
@@ -20,16 +20,26 @@ use crate::fields::Fields;
 use crate::fit::FitStage;
 use crate::reduce::Reduce;
 use crate::render::Render;
+use crate::spacetime::SpaceTime;
 use crate::sweep::Sweep;
 
 /// The kinds of stage, in pipeline order.
-pub const KINDS: &[&str] = &["sweep", "reduce", "fit", "approximate", "render"];
+pub const KINDS: &[&str] = &[
+    "sweep",
+    "spacetime",
+    "reduce",
+    "fit",
+    "approximate",
+    "render",
+];
 
 /// What a stage does, with its kind-specific parameters.
 #[derive(Debug, Clone)]
 pub enum Spec {
     /// Simulate a grid of scenes; output their fraction time series.
     Sweep(Sweep),
+    /// Record site velocities over time for a few scenes.
+    SpaceTime(SpaceTime),
     /// Read the fractions of a sweep at a time, optionally maximised over axes.
     Reduce(Reduce),
     /// Fit the paper's forms to columns of a table.
@@ -45,6 +55,7 @@ impl Spec {
     pub fn kind(&self) -> &'static str {
         match self {
             Spec::Sweep(_) => "sweep",
+            Spec::SpaceTime(_) => "spacetime",
             Spec::Reduce(_) => "reduce",
             Spec::Fit(_) => "fit",
             Spec::Approximate(_) => "approximate",
@@ -97,6 +108,7 @@ impl Stage {
         let inputs: Vec<String> = fields.optional("inputs")?.unwrap_or_default();
         let spec = match kind.as_str() {
             "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
+            "spacetime" => Spec::SpaceTime(SpaceTime::parse(&mut fields)?),
             "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
             "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
             "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),

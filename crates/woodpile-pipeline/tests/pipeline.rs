@@ -689,6 +689,46 @@ reflection = "R"
     assert!(e.contains("listed twice") || e.contains("fit stage"), "{e}");
 }
 
+#[test]
+fn spacetime_stages_record_velocities_on_the_requested_sites() {
+    let field = r#"
+kind = "spacetime"
+[axes]
+L = [0, 1]
+[scene]
+chain = { n = 12 }
+impulse = { site = -6, velocity = 1.0 }
+run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
+[[scene.defect]]
+site = 0
+through = "$L"
+eps = 2.0
+[field]
+sites = [-8, 8]
+"#;
+    let p = Project::new(&[("field", field)]);
+    p.run(&[]);
+    let out = table::read(&p.output("field")).unwrap();
+    assert_eq!(out.height(), 2 * 7 * 17, "points x samples x sites");
+    let (t, site, v) = (
+        table::f64_column(&out, "t").unwrap(),
+        table::f64_column(&out, "site").unwrap(),
+        table::f64_column(&out, "velocity").unwrap(),
+    );
+    for i in 0..out.height() {
+        let s = site[i].unwrap();
+        assert!((-8.0..=8.0).contains(&s));
+        if t[i] == Some(0.0) {
+            assert_eq!(v[i].unwrap(), if s == -6.0 { 1.0 } else { 0.0 });
+        }
+    }
+    let e = load_error(&[(
+        "field",
+        &field.replace("sites = [-8, 8]", "sites = [-80, 8]"),
+    )]);
+    assert!(e.contains("field.sites"), "{e}");
+}
+
 /// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.
 fn perturb(path: &Path, column: &str, delta: f64) {
     let manifest = table::read_manifest(path).unwrap().unwrap();

@@ -1,0 +1,130 @@
+//! `kind = "spacetime"`: site velocities over time for a few scenes, as the paper's space-time
+//! maps show them (Figs. 3 and 8). The scene grid is a sweep's (`[axes]`, `[scene]` with
+//! placeholders); the field is sampled every `run.sample_every` and kept for the paper sites
+//! `field.sites = [lo, hi]`, so files and figures stay small.
+//!
+//! ```toml
+//! kind = "spacetime"
+//! [axes]
+//! L = [2, 6]
+//! [scene]
+//! run = { t_end = 150.0, method = "auto", tolerance = 1e-6, sample_every = 1.0 }
+//! [[scene.defect]]
+//! site = 0
+//! through = "$L"
+//! eps = 10.0
+//! [field]
+//! sites = [-50, 50]
+//! ```
+//!
+//! Output: one row per point, sample and site: `point`, the axes, `t`, `site` (paper
+//! numbering), `velocity`. A scene whose simulation fails stops the stage with its reason.
+
+use rayon::prelude::*;
+use serde_json::json;
+use woodpile_sim::observe::SpaceTimeField;
+use woodpile_sim::run::simulate;
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::grid::AxisValue;
+use crate::sweep::Sweep;
+use crate::table::Columns;
+use crate::Output;
+
+/// A parsed spacetime stage.
+#[derive(Debug, Clone)]
+pub struct SpaceTime {
+    /// The scenes.
+    pub sweep: Sweep,
+    /// Paper sites kept, inclusive.
+    pub sites: [i64; 2],
+}
+
+impl SpaceTime {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<SpaceTime> {
+        let sweep = Sweep::parse(fields)?;
+        let table: toml::Table = fields.optional("field")?.unwrap_or_default();
+        let mut f = fields.nested("field", table);
+        let sites = match f.take("sites") {
+            None => None,
+            Some(v) => {
+                let pair: Option<Vec<i64>> = v
+                    .as_array()
+                    .map(|a| a.iter().filter_map(|x| x.as_integer()).collect());
+                match pair.as_deref() {
+                    Some(&[lo, hi]) if lo <= hi => Some([lo, hi]),
+                    _ => {
+                        return Err(f.error("sites", "expected [lo, hi] paper sites with lo <= hi"))
+                    }
+                }
+            }
+        };
+        f.finish()?;
+        let half = sweep.scene_at(0)?.half_width as i64;
+        let sites = sites.unwrap_or([-half, half]);
+        if sites[0] < -half || sites[1] > half {
+            return Err(fields.error("field.sites", format!("sites must lie in -{half}..{half}")));
+        }
+        Ok(SpaceTime { sweep, sites })
+    }
+
+    pub(crate) fn run(&self, stage: &str) -> Result<Output> {
+        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, usize)> = (0..self.sweep.count())
+            .into_par_iter()
+            .map(|i| {
+                let scene = self.sweep.scene_at(i)?;
+                let model = &scene.scenario.model;
+                let mut field = SpaceTimeField::new(model, 1, 1);
+                simulate(&scene.scenario, &mut field).map_err(|e| {
+                    PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
+                })?;
+                Ok((self.sweep.values(i), field, scene.half_width))
+            })
+            .collect::<Result<_>>()?;
+        let mut point = Vec::new();
+        let mut axes: Vec<Vec<AxisValue>> = vec![Vec::new(); self.sweep.axes.len()];
+        let (mut t, mut site, mut velocity) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, (values, field, half)) in fields.iter().enumerate() {
+            let n_sites = field.sites.len();
+            for (k, &time) in field.t.iter().enumerate() {
+                for (j, &s) in field.sites.iter().enumerate() {
+                    let paper = s as i64 - *half as i64;
+                    if paper < self.sites[0] || paper > self.sites[1] {
+                        continue;
+                    }
+                    point.push(Some(i as i64));
+                    for (column, v) in axes.iter_mut().zip(values) {
+                        column.push(*v);
+                    }
+                    t.push(Some(time));
+                    site.push(Some(paper));
+                    velocity.push(Some(f64::from(field.velocity[k * n_sites + j])));
+                }
+            }
+        }
+        let mut columns = Columns::new();
+        columns.i64("point", point);
+        for (axis, values) in self.sweep.axes.iter().zip(axes) {
+            if axis.is_integer() {
+                columns.i64(
+                    &axis.name,
+                    values.iter().map(|v| Some(v.as_f64() as i64)).collect(),
+                );
+            } else {
+                columns.f64(
+                    &axis.name,
+                    values.iter().map(|v| Some(v.as_f64())).collect(),
+                );
+            }
+        }
+        columns
+            .f64("t", t)
+            .i64("site", site)
+            .f64("velocity", velocity);
+        Ok(Output {
+            frame: columns.into_frame()?,
+            summary: json!({"points": self.sweep.count(), "sites": self.sites}),
+        })
+    }
+}
