@@ -7,6 +7,7 @@
 //!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
 //! - [`spacetime`]: site velocities over time for space-time maps (paper Figs. 3, 8).
 //! - [`reduce`]: read fractions at a time, maximise over axes.
+//! - [`optimize`]: Nelder–Mead refinement of a grid maximum, simulating between grid points.
 //! - [`fit`] (with [`lm`]): Levenberg–Marquardt fits of the paper's power and tanh forms.
 //! - [`approximate`]: the product approximation of two-defect trapping (paper Fig. 9).
 //! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
@@ -29,6 +30,7 @@ pub mod fit;
 pub mod grid;
 pub mod lm;
 pub mod manifest;
+pub mod optimize;
 pub mod pipeline;
 pub mod points;
 pub mod reduce;

@@ -109,6 +109,14 @@ impl Pipeline {
         &self.keys[self.index[name]]
     }
 
+    /// The sweep definition of stage `name`, if it is one.
+    pub fn sweep(&self, name: &str) -> Option<&crate::sweep::Sweep> {
+        match &self.stages[*self.index.get(name)?].spec {
+            Spec::Sweep(s) => Some(s),
+            _ => None,
+        }
+    }
+
     /// The grid axes of sweep `name`, if it is one.
     pub fn sweep_axes(&self, name: &str) -> Option<&[Axis]> {
         match &self.stages[*self.index.get(name)?].spec {
@@ -176,52 +184,89 @@ fn check_names(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
 
 /// Every input is of a kind the stage can read.
 fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
+    let kind_of = |name: &str| &by_name[name].spec;
+    let error = |key: &str, reason: String| Err(definition_error(stage, key, reason));
     match &stage.spec {
-        Spec::Sweep(_) if !stage.inputs.is_empty() => Err(definition_error(
-            stage,
-            "inputs",
-            "a sweep reads no other stage",
-        )),
+        Spec::Sweep(_) | Spec::SpaceTime(_) => match stage.inputs.is_empty() {
+            true => Ok(()),
+            false => error(
+                "inputs",
+                format!("a {} stage reads no other stage", stage.spec.kind()),
+            ),
+        },
         Spec::Reduce(reduce) => {
             let [input] = stage.inputs.as_slice() else {
-                return Err(definition_error(
-                    stage,
-                    "inputs",
-                    "a reduce stage reads exactly one sweep",
-                ));
+                return error("inputs", "a reduce stage reads exactly one sweep".into());
             };
-            match &by_name[input.as_str()].spec {
+            match kind_of(input) {
                 Spec::Sweep(sweep) => reduce
                     .check_axes(&sweep.axes)
                     .map_err(|reason| definition_error(stage, "maximize.over", reason)),
-                other => Err(definition_error(
-                    stage,
+                other => error(
                     "inputs[0]",
                     format!(
                         "`{input}` is a {} stage; a reduce reads a sweep",
                         other.kind()
                     ),
-                )),
+                ),
             }
         }
-        Spec::Render(_) => {
+        Spec::Optimize(optimize) => {
             let [input] = stage.inputs.as_slice() else {
-                return Err(definition_error(
-                    stage,
+                return error(
                     "inputs",
-                    "a render stage draws exactly one table",
-                ));
+                    "an optimize stage reads exactly one reduce stage".into(),
+                );
             };
-            match &by_name[input.as_str()].spec {
-                Spec::Render(_) => Err(definition_error(
-                    stage,
+            let reduce = by_name[input.as_str()];
+            let Spec::Reduce(r) = &reduce.spec else {
+                return error(
                     "inputs[0]",
-                    format!("`{input}` is a render stage: draw a data table"),
-                )),
+                    format!(
+                        "`{input}` is a {} stage; expected a reduce stage",
+                        reduce.spec.kind()
+                    ),
+                );
+            };
+            if r.maximize.is_some() {
+                return error(
+                    "inputs[0]",
+                    format!("`{input}` maximises already; read a plain reduce"),
+                );
+            }
+            match reduce.inputs.first().map(|s| kind_of(s)) {
+                Some(Spec::Sweep(sweep)) => optimize
+                    .check_axes(sweep)
+                    .map_err(|reason| definition_error(stage, "over", reason)),
+                _ => error("inputs[0]", format!("`{input}` does not read a sweep")),
+            }
+        }
+        Spec::Approximate(_) => match stage.inputs.as_slice() {
+            [fits, data]
+                if matches!(
+                    (kind_of(fits), kind_of(data)),
+                    (Spec::Fit(_), Spec::Reduce(_))
+                ) =>
+            {
+                Ok(())
+            }
+            _ => error("inputs", "expected [a fit stage, a reduce stage]".into()),
+        },
+        Spec::Fit(_) | Spec::Render(_) => {
+            let [input] = stage.inputs.as_slice() else {
+                return error(
+                    "inputs",
+                    format!("a {} stage reads exactly one table", stage.spec.kind()),
+                );
+            };
+            match kind_of(input) {
+                Spec::Render(_) => error(
+                    "inputs[0]",
+                    format!("`{input}` is a render stage: read a data table"),
+                ),
                 _ => Ok(()),
             }
         }
-        _ => Ok(()),
     }
 }
 

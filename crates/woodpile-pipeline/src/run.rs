@@ -115,6 +115,19 @@ fn execute(
             })?;
             reduce.run(&stage.name, &frame, axes)?
         }
+        Spec::Optimize(optimize) => {
+            let input = &stage.inputs[0];
+            let frame = table::read(&output_path(results, input))?;
+            let sweep = pipeline
+                .stage(input)?
+                .inputs
+                .first()
+                .and_then(|s| pipeline.sweep(s))
+                .ok_or_else(|| {
+                    PipelineError::stage(&stage.name, format!("`{input}` does not read a sweep"))
+                })?;
+            optimize.run(&stage.name, &frame, sweep)?
+        }
         Spec::Fit(fit) => {
             let frame = table::read(&output_path(results, &stage.inputs[0]))?;
             fit.run(&stage.name, &frame)?

@@ -1,7 +1,7 @@
 //! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # sweep | spacetime | reduce | fit | approximate | render
+//! kind = "sweep"               # sweep | spacetime | reduce | optimize | fit | approximate | render
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
@@ -18,6 +18,7 @@ use crate::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::fit::FitStage;
+use crate::optimize::Optimize;
 use crate::reduce::Reduce;
 use crate::render::Render;
 use crate::spacetime::SpaceTime;
@@ -42,6 +43,8 @@ pub enum Spec {
     SpaceTime(SpaceTime),
     /// Read the fractions of a sweep at a time, optionally maximised over axes.
     Reduce(Reduce),
+    /// Refine a grid maximum with a continuous search.
+    Optimize(Optimize),
     /// Fit the paper's forms to columns of a table.
     Fit(FitStage),
     /// The product approximation of two-defect trapping from single-defect fits.
@@ -57,6 +60,7 @@ impl Spec {
             Spec::Sweep(_) => "sweep",
             Spec::SpaceTime(_) => "spacetime",
             Spec::Reduce(_) => "reduce",
+            Spec::Optimize(_) => "optimize",
             Spec::Fit(_) => "fit",
             Spec::Approximate(_) => "approximate",
             Spec::Render(_) => "render",
@@ -110,6 +114,7 @@ impl Stage {
             "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
             "spacetime" => Spec::SpaceTime(SpaceTime::parse(&mut fields)?),
             "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
+            "optimize" => Spec::Optimize(Optimize::parse(&mut fields)?),
             "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
             "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),
             "render" => Spec::Render(Render::parse(&mut fields)?),

@@ -80,12 +80,17 @@ impl Sweep {
 
     /// The validated scene of point `index`.
     pub fn scene_at(&self, index: usize) -> Result<Scene> {
-        let values = self.values(index);
+        self.scene_with(&self.values(index), None)
+    }
+
+    /// The validated scene at arbitrary axis `values` (one per axis, in order), optionally with
+    /// `run.tolerance` replaced (an optimiser's refinement runs between grid points, tighter).
+    pub fn scene_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<Scene> {
         let at = || {
             let parts: Vec<String> = self
                 .axes
                 .iter()
-                .zip(&values)
+                .zip(values)
                 .map(|(a, v)| format!("{} = {v}", a.name))
                 .collect();
             if parts.is_empty() {
@@ -94,10 +99,18 @@ impl Sweep {
                 format!(" (at {})", parts.join(", "))
             }
         };
-        let table = self
+        let mut table = self
             .template
-            .instantiate(&self.axes, &values)
+            .instantiate(&self.axes, values)
             .map_err(|(key, reason)| self.error(key, reason + &at()))?;
+        if let Some(tol) = tolerance {
+            let run = table
+                .entry("run")
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            if let toml::Value::Table(run) = run {
+                run.insert("tolerance".into(), toml::Value::Float(tol));
+            }
+        }
         woodpile_scene::from_table(table, &self.file).map_err(|e| match e {
             SceneError::Invalid { key, reason, .. } => {
                 self.error(format!("scene.{key}"), reason + &at())

@@ -679,14 +679,19 @@ reflection = "R"
     );
     let manifest = table::read_manifest(&p.output("approx")).unwrap().unwrap();
     assert!(manifest.summary["relative_error"].as_f64().unwrap() > 0.0);
+    let swapped = approx.replace("[\"fits\", \"pair_at_end\"]", "[\"pair_at_end\", \"fits\"]");
     let e = load_error(&[
         ("single", &single),
-        (
-            "approx",
-            &approx.replace("\"fits\", \"pair_at_end\"", "\"single\", \"single\""),
-        ),
+        ("single_at_end", &REDUCE.replace("\"sweep\"", "\"single\"")),
+        ("fits", fits),
+        ("pair", pair),
+        ("pair_at_end", &REDUCE.replace("\"sweep\"", "\"pair\"")),
+        ("approx", &swapped),
     ]);
-    assert!(e.contains("listed twice") || e.contains("fit stage"), "{e}");
+    assert!(
+        e.contains("approx.toml") && e.contains("expected [a fit stage, a reduce stage]"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -727,6 +732,50 @@ sites = [-8, 8]
         &field.replace("sites = [-8, 8]", "sites = [-80, 8]"),
     )]);
     assert!(e.contains("field.sites"), "{e}");
+}
+
+#[test]
+fn optimize_refines_a_grid_maximum_between_grid_points() {
+    let coarse = SWEEP.replace("L = [0, 1]", "L = [0]").replace(
+        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
+        "eps = { from = 0.5, to = 3.0, step = 0.5 }",
+    );
+    let optimum = r#"
+kind = "optimize"
+inputs = ["at_end"]
+over = ["eps"]
+tolerance = 1e-7
+"#;
+    let p = Project::new(&[("sweep", &coarse), ("at_end", REDUCE), ("optimum", optimum)]);
+    p.run(&[]);
+    let out = table::read(&p.output("optimum")).unwrap();
+    let e_tr = table::f64_column(&out, "E_tr").unwrap();
+    let eps = table::f64_column(&out, "eps").unwrap();
+    let (grid, refined) = (e_tr[0].unwrap(), e_tr[1].unwrap());
+    assert!(
+        refined >= grid,
+        "the search never ends below its start: {grid} -> {refined}"
+    );
+    assert!(
+        (0.5..=3.0).contains(&eps[1].unwrap()),
+        "stays inside the grid's box"
+    );
+    // Only float axes can be searched, and only through a plain reduce.
+    let e = load_error(&[
+        ("sweep", &coarse),
+        ("at_end", REDUCE),
+        ("optimum", &optimum.replace("[\"eps\"]", "[\"L\"]")),
+    ]);
+    assert!(
+        e.contains("optimum.toml") && e.contains("integer axis"),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("sweep", &coarse),
+        ("best", BEST),
+        ("optimum", &optimum.replace("at_end", "best")),
+    ]);
+    assert!(e.contains("maximises already"), "{e}");
 }
 
 /// Adds `delta` to the first value of `column` in the table at `path`, keeping its manifest.
