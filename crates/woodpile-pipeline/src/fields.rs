@@ -86,6 +86,21 @@ impl<'a> Fields<'a> {
         }
     }
 
+    /// An optional `key = { column = value, ... }` row filter (numeric equality).
+    pub(crate) fn equality_filter(
+        &mut self,
+        key: &str,
+    ) -> Result<Vec<(String, f64)>, PipelineError> {
+        let Some(table) = self.optional::<toml::Table>(key)? else {
+            return Ok(Vec::new());
+        };
+        let mut f = self.nested(key, table);
+        f.keys()
+            .into_iter()
+            .map(|column| Ok((column.clone(), f.required::<f64>(&column)?)))
+            .collect()
+    }
+
     /// Rejects every key left unconsumed.
     pub(crate) fn finish(self) -> Result<(), PipelineError> {
         match self.table.keys().next() {

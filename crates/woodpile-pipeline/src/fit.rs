@@ -23,7 +23,7 @@ use serde_json::json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::lm::{fit, Form};
-use crate::table::{f64_column, Columns};
+use crate::table::{f64_column, matching_rows, Columns};
 use crate::Output;
 
 /// A parsed fit stage.
@@ -68,17 +68,7 @@ fn triple(fields: &Fields<'_>, key: &str, value: Option<toml::Value>) -> Result<
 impl FitStage {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<FitStage> {
         let x: String = fields.required("x")?;
-        let filter = match fields.optional::<toml::Table>("where")? {
-            None => Vec::new(),
-            Some(table) => {
-                let mut f = fields.nested("where", table);
-                let mut out = Vec::new();
-                for key in f.keys() {
-                    out.push((key.clone(), f.required::<f64>(&key)?));
-                }
-                out
-            }
-        };
+        let filter = fields.equality_filter("where")?;
         let raw = fields.take("model");
         let Some(toml::Value::Array(entries)) = raw else {
             return Err(fields.error("model", "expected one or more [[model]] tables"));
@@ -121,14 +111,8 @@ impl FitStage {
     pub(crate) fn run(&self, stage: &str, input: &DataFrame) -> Result<Output> {
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let column = |name: &str| f64_column(input, name).map_err(|e| fail(e.to_string()));
-        let filters: Vec<(Vec<Option<f64>>, f64)> = self
-            .filter
-            .iter()
-            .map(|(c, v)| Ok((column(c)?, *v)))
-            .collect::<Result<_>>()?;
-        let keep: Vec<usize> = (0..input.height())
-            .filter(|&r| filters.iter().all(|(col, v)| col[r] == Some(*v)))
-            .collect();
+        let keep = matching_rows(input, &self.filter)
+            .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
         let xs = column(&self.x)?;
         let mut out = Rows::default();
         for m in &self.models {

@@ -26,7 +26,7 @@ use woodpile_plot::{Figure, HeatPanel, LinePanel, Panel, Series};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::table::{f64_column, Columns};
+use crate::table::{f64_column, matching_rows, Columns};
 use crate::Output;
 
 /// A parsed render stage.
@@ -86,17 +86,7 @@ impl Render {
         if !(1..=8).contains(&columns) {
             return Err(fields.error("columns", "expected 1 to 8 panels per row"));
         }
-        let filter = match fields.optional::<toml::Table>("where")? {
-            None => Vec::new(),
-            Some(table) => {
-                let mut f = fields.nested("where", table);
-                let mut out = Vec::new();
-                for key in f.keys() {
-                    out.push((key.clone(), f.required::<f64>(&key)?));
-                }
-                out
-            }
-        };
+        let filter = fields.equality_filter("where")?;
         let lines = fields.optional::<toml::Table>("lines")?;
         let heat = fields.optional::<toml::Table>("heatmap")?;
         let plot = match (lines, heat) {
@@ -165,14 +155,8 @@ impl Render {
     pub(crate) fn run(&self, stage: &str, input: &DataFrame, figures: &Path) -> Result<Output> {
         let fail = |e: PipelineError| PipelineError::stage(stage, e.to_string());
         let all = |name: &str| f64_column(input, name).map_err(fail);
-        let filters: Vec<(Vec<Option<f64>>, f64)> = self
-            .filter
-            .iter()
-            .map(|(c, v)| Ok((all(c)?, *v)))
-            .collect::<Result<_>>()?;
-        let keep: Vec<usize> = (0..input.height())
-            .filter(|&r| filters.iter().all(|(col, v)| col[r] == Some(*v)))
-            .collect();
+        let keep = matching_rows(input, &self.filter)
+            .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
         let column = |name: &str| -> Result<Vec<Option<f64>>> {
             let values = all(name)?;
             Ok(keep.iter().map(|&r| values[r]).collect())

@@ -105,6 +105,17 @@ pub fn f64_column(frame: &DataFrame, name: &str) -> Result<Vec<Option<f64>>> {
     Ok(values)
 }
 
+/// The rows of `frame` where every `(column, value)` of `filter` holds (all rows if empty).
+pub fn matching_rows(frame: &DataFrame, filter: &[(String, f64)]) -> Result<Vec<usize>> {
+    let columns: Vec<(Vec<Option<f64>>, f64)> = filter
+        .iter()
+        .map(|(c, v)| Ok((f64_column(frame, c)?, *v)))
+        .collect::<Result<_>>()?;
+    Ok((0..frame.height())
+        .filter(|&r| columns.iter().all(|(col, v)| col[r] == Some(*v)))
+        .collect())
+}
+
 /// A column of `frame` as strings, nulls kept.
 pub fn str_column(frame: &DataFrame, name: &str) -> Result<Vec<Option<String>>> {
     let column = frame
