@@ -159,6 +159,16 @@ impl FromToml for Vec<String> {
     }
 }
 
+impl FromToml for Vec<f64> {
+    const EXPECTED: &'static str = "an array of numbers";
+    fn from_toml(value: toml::Value) -> Option<Self> {
+        match value {
+            toml::Value::Array(items) => items.into_iter().map(f64::from_toml).collect(),
+            _ => None,
+        }
+    }
+}
+
 impl FromToml for toml::Table {
     const EXPECTED: &'static str = "a table";
     fn from_toml(value: toml::Value) -> Option<Self> {

@@ -11,6 +11,7 @@
 //! form = "power"                           # A x^B + C, or "tanh": A tanh(B x) + C
 //! start = [0.5, -0.05, 0.3]
 //! paper = [0.5630, -0.0110, 0.3345]        # optional: the paper's coefficients, for comparison
+//! x_range = [0.0, 1.0]                     # optional: fit only rows with lo <= x <= hi
 //! ```
 //!
 //! One output row per model: A, B, C with standard errors, the relative error
@@ -50,6 +51,8 @@ pub struct Model {
     pub start: [f64; 3],
     /// The paper's A, B, C.
     pub paper: Option<[f64; 3]>,
+    /// Fit only rows with x in this inclusive range.
+    pub x_range: Option<[f64; 2]>,
 }
 
 fn triple(fields: &Fields<'_>, key: &str, value: Option<toml::Value>) -> Result<Option<[f64; 3]>> {
@@ -93,6 +96,11 @@ impl FitStage {
                 .ok_or_else(|| f.error("start", "missing (expected [A, B, C])"))?;
             let paper = f.take("paper");
             let paper = triple(&f, "paper", paper)?;
+            let x_range = match f.optional::<Vec<f64>>("x_range")?.as_deref() {
+                None => None,
+                Some(&[lo, hi]) if lo <= hi => Some([lo, hi]),
+                Some(_) => return Err(f.error("x_range", "expected [lo, hi] with lo <= hi")),
+            };
             f.finish()?;
             models.push(Model {
                 name,
@@ -100,6 +108,7 @@ impl FitStage {
                 form,
                 start,
                 paper,
+                x_range,
             });
         }
         if models.is_empty() {
@@ -121,6 +130,7 @@ impl FitStage {
                 .iter()
                 .filter_map(|&r| Some((xs[r]?, ys[r]?)))
                 .filter(|(a, b)| a.is_finite() && b.is_finite())
+                .filter(|(a, _)| m.x_range.is_none_or(|[lo, hi]| (lo..=hi).contains(a)))
                 .unzip();
             let result = fit(m.form, &x, &y, m.start)
                 .map_err(|e| fail(format!("model `{}`: {e}", m.name)))?;
@@ -132,7 +142,8 @@ impl FitStage {
                     .sum();
                 ssr.sqrt() / y.iter().map(|v| v * v).sum::<f64>().sqrt()
             });
-            out.push(m, &result, x.len(), paper_error);
+            let span = |pick: fn(f64, f64) -> f64| x.iter().copied().reduce(pick);
+            out.push(m, &result, (span(f64::min), span(f64::max)), x.len(), paper_error);
         }
         let rows = out.name.len();
         Ok(Output {
@@ -150,6 +161,8 @@ struct Rows {
     params: [Vec<Option<f64>>; 3],
     errors: [Vec<Option<f64>>; 3],
     relative_error: Vec<Option<f64>>,
+    x_min: Vec<Option<f64>>,
+    x_max: Vec<Option<f64>>,
     n: Vec<Option<i64>>,
     iterations: Vec<Option<i64>>,
     paper: [Vec<Option<f64>>; 3],
@@ -157,7 +170,16 @@ struct Rows {
 }
 
 impl Rows {
-    fn push(&mut self, m: &Model, f: &crate::lm::Fit, n: usize, paper_error: Option<f64>) {
+    fn push(
+        &mut self,
+        m: &Model,
+        f: &crate::lm::Fit,
+        (x_min, x_max): (Option<f64>, Option<f64>),
+        n: usize,
+        paper_error: Option<f64>,
+    ) {
+        self.x_min.push(x_min);
+        self.x_max.push(x_max);
         self.name.push(Some(m.name.clone()));
         self.form.push(Some(m.form.name().to_string()));
         self.y.push(Some(m.y.clone()));
@@ -183,6 +205,7 @@ impl Rows {
         c.f64("A", a).f64("B", b).f64("C", cc);
         c.f64("se_A", sa).f64("se_B", sb).f64("se_C", sc);
         c.f64("relative_error", self.relative_error);
+        c.f64("x_min", self.x_min).f64("x_max", self.x_max);
         c.i64("n", self.n).i64("iterations", self.iterations);
         c.f64("paper_A", pa).f64("paper_B", pb).f64("paper_C", pc);
         c.f64("paper_relative_error", self.paper_relative_error);

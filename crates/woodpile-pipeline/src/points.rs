@@ -58,10 +58,29 @@ pub struct PointData {
     pub energy: Vec<f64>,
 }
 
+/// Which energy a sweep's fractions split.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Series {
+    /// Total energy, fractions of E(t) (the paper's Sections IV–V).
+    Energy,
+    /// Kinetic energy divided by the impact energy (the woodpile experiment, paper Fig. 2).
+    Kinetic,
+}
+
 /// Simulates `scene`, recording its fractions at every sample.
-pub fn simulate_point(scene: &Scene) -> PointResult {
+pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
     let s = &scene.scenario;
-    let mut series = FractionSeries::new(&s.model, s.region);
+    let mut series = match kind {
+        Series::Energy => FractionSeries::new(&s.model, s.region),
+        Series::Kinetic => {
+            let striker_mass = s.model.site_mass(s.impulse_site);
+            let impact_energy = 0.5 * striker_mass * s.impulse_velocity * s.impulse_velocity;
+            if !(impact_energy > 0.0) {
+                return Err("a kinetic series is divided by the impact energy, which is zero".into());
+            }
+            FractionSeries::kinetic(&s.model, s.region, impact_energy)
+        }
+    };
     let out = simulate(s, &mut series).map_err(|e| e.to_string())?;
     Ok(PointData {
         method: out.plan.method.name().to_string(),

@@ -61,16 +61,17 @@ impl SpaceTime {
             }
         };
         f.finish()?;
-        let half = sweep.scene_at(0)?.half_width as i64;
-        let sites = sites.unwrap_or([-half, half]);
-        if sites[0] < -half || sites[1] > half {
-            return Err(fields.error("field.sites", format!("sites must lie in -{half}..{half}")));
+        let scene = sweep.scene_at(0)?;
+        let (first, last) = (scene.first_site, scene.last_site);
+        let sites = sites.unwrap_or([first, last]);
+        if sites[0] < first || sites[1] > last {
+            return Err(fields.error("field.sites", format!("sites must lie in {first}..{last}")));
         }
         Ok(SpaceTime { sweep, sites })
     }
 
     pub(crate) fn run(&self, stage: &str) -> Result<Output> {
-        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, usize)> = (0..self.sweep.count())
+        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> = (0..self.sweep.count())
             .into_par_iter()
             .map(|i| {
                 let scene = self.sweep.scene_at(i)?;
@@ -79,17 +80,17 @@ impl SpaceTime {
                 simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;
-                Ok((self.sweep.values(i), field, scene.half_width))
+                Ok((self.sweep.values(i), field, scene.first_site))
             })
             .collect::<Result<_>>()?;
         let mut point = Vec::new();
         let mut axes: Vec<Vec<AxisValue>> = vec![Vec::new(); self.sweep.axes.len()];
         let (mut t, mut site, mut velocity) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, (values, field, half)) in fields.iter().enumerate() {
+        for (i, (values, field, first)) in fields.iter().enumerate() {
             let n_sites = field.sites.len();
             for (k, &time) in field.t.iter().enumerate() {
                 for (j, &s) in field.sites.iter().enumerate() {
-                    let paper = s as i64 - *half as i64;
+                    let paper = s as i64 + *first;
                     if paper < self.sites[0] || paper > self.sites[1] {
                         continue;
                     }

@@ -14,6 +14,10 @@
 //! eps = "$eps"
 //! ```
 //!
+//! An optional `series = "kinetic"` records kinetic-energy shares divided by the impact energy
+//! (what the woodpile experiment measures, paper Fig. 2 c, f) instead of total-energy fractions;
+//! the columns keep their names (`R`, `T`, `E_tr`, `E`).
+//!
 //! Points are cached one by one in the [`PointStore`] under the key of their resolved scene,
 //! so a sweep resumes after a kill and sweeps that share scenes share the work. Points are
 //! simulated in parallel (rayon) and assembled in grid order: the output is bitwise the same
@@ -33,7 +37,7 @@ use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::fields::Fields;
 use crate::grid::{parse_axes, point, point_count, Axis, AxisValue};
-use crate::points::{simulate_point, PointResult, PointStore};
+use crate::points::{simulate_point, PointResult, PointStore, Series};
 use crate::table::Columns;
 use crate::template::Template;
 use crate::Output;
@@ -43,6 +47,8 @@ use crate::Output;
 pub struct Sweep {
     /// The grid axes, sorted by name (the last varies fastest).
     pub axes: Vec<Axis>,
+    /// Which energy the recorded fractions split.
+    pub series: Series,
     template: Template,
     file: PathBuf,
 }
@@ -53,11 +59,22 @@ impl Sweep {
             Some(table) => parse_axes(fields.nested("axes", table))?,
             None => Vec::new(),
         };
+        let series = match fields.optional::<String>("series")?.as_deref() {
+            None | Some("energy") => Series::Energy,
+            Some("kinetic") => Series::Kinetic,
+            Some(other) => {
+                return Err(fields.error(
+                    "series",
+                    format!("expected \"energy\" or \"kinetic\", got \"{other}\""),
+                ))
+            }
+        };
         let scene: toml::Table = fields.required("scene")?;
         let template =
             Template::new(scene, &axes).map_err(|(key, reason)| fields.error(&key, reason))?;
         let sweep = Sweep {
             axes,
+            series,
             template,
             file: fields.file().to_path_buf(),
         };
@@ -141,7 +158,7 @@ impl Sweep {
             .par_iter()
             .map(|&i| {
                 let scene = self.scene_at(i)?;
-                Ok((point_key(&scene), scene))
+                Ok((point_key(&scene, self.series), scene))
             })
             .collect()
     }
@@ -190,7 +207,7 @@ impl Sweep {
             .par_iter()
             .map(|&i| {
                 let (key, scene) = &points[i];
-                let result = simulate_point(scene);
+                let result = simulate_point(scene, self.series);
                 store.save(key, &result)?;
                 events.point_done();
                 Ok((i, result))
@@ -257,7 +274,20 @@ impl Sweep {
 
     /// The manifest summary of a whole sweep with statistics `stats`.
     pub(crate) fn summary(&self, stats: &SweepStats) -> Result<Value> {
-        let first = self.scene_at(0)?.scenario;
+        let scene = self.scene_at(0)?;
+        let physical = scene.physical.as_ref().map(|p| {
+            json!({
+                "time_unit_s": p.scales.time_s(),
+                "length_unit_m": p.scales.length_m(),
+                "defects": p.defects.iter().map(|d| json!({
+                    "site": d.site,
+                    "host_mass_ratio": d.host_mass_ratio,
+                    "eps": d.eps,
+                    "kappa": d.kappa,
+                })).collect::<Vec<_>>(),
+            })
+        });
+        let first = scene.scenario;
         Ok(json!({
             "points": stats.points,
             "failed": stats.failed,
@@ -267,6 +297,8 @@ impl Sweep {
             "dt": first.accuracy.dt,
             "t_end": first.t_end,
             "sample_every": first.sample_every,
+            "physical_point_0": physical,
+            "series": match self.series { Series::Energy => "energy", Series::Kinetic => "kinetic" },
             "rhs_evals": stats.rhs_evals,
             "max_error_estimate": stats.max_error_estimate,
             "max_energy_drift": stats.max_energy_drift,
@@ -321,8 +353,17 @@ impl SweepStats {
 }
 
 /// The cache key of one scene: its canonical form and the code version.
-pub fn point_key(scene: &Scene) -> Key {
-    Key::of(&json!({"scene": scene_json(scene), "code": code_version()}))
+/// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
+/// that energy points keep their keys), the series.
+pub fn point_key(scene: &Scene, series: Series) -> Key {
+    match series {
+        Series::Energy => Key::of(&json!({"scene": scene_json(scene), "code": code_version()})),
+        Series::Kinetic => Key::of(&json!({
+            "scene": scene_json(scene),
+            "code": code_version(),
+            "series": "kinetic",
+        })),
+    }
 }
 
 /// The per-row columns of a sweep output (everything but the point index and the axes).

@@ -20,6 +20,9 @@ pub(crate) struct SceneFile {
 #[serde(deny_unknown_fields)]
 pub(crate) struct Chain {
     pub n: Option<i64>,
+    /// `[first, last]` paper sites: an asymmetric chain (the woodpile experiment's 40 rods),
+    /// instead of `n`.
+    pub sites: Option<Vec<i64>>,
     pub boundary: Option<String>,
 }
 

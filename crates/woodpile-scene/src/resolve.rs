@@ -1,6 +1,7 @@
 //! From the raw file to a validated [`Scene`]: defaults, paper numbering, typed enums.
 //!
-//! Paper numbering: sites n = -N..N with N = `chain.n`; the simulator's index is n + N.
+//! Paper numbering: sites n = -N..N with N = `chain.n` (or `chain.sites = [first, last]`); the
+//! simulator's index is n - first.
 
 use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
@@ -24,8 +25,11 @@ const MAX_N: i64 = 5_000_000;
 pub struct Scene {
     /// What to simulate.
     pub scenario: Scenario,
-    /// Half-width N: sites run -N..N.
-    pub half_width: usize,
+    /// The paper number of the first site (-N for a chain -N..N): paper site n is index
+    /// n - first_site.
+    pub first_site: i64,
+    /// The paper number of the last site.
+    pub last_site: i64,
     /// The region in paper numbering.
     pub region_paper: [i64; 2],
     /// SI scales and derived parameters, for physical scenes.
@@ -87,17 +91,43 @@ fn non_negative(key: &str, x: f64) -> Result<f64, Invalid> {
 pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     let chain = file.chain.unwrap_or(raw::Chain {
         n: None,
+        sites: None,
         boundary: None,
     });
-    let n = chain.n.unwrap_or(DEFAULT_N);
-    if !(1..=MAX_N).contains(&n) {
-        return Err(invalid(
-            "chain.n",
-            format!("must be an integer in 1..={MAX_N}, got {n}"),
-        ));
-    }
-    let half_width = n as usize;
-    let n_sites = 2 * half_width + 1;
+    let (first, last) = match (chain.n, chain.sites.as_deref()) {
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "chain.sites",
+                "give either chain.n (sites -n..n) or chain.sites = [first, last], not both",
+            ))
+        }
+        (_, Some(&[first, last])) => {
+            if first >= last || last.checked_sub(first).is_none_or(|w| w > 2 * MAX_N) {
+                return Err(invalid(
+                    "chain.sites",
+                    format!("must be [first, last] with first < last and at most {} sites, got [{first}, {last}]", 2 * MAX_N + 1),
+                ));
+            }
+            (first, last)
+        }
+        (_, Some(other)) => {
+            return Err(invalid(
+                "chain.sites",
+                format!("must be [first, last], got {} values", other.len()),
+            ))
+        }
+        (n, None) => {
+            let n = n.unwrap_or(DEFAULT_N);
+            if !(1..=MAX_N).contains(&n) {
+                return Err(invalid(
+                    "chain.n",
+                    format!("must be an integer in 1..={MAX_N}, got {n}"),
+                ));
+            }
+            (-n, n)
+        }
+    };
+    let n_sites = (last - first + 1) as usize;
     let boundary = match chain.boundary.as_deref().unwrap_or("fixed") {
         "fixed" => Boundary::Fixed,
         "free" => Boundary::Free,
@@ -109,15 +139,12 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         }
     };
     let on_chain = |key: &str, site: i64| -> Result<usize, Invalid> {
-        if (-n..=n).contains(&site) {
-            Ok((site + n) as usize)
+        if (first..=last).contains(&site) {
+            Ok((site - first) as usize)
         } else {
             Err(invalid(
                 key,
-                format!(
-                    "site {site} is off the chain (sites run from {} to {n})",
-                    -n
-                ),
+                format!("site {site} is off the chain (sites run from {first} to {last})"),
             ))
         }
     };
@@ -323,7 +350,8 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     });
     Ok(Scene {
         scenario,
-        half_width,
+        first_site: first,
+        last_site: last,
         region_paper,
         physical,
     })
@@ -414,6 +442,29 @@ mod tests {
         assert_eq!(s.model.resonators()[0].site, 100);
         assert_eq!(scene.region_paper, [-1, 1]);
         assert_eq!((s.region.lo(), s.region.hi()), (99, 101));
+    }
+
+    /// `chain.sites` numbers an asymmetric chain: the woodpile's 40 rods -20..19.
+    #[test]
+    fn asymmetric_chain_numbering() {
+        let text = "[chain]\nsites = [-20, 19]\n[impulse]\nsite = -20\n[[defect]]\nsite = 0\neps = 1.0\n";
+        let scene = parse(text, Path::new("s.toml")).unwrap();
+        let s = &scene.scenario;
+        assert_eq!(s.model.n_sites(), 40);
+        assert_eq!((scene.first_site, scene.last_site), (-20, 19));
+        assert_eq!(s.impulse_site, 0);
+        assert_eq!(s.model.resonators()[0].site, 20);
+        assert_eq!(
+            invalid_key("[chain]\nsites = [-20, 19]\n[impulse]\nsite = 20\n"),
+            "impulse.site"
+        );
+        assert_eq!(invalid_key("[chain]\nn = 5\nsites = [-5, 5]\n"), "chain.sites");
+        assert_eq!(invalid_key("[chain]\nsites = [3, 3]\n"), "chain.sites");
+        assert_eq!(invalid_key("[chain]\nsites = [1, 2, 3]\n"), "chain.sites");
+        assert_eq!(
+            invalid_key(&format!("[chain]\nsites = [{}, {}]\n", i64::MIN, i64::MAX)),
+            "chain.sites"
+        );
     }
 
     /// The default region spans the defects plus one site each side (paper Eqs. 10 and 11).
