@@ -73,21 +73,22 @@ impl Approximate {
         // Two error measures: the relative L2 error ‖f − y‖/‖y‖, and the root-mean-square
         // difference sqrt(mean (f − y)²), which is the measure that reproduces the paper's
         // "relative error ~0.0369" (REPRODUCTION.md).
-        let errors = |approx: &[Option<f64>], keep: &dyn Fn(usize) -> bool| -> (Option<f64>, Option<f64>) {
-            let (mut num, mut den, mut count) = (0.0, 0.0, 0usize);
-            for i in (0..n).filter(|&i| keep(i)) {
-                let (Some(y), Some(f)) = (e_tr[i], approx[i]) else {
-                    continue;
-                };
-                num += (f - y) * (f - y);
-                den += y * y;
-                count += 1;
-            }
-            (
-                (den > 0.0).then(|| (num / den).sqrt()),
-                (count > 0).then(|| (num / count as f64).sqrt()),
-            )
-        };
+        let errors =
+            |approx: &[Option<f64>], keep: &dyn Fn(usize) -> bool| -> (Option<f64>, Option<f64>) {
+                let (mut num, mut den, mut count) = (0.0, 0.0, 0usize);
+                for i in (0..n).filter(|&i| keep(i)) {
+                    let (Some(y), Some(f)) = (e_tr[i], approx[i]) else {
+                        continue;
+                    };
+                    num += (f - y) * (f - y);
+                    den += y * y;
+                    count += 1;
+                }
+                (
+                    (den > 0.0).then(|| (num / den).sqrt()),
+                    (count > 0).then(|| (num / count as f64).sqrt()),
+                )
+            };
         let all = |_: usize| true;
         let diag = |i: usize| diagonal[i] == Some(1);
         let (ours_all, ours_diag) = (errors(&ours, &all), errors(&ours, &diag));

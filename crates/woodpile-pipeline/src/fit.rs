@@ -143,7 +143,13 @@ impl FitStage {
                 ssr.sqrt() / y.iter().map(|v| v * v).sum::<f64>().sqrt()
             });
             let span = |pick: fn(f64, f64) -> f64| x.iter().copied().reduce(pick);
-            out.push(m, &result, (span(f64::min), span(f64::max)), x.len(), paper_error);
+            out.push(
+                m,
+                &result,
+                (span(f64::min), span(f64::max)),
+                x.len(),
+                paper_error,
+            );
         }
         let rows = out.name.len();
         Ok(Output {

@@ -35,6 +35,7 @@ pub mod pipeline;
 pub mod points;
 pub mod reduce;
 pub mod render;
+pub mod report;
 pub mod run;
 pub mod shard;
 pub mod slurm;

@@ -252,6 +252,20 @@ fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
             }
             _ => error("inputs", "expected [a fit stage, a reduce stage]".into()),
         },
+        Spec::Report(report) => {
+            if stage.inputs.is_empty() {
+                return error("inputs", "a report reads the stages its quotes name".into());
+            }
+            for (key, source) in report.sources() {
+                if !stage.inputs.contains(&source.stage) {
+                    return error(
+                        &key,
+                        format!("`{}` is not among this stage's inputs", source.stage),
+                    );
+                }
+            }
+            Ok(())
+        }
         Spec::Fit(_) | Spec::Render(_) => {
             let [input] = stage.inputs.as_slice() else {
                 return error(

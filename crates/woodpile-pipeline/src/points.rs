@@ -75,8 +75,10 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
         Series::Kinetic => {
             let striker_mass = s.model.site_mass(s.impulse_site);
             let impact_energy = 0.5 * striker_mass * s.impulse_velocity * s.impulse_velocity;
-            if !(impact_energy > 0.0) {
-                return Err("a kinetic series is divided by the impact energy, which is zero".into());
+            if impact_energy.is_nan() || impact_energy <= 0.0 {
+                return Err(
+                    "a kinetic series is divided by the impact energy, which is zero".into(),
+                );
             }
             FractionSeries::kinetic(&s.model, s.region, impact_energy)
         }

@@ -141,6 +141,7 @@ fn execute(
             let frame = table::read(&output_path(results, &stage.inputs[0]))?;
             render.run(&stage.name, &frame, &options.figures)?
         }
+        Spec::Report(report) => report.run(&stage.name, results)?,
     };
     let manifest = manifest_for(pipeline, stage, output.summary.clone());
     let rows = output.frame.height();

@@ -21,6 +21,7 @@ use crate::fit::FitStage;
 use crate::optimize::Optimize;
 use crate::reduce::Reduce;
 use crate::render::Render;
+use crate::report::Report;
 use crate::spacetime::SpaceTime;
 use crate::sweep::Sweep;
 
@@ -32,6 +33,7 @@ pub const KINDS: &[&str] = &[
     "fit",
     "approximate",
     "render",
+    "report",
 ];
 
 /// What a stage does, with its kind-specific parameters.
@@ -51,6 +53,8 @@ pub enum Spec {
     Approximate(Approximate),
     /// Draw a table as a figure.
     Render(Render),
+    /// The reproduction report: the paper's numbers against ours.
+    Report(Report),
 }
 
 impl Spec {
@@ -64,6 +68,7 @@ impl Spec {
             Spec::Fit(_) => "fit",
             Spec::Approximate(_) => "approximate",
             Spec::Render(_) => "render",
+            Spec::Report(_) => "report",
         }
     }
 }
@@ -118,6 +123,7 @@ impl Stage {
             "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
             "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),
             "render" => Spec::Render(Render::parse(&mut fields)?),
+            "report" => Spec::Report(Report::parse(&mut fields)?),
             other => {
                 return Err(fields.error(
                     "kind",

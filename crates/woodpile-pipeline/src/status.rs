@@ -65,6 +65,12 @@ pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage)
                 return State::Stale(missing);
             }
         }
+        if let Spec::Report(report) = &stage.spec {
+            let markdown = report.markdown_path(results);
+            if !markdown.exists() {
+                return State::Stale(vec![format!("{} missing", markdown.display())]);
+            }
+        }
         return State::Fresh;
     }
     let mut reasons = Vec::new();

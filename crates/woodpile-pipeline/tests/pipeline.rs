@@ -789,3 +789,115 @@ fn perturb(path: &Path, column: &str, delta: f64) {
         .unwrap();
     table::write(path, frame, &manifest).unwrap();
 }
+
+const REPORT: &str = r#"
+kind = "report"
+inputs = ["sweep", "at_end"]
+markdown = "REPORT.md"
+title = "Tiny report"
+
+[[quote]]
+figure = "X1"
+quantity = "E_tr at L = 0, eps = 1, end"
+paper = PAPER
+agree = 1e-12
+as_run = "t = 12"
+ours = { stage = "at_end", column = "E_tr", where = { L = 0, eps = 1.0 } }
+[[quote.convention]]
+name = "read-out time"
+source = { stage = "sweep", column = "E_tr", where = { L = 0, eps = 1.0 }, scan = "t" }
+[[quote.convention]]
+name = "largest over the grid"
+source = { stage = "at_end", column = "E_tr", max = "E_tr", locate = ["L", "eps"] }
+"#;
+
+/// The report reads numbers where its sources say, finds by scanning the read-out time where a
+/// quoted number is met, and writes its Markdown beside `results/`.
+#[test]
+fn a_report_reads_and_scans_the_quoted_numbers() {
+    // The "paper's" number: E_tr at t = 8, which the end-time read-out misses.
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE)]);
+    p.run(&[]);
+    let sweep = table::read(&p.output("sweep")).unwrap();
+    let column = |name: &str| table::f64_column(&sweep, name).unwrap();
+    let (l, eps, t, e_tr) = (column("L"), column("eps"), column("t"), column("E_tr"));
+    let row = |time: f64| {
+        (0..sweep.height())
+            .find(|&r| l[r] == Some(0.0) && eps[r] == Some(1.0) && t[r] == Some(time))
+            .unwrap()
+    };
+    let at_8 = e_tr[row(8.0)].unwrap();
+    let at_12 = e_tr[row(12.0)].unwrap();
+    assert!(
+        (at_8 - at_12).abs() > 1e-6,
+        "the test needs two distinct read-outs"
+    );
+
+    p.write("report", &REPORT.replace("PAPER", &format!("{at_8:e}")));
+    p.run(&["report"]);
+    let report = table::read(&p.output("report")).unwrap();
+    assert_eq!(report.height(), 3);
+    let value = table::f64_column(&report, "value").unwrap();
+    let reproduces = table::f64_column(&report, "reproduces").unwrap();
+    let closest = table::f64_column(&report, "scan_closest").unwrap();
+    assert_eq!(value[0], Some(at_12));
+    assert_eq!(reproduces[0], Some(0.0));
+    assert_eq!(value[1], Some(at_8));
+    assert_eq!(reproduces[1], Some(1.0));
+    assert_eq!(closest[1], Some(8.0));
+    let best = (0..sweep.height())
+        .filter(|&r| t[r] == Some(12.0))
+        .filter_map(|r| e_tr[r])
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(value[2], Some(best));
+
+    let markdown = p.results.parent().unwrap().join("REPORT.md");
+    let text = std::fs::read_to_string(&markdown).unwrap();
+    assert!(
+        text.starts_with("# Tiny report") && text.contains("| X1 |"),
+        "{text}"
+    );
+    assert_eq!(p.state("report"), State::Fresh);
+    std::fs::remove_file(&markdown).unwrap();
+    assert!(matches!(p.state("report"), State::Stale(_)));
+}
+
+#[test]
+fn a_report_source_must_be_an_input() {
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        (
+            "report",
+            &REPORT
+                .replace("PAPER", "0.1")
+                .replace("inputs = [\"sweep\", \"at_end\"]", "inputs = [\"sweep\"]"),
+        ),
+    ]);
+    assert!(
+        e.contains("report.toml") && e.contains("quote[0].ours.stage") && e.contains("at_end"),
+        "{e}"
+    );
+}
+
+/// A kinetic sweep divides kinetic energy by the impact energy: at t = 0 all of it is the
+/// striker's, left of the region. Its points are cached apart from the energy sweep's.
+#[test]
+fn a_kinetic_sweep_starts_with_the_impact_energy_left_of_the_region() {
+    let kinetic = SWEEP.replace("kind = \"sweep\"", "kind = \"sweep\"\nseries = \"kinetic\"");
+    let p = Project::new(&[("sweep", SWEEP), ("kinetic", &kinetic)]);
+    let events = p.run(&[]);
+    assert_eq!(events.points.load(Ordering::SeqCst), 12);
+    let frame = table::read(&p.output("kinetic")).unwrap();
+    let t = table::f64_column(&frame, "t").unwrap();
+    let r = table::f64_column(&frame, "R").unwrap();
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    for row in (0..frame.height()).filter(|&i| t[i] == Some(0.0)) {
+        assert_eq!(r[row], Some(1.0));
+        assert_eq!(e_tr[row], Some(0.0));
+    }
+    let energy = table::read(&p.output("sweep")).unwrap();
+    let r_energy = table::f64_column(&energy, "R").unwrap();
+    // Later on potential energy exists, so the two series differ.
+    assert!((0..frame.height()).any(|i| (r[i].unwrap() - r_energy[i].unwrap()).abs() > 1e-3));
+}

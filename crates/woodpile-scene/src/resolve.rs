@@ -447,7 +447,8 @@ mod tests {
     /// `chain.sites` numbers an asymmetric chain: the woodpile's 40 rods -20..19.
     #[test]
     fn asymmetric_chain_numbering() {
-        let text = "[chain]\nsites = [-20, 19]\n[impulse]\nsite = -20\n[[defect]]\nsite = 0\neps = 1.0\n";
+        let text =
+            "[chain]\nsites = [-20, 19]\n[impulse]\nsite = -20\n[[defect]]\nsite = 0\neps = 1.0\n";
         let scene = parse(text, Path::new("s.toml")).unwrap();
         let s = &scene.scenario;
         assert_eq!(s.model.n_sites(), 40);
@@ -458,7 +459,10 @@ mod tests {
             invalid_key("[chain]\nsites = [-20, 19]\n[impulse]\nsite = 20\n"),
             "impulse.site"
         );
-        assert_eq!(invalid_key("[chain]\nn = 5\nsites = [-5, 5]\n"), "chain.sites");
+        assert_eq!(
+            invalid_key("[chain]\nn = 5\nsites = [-5, 5]\n"),
+            "chain.sites"
+        );
         assert_eq!(invalid_key("[chain]\nsites = [3, 3]\n"), "chain.sites");
         assert_eq!(invalid_key("[chain]\nsites = [1, 2, 3]\n"), "chain.sites");
         assert_eq!(

@@ -1,0 +1,845 @@
+//! `kind = "report"`: the reproduction report. Every number the paper quotes, next to ours and
+//! the difference; for each, the conventions searched (read-out time, boundaries, region,
+//! striker site, stated against derived parameters), what each gives, whether it reproduces the
+//! quoted number, and how sensitive the number is. Written as `REPRODUCTION.md` (beside
+//! `results/`) and as the stage's parquet table, one row per quote and convention.
+//!
+//! ```toml
+//! kind = "report"
+//! inputs = ["f7_fine", "f7_readout_sweep"]   # every stage a source reads
+//! markdown = "REPRODUCTION.md"               # relative to the directory holding results/
+//! title = "Reproduction report"
+//! preamble = "..."
+//!
+//! [[quote]]
+//! figure = "F7"
+//! quantity = "fine-grid optimum E_tr"
+//! paper = 0.2112                  # or paper_text = "..." with an optional range = [lo, hi]
+//! agree = 0.00005                 # |ours - paper| <= agree counts as reproducing it
+//! as_run = "read at t = 150"
+//! ours = { stage = "f7_fine", column = "E_tr", max = "E_tr", locate = ["eps1", "eps2"] }
+//! note = "..."
+//! [[quote.convention]]
+//! name = "read-out time t"
+//! source = { stage = "f7_readout_sweep", column = "E_tr", where = { eps1 = 0.67 }, scan = "t" }
+//! ```
+//!
+//! A source reads one number from a stage's output:
+//! - `column` with `where` (numbers or strings, equality): exactly one row, or with
+//!   `max = "col"` the row where `col` is largest (its `locate` columns are reported);
+//! - `manifest = "/summary/key"`: a JSON pointer into the stage's manifest;
+//! - `scan = "col"` (optionally `scan_range = [lo, hi]`): the value as a function of `col` (with `max`, the largest over the other
+//!   rows at each `col`): where it comes within `agree` of the paper's number, and its slope
+//!   there, so the report says which read-out time reproduces a number and how sensitive it is.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use polars::prelude::DataFrame;
+use serde_json::json;
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::table::{self, f64_column, str_column, Columns};
+use crate::Output;
+
+/// A parsed report stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Report {
+    /// The Markdown file, relative to the directory holding `results/`.
+    pub markdown: String,
+    /// Its title.
+    pub title: String,
+    /// Text before the tables.
+    pub preamble: String,
+    /// The quoted numbers.
+    pub quotes: Vec<Quote>,
+}
+
+/// One number (or statement) the paper makes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Quote {
+    /// Figure id, e.g. `F7`.
+    pub figure: String,
+    /// What the number is.
+    pub quantity: String,
+    /// What the paper says.
+    pub paper: Paper,
+    /// Our number as the pipeline runs it.
+    pub ours: Source,
+    /// The conventions of `ours`, in words.
+    pub as_run: String,
+    /// Explanation for the reader.
+    pub note: String,
+    /// The alternatives searched.
+    pub conventions: Vec<Convention>,
+}
+
+/// The paper's side of a quote.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Paper {
+    /// A number, reproduced when within `agree`.
+    Value {
+        /// The quoted number.
+        value: f64,
+        /// Agreement tolerance (half a unit of the quoted number's last digit, or the paper's
+        /// "about").
+        agree: f64,
+    },
+    /// A statement; reproduced when the value lies in `range`, if given.
+    Text {
+        /// The statement.
+        text: String,
+        /// The range that satisfies it.
+        range: Option<[f64; 2]>,
+    },
+}
+
+/// One alternative convention and where its number comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Convention {
+    /// The convention, in words.
+    pub name: String,
+    /// Its number.
+    pub source: Source,
+}
+
+/// Where a number is read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Source {
+    /// The stage whose output is read.
+    pub stage: String,
+    /// What is read.
+    pub read: Read,
+    /// Row filter.
+    pub filter: Vec<(String, Match)>,
+    /// Take the row where this column is largest.
+    pub max: Option<String>,
+    /// Columns reported as the location of the row read.
+    pub locate: Vec<String>,
+    /// Scan this column.
+    pub scan: Option<String>,
+    /// Only scan values in this inclusive range.
+    pub scan_range: Option<[f64; 2]>,
+}
+
+/// A column or a manifest entry.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Read {
+    /// A table column.
+    Column(String),
+    /// A JSON pointer into the manifest.
+    Manifest(String),
+}
+
+/// One equality of a row filter.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Match {
+    /// Numeric equality.
+    Number(f64),
+    /// String equality.
+    Text(String),
+}
+
+/// What a source measured.
+#[derive(Debug, Clone, PartialEq)]
+struct Measured {
+    value: f64,
+    location: String,
+    scan: Option<Scanned>,
+}
+
+/// Where along a scan the value meets the paper's number.
+#[derive(Debug, Clone, PartialEq)]
+struct Scanned {
+    /// The scanned column.
+    column: String,
+    /// Runs of consecutive scan values within `agree` of the paper's number (first, last).
+    runs: Vec<(f64, f64)>,
+    /// The scan value where the number comes closest.
+    closest: f64,
+    /// |d value / d scan| at the closest approach.
+    slope: f64,
+}
+
+impl Report {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Report> {
+        let markdown: String = fields.required("markdown")?;
+        let title: String = fields.required("title")?;
+        let preamble: String = fields.optional("preamble")?.unwrap_or_default();
+        let Some(toml::Value::Array(entries)) = fields.take("quote") else {
+            return Err(fields.error("quote", "expected one or more [[quote]] tables"));
+        };
+        let mut quotes = Vec::with_capacity(entries.len());
+        for (i, entry) in entries.into_iter().enumerate() {
+            let key = format!("quote[{i}]");
+            let toml::Value::Table(table) = entry else {
+                return Err(fields.error(&key, "expected a table"));
+            };
+            quotes.push(parse_quote(fields.nested(&key, table))?);
+        }
+        if quotes.is_empty() {
+            return Err(fields.error("quote", "expected one or more [[quote]] tables"));
+        }
+        Ok(Report {
+            markdown,
+            title,
+            preamble,
+            quotes,
+        })
+    }
+
+    /// Every source with its dotted key, for the pipeline's input check.
+    pub fn sources(&self) -> Vec<(String, &Source)> {
+        let mut out = Vec::new();
+        for (i, q) in self.quotes.iter().enumerate() {
+            out.push((format!("quote[{i}].ours.stage"), &q.ours));
+            for (j, c) in q.conventions.iter().enumerate() {
+                out.push((
+                    format!("quote[{i}].convention[{j}].source.stage"),
+                    &c.source,
+                ));
+            }
+        }
+        out
+    }
+
+    /// The Markdown file for outputs under `results`.
+    pub fn markdown_path(&self, results: &Path) -> PathBuf {
+        results
+            .parent()
+            .unwrap_or_else(|| Path::new(""))
+            .join(&self.markdown)
+    }
+
+    pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
+        let mut reader = Reader {
+            results,
+            frames: HashMap::new(),
+        };
+        let mut rows = Rows::default();
+        let mut evaluated = Vec::with_capacity(self.quotes.len());
+        for (i, q) in self.quotes.iter().enumerate() {
+            let fail = |what: &str, e: PipelineError| {
+                PipelineError::stage(
+                    stage,
+                    format!("quote[{i}] ({} {}), {what}: {e}", q.figure, q.quantity),
+                )
+            };
+            let ours = reader
+                .measure(&q.ours, &q.paper)
+                .map_err(|e| fail("ours", e))?;
+            let mut conventions = Vec::with_capacity(q.conventions.len());
+            for (j, c) in q.conventions.iter().enumerate() {
+                let m = reader
+                    .measure(&c.source, &q.paper)
+                    .map_err(|e| fail(&format!("convention[{j}]"), e))?;
+                conventions.push((c.name.clone(), m));
+            }
+            rows.push(q, &format!("as run: {}", q.as_run), &ours);
+            for (name, m) in &conventions {
+                rows.push(q, name, m);
+            }
+            evaluated.push((ours, conventions));
+        }
+        let text = markdown(self, &evaluated);
+        crate::atomic::write(&self.markdown_path(results), text.as_bytes())?;
+        let reproduced = evaluated
+            .iter()
+            .zip(&self.quotes)
+            .filter(|((ours, _), q)| reproduces(&q.paper, ours) == Some(true))
+            .count();
+        let by_some = evaluated
+            .iter()
+            .zip(&self.quotes)
+            .filter(|((ours, cs), q)| {
+                reproduces(&q.paper, ours) == Some(true)
+                    || cs
+                        .iter()
+                        .any(|(_, m)| reproduces(&q.paper, m) == Some(true))
+            })
+            .count();
+        Ok(Output {
+            frame: rows.into_columns().into_frame()?,
+            summary: json!({
+                "quotes": self.quotes.len(),
+                "reproduced_as_run": reproduced,
+                "reproduced_by_some_convention": by_some,
+                "markdown": self.markdown,
+            }),
+        })
+    }
+}
+
+fn parse_quote(mut f: Fields<'_>) -> Result<Quote> {
+    let figure: String = f.required("figure")?;
+    let quantity: String = f.required("quantity")?;
+    let paper = match (
+        f.optional::<f64>("paper")?,
+        f.optional::<String>("paper_text")?,
+    ) {
+        (Some(value), None) => Paper::Value {
+            value,
+            agree: f.required::<f64>("agree")?.abs(),
+        },
+        (None, Some(text)) => Paper::Text {
+            text,
+            range: match f.optional::<Vec<f64>>("range")?.as_deref() {
+                None => None,
+                Some(&[lo, hi]) if lo <= hi => Some([lo, hi]),
+                Some(_) => return Err(f.error("range", "expected [lo, hi] with lo <= hi")),
+            },
+        },
+        _ => {
+            return Err(f.error(
+                "paper",
+                "give exactly one of `paper` (a number) and `paper_text`",
+            ))
+        }
+    };
+    let as_run: String = f.required("as_run")?;
+    let note: String = f.optional("note")?.unwrap_or_default();
+    let ours_table: toml::Table = f.required("ours")?;
+    let ours = parse_source(f.nested("ours", ours_table))?;
+    let mut conventions = Vec::new();
+    if let Some(value) = f.take("convention") {
+        let toml::Value::Array(entries) = value else {
+            return Err(f.error("convention", "expected [[quote.convention]] tables"));
+        };
+        for (j, entry) in entries.into_iter().enumerate() {
+            let key = format!("convention[{j}]");
+            let toml::Value::Table(table) = entry else {
+                return Err(f.error(&key, "expected a table"));
+            };
+            let mut c = f.nested(&key, table);
+            let name: String = c.required("name")?;
+            let source_table: toml::Table = c.required("source")?;
+            let source = parse_source(c.nested("source", source_table))?;
+            c.finish()?;
+            conventions.push(Convention { name, source });
+        }
+    }
+    f.finish()?;
+    Ok(Quote {
+        figure,
+        quantity,
+        paper,
+        ours,
+        as_run,
+        note,
+        conventions,
+    })
+}
+
+fn parse_source(mut f: Fields<'_>) -> Result<Source> {
+    let stage: String = f.required("stage")?;
+    let read = match (
+        f.optional::<String>("column")?,
+        f.optional::<String>("manifest")?,
+    ) {
+        (Some(c), None) => Read::Column(c),
+        (None, Some(p)) if p.starts_with('/') => Read::Manifest(p),
+        (None, Some(_)) => {
+            return Err(f.error(
+                "manifest",
+                "expected a JSON pointer such as \"/summary/rms_error\"",
+            ))
+        }
+        _ => return Err(f.error("column", "give exactly one of `column` and `manifest`")),
+    };
+    let mut filter = Vec::new();
+    if let Some(table) = f.optional::<toml::Table>("where")? {
+        for (column, value) in table {
+            let m = match value {
+                toml::Value::Float(x) => Match::Number(x),
+                toml::Value::Integer(i) => Match::Number(i as f64),
+                toml::Value::String(s) => Match::Text(s),
+                _ => {
+                    return Err(f.error(&format!("where.{column}"), "expected a number or a string"))
+                }
+            };
+            filter.push((column, m));
+        }
+    }
+    let max = f.optional::<String>("max")?;
+    let locate = f.optional::<Vec<String>>("locate")?.unwrap_or_default();
+    let scan = f.optional::<String>("scan")?;
+    let scan_range = match f.optional::<Vec<f64>>("scan_range")?.as_deref() {
+        None => None,
+        Some(&[lo, hi]) if lo <= hi && scan.is_some() => Some([lo, hi]),
+        Some(&[_, _]) if scan.is_none() => return Err(f.error("scan_range", "needs `scan`")),
+        Some(_) => return Err(f.error("scan_range", "expected [lo, hi] with lo <= hi")),
+    };
+    if matches!(read, Read::Manifest(_))
+        && (!filter.is_empty() || max.is_some() || scan.is_some() || !locate.is_empty())
+    {
+        return Err(f.error(
+            "manifest",
+            "a manifest entry takes no `where`, `max`, `locate` or `scan`",
+        ));
+    }
+    f.finish()?;
+    Ok(Source {
+        stage,
+        read,
+        filter,
+        max,
+        locate,
+        scan,
+        scan_range,
+    })
+}
+
+/// Reads stage outputs once each.
+struct Reader<'a> {
+    results: &'a Path,
+    frames: HashMap<String, DataFrame>,
+}
+
+impl Reader<'_> {
+    fn frame(&mut self, stage: &str) -> Result<&DataFrame> {
+        if !self.frames.contains_key(stage) {
+            let frame = table::read(&self.results.join(format!("{stage}.parquet")))?;
+            self.frames.insert(stage.to_string(), frame);
+        }
+        Ok(&self.frames[stage])
+    }
+
+    fn measure(&mut self, source: &Source, paper: &Paper) -> Result<Measured> {
+        let fail = |reason: String| PipelineError::stage(&source.stage, reason);
+        let column = match &source.read {
+            Read::Manifest(pointer) => {
+                let path = self.results.join(format!("{}.parquet", source.stage));
+                let manifest =
+                    table::read_manifest(&path)?.ok_or_else(|| fail("no manifest".into()))?;
+                let value = serde_json::to_value(&manifest)
+                    .ok()
+                    .and_then(|v| v.pointer(pointer).and_then(|x| x.as_f64()))
+                    .ok_or_else(|| fail(format!("manifest has no number at `{pointer}`")))?;
+                return Ok(Measured {
+                    value,
+                    location: String::new(),
+                    scan: None,
+                });
+            }
+            Read::Column(c) => c.clone(),
+        };
+        let frame = self.frame(&source.stage)?;
+        let rows = filtered_rows(frame, &source.filter)?;
+        let values = f64_column(frame, &column)?;
+        let ranking = match &source.max {
+            Some(m) => Some(f64_column(frame, m)?),
+            None => None,
+        };
+        let locate: Vec<(String, Vec<Option<f64>>)> = source
+            .locate
+            .iter()
+            .map(|c| Ok((c.clone(), f64_column(frame, c)?)))
+            .collect::<Result<_>>()?;
+        let location = |r: usize| -> String {
+            locate
+                .iter()
+                .map(|(c, v)| format!("{c} = {}", v[r].map_or("null".into(), fmt)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        // The row read within a set of candidate rows: the only one, or the largest.
+        let pick = |candidates: &[usize]| -> std::result::Result<usize, String> {
+            match &ranking {
+                Some(rank) => candidates
+                    .iter()
+                    .copied()
+                    .filter_map(|r| rank[r].filter(|v| v.is_finite()).map(|v| (r, v)))
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map(|(r, _)| r)
+                    .ok_or_else(|| "no finite row to maximise".to_string()),
+                None => match candidates {
+                    [r] => Ok(*r),
+                    _ => Err(format!(
+                        "{} rows match where exactly one was expected (add `where` or `max`)",
+                        candidates.len()
+                    )),
+                },
+            }
+        };
+        let value_at = |r: usize| -> std::result::Result<f64, String> {
+            values[r]
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("column `{column}` is null or not finite in the row read"))
+        };
+        let Some(scan_column) = &source.scan else {
+            let r = pick(&rows).map_err(fail)?;
+            return Ok(Measured {
+                value: value_at(r).map_err(fail)?,
+                location: location(r),
+                scan: None,
+            });
+        };
+        let scan_values = f64_column(frame, scan_column)?;
+        let mut groups: Vec<(f64, Vec<usize>)> = Vec::new();
+        let mut sorted: Vec<(usize, f64)> = rows
+            .iter()
+            .filter_map(|&r| scan_values[r].filter(|s| s.is_finite()).map(|s| (r, s)))
+            .filter(|&(_, s)| {
+                source
+                    .scan_range
+                    .is_none_or(|[lo, hi]| (lo..=hi).contains(&s))
+            })
+            .collect();
+        sorted.sort_by(|a, b| a.1.total_cmp(&b.1));
+        for (r, s) in sorted {
+            match groups.last_mut() {
+                Some((last, members)) if *last == s => members.push(r),
+                _ => groups.push((s, vec![r])),
+            }
+        }
+        let series: Vec<(f64, f64, usize)> = groups
+            .iter()
+            .map(|(s, members)| {
+                let r = pick(members)?;
+                Ok((*s, value_at(r)?, r))
+            })
+            .collect::<std::result::Result<_, String>>()
+            .map_err(|e| fail(format!("scanning `{scan_column}`: {e}")))?;
+        let target = match paper {
+            Paper::Value { value, .. } => *value,
+            Paper::Text {
+                range: Some([lo, hi]),
+                ..
+            } => 0.5 * (lo + hi),
+            Paper::Text { range: None, .. } => {
+                return Err(fail(
+                    "a scan needs a paper number or range to aim at".into(),
+                ))
+            }
+        };
+        let within = |v: f64| match paper {
+            Paper::Value { value, agree } => (v - value).abs() <= *agree,
+            Paper::Text {
+                range: Some([lo, hi]),
+                ..
+            } => (*lo..=*hi).contains(&v),
+            Paper::Text { range: None, .. } => false,
+        };
+        let best = (0..series.len())
+            .min_by(|&a, &b| {
+                (series[a].1 - target)
+                    .abs()
+                    .total_cmp(&(series[b].1 - target).abs())
+            })
+            .ok_or_else(|| fail(format!("no rows to scan over `{scan_column}`")))?;
+        let mut runs: Vec<(f64, f64)> = Vec::new();
+        let mut previous_hit = false;
+        for &(s, v, _) in &series {
+            let hit = within(v);
+            match runs.last_mut() {
+                Some(run) if hit && previous_hit => run.1 = s,
+                _ if hit => runs.push((s, s)),
+                _ => {}
+            }
+            previous_hit = hit;
+        }
+        let slope_between = |a: usize, b: usize| {
+            let ds = series[b].0 - series[a].0;
+            if ds > 0.0 {
+                ((series[b].1 - series[a].1) / ds).abs()
+            } else {
+                0.0
+            }
+        };
+        let mut slope: f64 = 0.0;
+        if best > 0 {
+            slope = slope.max(slope_between(best - 1, best));
+        }
+        if best + 1 < series.len() {
+            slope = slope.max(slope_between(best, best + 1));
+        }
+        let (s, value, r) = series[best];
+        let mut where_text = format!("{scan_column} = {}", fmt(s));
+        let located = location(r);
+        if !located.is_empty() {
+            where_text = format!("{where_text}: {located}");
+        }
+        Ok(Measured {
+            value,
+            location: where_text,
+            scan: Some(Scanned {
+                column: scan_column.clone(),
+                runs,
+                closest: s,
+                slope,
+            }),
+        })
+    }
+}
+
+fn filtered_rows(frame: &DataFrame, filter: &[(String, Match)]) -> Result<Vec<usize>> {
+    let mut keep: Vec<bool> = vec![true; frame.height()];
+    for (column, m) in filter {
+        match m {
+            Match::Number(x) => {
+                let values = f64_column(frame, column)?;
+                for (k, v) in keep.iter_mut().zip(values) {
+                    *k &= v == Some(*x);
+                }
+            }
+            Match::Text(s) => {
+                let values = str_column(frame, column)?;
+                for (k, v) in keep.iter_mut().zip(values) {
+                    *k &= v.as_deref() == Some(s.as_str());
+                }
+            }
+        }
+    }
+    Ok((0..frame.height()).filter(|&r| keep[r]).collect())
+}
+
+/// Whether `m` reproduces the paper's number (None for a statement without a range).
+fn reproduces(paper: &Paper, m: &Measured) -> Option<bool> {
+    match paper {
+        Paper::Value { value, agree } => Some((m.value - value).abs() <= *agree),
+        Paper::Text {
+            range: Some([lo, hi]),
+            ..
+        } => Some((*lo..=*hi).contains(&m.value)),
+        Paper::Text { range: None, .. } => None,
+    }
+}
+
+/// Four significant digits, without exponent for the magnitudes a report shows.
+fn fmt(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i32;
+    if !(-4..=7).contains(&magnitude) {
+        return format!("{x:.3e}");
+    }
+    let decimals = (3 - magnitude).clamp(0, 8) as usize;
+    format!("{x:.decimals$}")
+}
+
+/// The runs of a scan in words: "t in [30.25, 31.00], t = 35.50, … (7 runs)".
+fn runs_text(s: &Scanned) -> String {
+    const SHOWN: usize = 3;
+    if s.runs.is_empty() {
+        return format!("never (closest at {} = {})", s.column, fmt(s.closest));
+    }
+    let mut parts: Vec<String> = s
+        .runs
+        .iter()
+        .take(SHOWN)
+        .map(|&(a, b)| {
+            if a == b {
+                format!("{} = {}", s.column, fmt(a))
+            } else {
+                format!("{} in [{}, {}]", s.column, fmt(a), fmt(b))
+            }
+        })
+        .collect();
+    if let (true, Some(last)) = (s.runs.len() > SHOWN, s.runs.last()) {
+        parts.push(format!(
+            "… ({} runs, the last ending at {})",
+            s.runs.len(),
+            fmt(last.1)
+        ));
+    }
+    parts.join(", ")
+}
+
+fn paper_text(p: &Paper) -> String {
+    match p {
+        Paper::Value { value, .. } => fmt(*value),
+        Paper::Text { text, .. } => text.clone(),
+    }
+}
+
+fn difference(p: &Paper, m: &Measured) -> (Option<f64>, Option<f64>) {
+    match p {
+        Paper::Value { value, .. } => (
+            Some(m.value - value),
+            (*value != 0.0).then(|| (m.value - value) / value.abs()),
+        ),
+        Paper::Text { .. } => (None, None),
+    }
+}
+
+fn verdict(p: &Paper, m: &Measured) -> &'static str {
+    match reproduces(p, m) {
+        Some(true) => "yes",
+        Some(false) => "no",
+        None => "–",
+    }
+}
+
+fn markdown(report: &Report, evaluated: &[(Measured, Vec<(String, Measured)>)]) -> String {
+    let mut out = String::new();
+    out.push_str(&format!("# {}\n\n", report.title));
+    out.push_str("<!-- Generated by `woodpile run report`; do not edit by hand. -->\n\n");
+    if !report.preamble.is_empty() {
+        out.push_str(report.preamble.trim());
+        out.push_str("\n\n");
+    }
+    out.push_str("## Summary\n\n");
+    out.push_str("| figure | quantity | paper | ours (as run) | difference | reproduced as run | conventions that reproduce it |\n");
+    out.push_str("|---|---|---|---|---|---|---|\n");
+    for (q, (ours, conventions)) in report.quotes.iter().zip(evaluated) {
+        let (diff, _) = difference(&q.paper, ours);
+        let by: Vec<&str> = conventions
+            .iter()
+            .filter(|(_, m)| reproduces(&q.paper, m) == Some(true))
+            .map(|(name, _)| name.as_str())
+            .collect();
+        out.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {} | {} |\n",
+            q.figure,
+            q.quantity,
+            paper_text(&q.paper),
+            fmt(ours.value),
+            diff.map_or("–".into(), fmt),
+            verdict(&q.paper, ours),
+            if by.is_empty() {
+                "none".to_string()
+            } else {
+                by.join("; ")
+            },
+        ));
+    }
+    let mut figures: Vec<&str> = Vec::new();
+    for q in &report.quotes {
+        if !figures.contains(&q.figure.as_str()) {
+            figures.push(&q.figure);
+        }
+    }
+    for figure in figures {
+        out.push_str(&format!("\n## {figure}\n"));
+        for (q, (ours, conventions)) in report.quotes.iter().zip(evaluated) {
+            if q.figure != figure {
+                continue;
+            }
+            out.push_str(&format!("\n### {}\n\n", q.quantity));
+            let agree = match &q.paper {
+                Paper::Value { agree, .. } => format!(" (reproduced when within ±{})", fmt(*agree)),
+                Paper::Text {
+                    range: Some([lo, hi]),
+                    ..
+                } => {
+                    format!(" (taken as {} to {})", fmt(*lo), fmt(*hi))
+                }
+                Paper::Text { range: None, .. } => String::new(),
+            };
+            out.push_str(&format!("Paper: **{}**{agree}.\n\n", paper_text(&q.paper)));
+            if !q.note.is_empty() {
+                out.push_str(q.note.trim());
+                out.push_str("\n\n");
+            }
+            out.push_str("| convention | value | where | difference | reproduces | scan: within tolerance at | sensitivity |\n");
+            out.push_str("|---|---|---|---|---|---|---|\n");
+            let as_run = format!("as run: {}", q.as_run);
+            for (name, m) in
+                std::iter::once((&as_run, ours)).chain(conventions.iter().map(|(n, m)| (n, m)))
+            {
+                let (diff, _) = difference(&q.paper, m);
+                let (range, slope) = match &m.scan {
+                    Some(s) => (
+                        runs_text(s),
+                        format!("{} per unit {}", fmt(s.slope), s.column),
+                    ),
+                    None => ("–".into(), "–".into()),
+                };
+                out.push_str(&format!(
+                    "| {} | {} | {} | {} | {} | {} | {} |\n",
+                    name,
+                    fmt(m.value),
+                    if m.location.is_empty() {
+                        "–"
+                    } else {
+                        &m.location
+                    },
+                    diff.map_or("–".into(), fmt),
+                    verdict(&q.paper, m),
+                    range,
+                    slope,
+                ));
+            }
+        }
+    }
+    out
+}
+
+/// The parquet rows: one per quote and convention.
+#[derive(Default)]
+struct Rows {
+    figure: Vec<Option<String>>,
+    quantity: Vec<Option<String>>,
+    convention: Vec<Option<String>>,
+    paper: Vec<Option<f64>>,
+    paper_text: Vec<Option<String>>,
+    value: Vec<Option<f64>>,
+    location: Vec<Option<String>>,
+    difference: Vec<Option<f64>>,
+    relative_difference: Vec<Option<f64>>,
+    reproduces: Vec<Option<i64>>,
+    scan_column: Vec<Option<String>>,
+    scan_closest: Vec<Option<f64>>,
+    scan_runs: Vec<Option<String>>,
+    sensitivity: Vec<Option<f64>>,
+}
+
+impl Rows {
+    fn push(&mut self, q: &Quote, convention: &str, m: &Measured) {
+        let (diff, rel) = difference(&q.paper, m);
+        self.figure.push(Some(q.figure.clone()));
+        self.quantity.push(Some(q.quantity.clone()));
+        self.convention.push(Some(convention.to_string()));
+        self.paper.push(match q.paper {
+            Paper::Value { value, .. } => Some(value),
+            Paper::Text { .. } => None,
+        });
+        self.paper_text.push(Some(paper_text(&q.paper)));
+        self.value.push(Some(m.value));
+        self.location
+            .push((!m.location.is_empty()).then(|| m.location.clone()));
+        self.difference.push(diff);
+        self.relative_difference.push(rel);
+        self.reproduces.push(reproduces(&q.paper, m).map(i64::from));
+        self.scan_column
+            .push(m.scan.as_ref().map(|s| s.column.clone()));
+        self.scan_closest.push(m.scan.as_ref().map(|s| s.closest));
+        self.scan_runs.push(m.scan.as_ref().map(runs_text));
+        self.sensitivity.push(m.scan.as_ref().map(|s| s.slope));
+    }
+
+    fn into_columns(self) -> Columns {
+        let mut c = Columns::new();
+        c.str("figure", self.figure)
+            .str("quantity", self.quantity)
+            .str("convention", self.convention)
+            .f64("paper", self.paper)
+            .str("paper_text", self.paper_text)
+            .f64("value", self.value)
+            .str("location", self.location)
+            .f64("difference", self.difference)
+            .f64("relative_difference", self.relative_difference)
+            .i64("reproduces", self.reproduces)
+            .str("scan_column", self.scan_column)
+            .f64("scan_closest", self.scan_closest)
+            .str("scan_within_tolerance", self.scan_runs)
+            .f64("sensitivity", self.sensitivity);
+        c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt;
+
+    #[test]
+    fn four_significant_digits() {
+        assert_eq!(fmt(0.21116587), "0.2112");
+        assert_eq!(fmt(3961000.0), "3961000");
+        assert_eq!(fmt(-0.0110), "-0.01100");
+        assert_eq!(fmt(124.0), "124.0");
+        assert_eq!(fmt(1.5e-9), "1.500e-9");
+    }
+}
