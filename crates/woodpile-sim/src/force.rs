@@ -4,7 +4,7 @@
 //! evaluates a power 3/2 only for compressed contacts: at any moment only a handful of the
 //! chain's contacts are closed.
 
-use crate::model::{Boundary, Model};
+use crate::model::{Boundary, Model, Window};
 
 /// Hertz contact force for an overlap `d`: `[d]_+^{3/2}`.
 #[inline(always)]
@@ -41,14 +41,23 @@ impl Model {
     /// Accelerations `q'' = M^{-1} F(t, q)` for positions `q` (length `n_dof`), written into
     /// `acc` (same length).
     pub fn accelerations(&self, t: f64, q: &[f64], acc: &mut [f64]) {
+        self.accelerations_in(t, q, acc, Window::full(self));
+    }
+
+    /// [`Model::accelerations`] for the sites of `window` (and every resonator). Entries of
+    /// `acc` outside the window are left untouched: the caller keeps them at zero, which is
+    /// their exact value while those sites are at rest.
+    pub fn accelerations_in(&self, t: f64, q: &[f64], acc: &mut [f64], window: Window) {
         let n_sites = self.n_sites();
         debug_assert_eq!(q.len(), self.n_dof());
         debug_assert_eq!(acc.len(), self.n_dof());
+        debug_assert!(window.lo <= window.hi && window.hi < n_sites);
         let (u, v) = q.split_at(n_sites);
         let (acc_u, acc_v) = acc.split_at_mut(n_sites);
+        let (lo, hi) = (window.lo, window.hi);
 
-        acc_u.fill(0.0);
-        for bond in 0..n_sites - 1 {
+        acc_u[lo..=hi].fill(0.0);
+        for bond in lo..hi {
             let overlap = u[bond] - u[bond + 1];
             if overlap > 0.0 {
                 let f = overlap * overlap.sqrt();
@@ -57,16 +66,23 @@ impl Model {
             }
         }
         if self.boundary() == Boundary::Fixed {
-            acc_u[0] += hertz_force(-u[0]);
-            acc_u[n_sites - 1] -= hertz_force(u[n_sites - 1]);
+            if lo == 0 {
+                acc_u[0] += hertz_force(-u[0]);
+            }
+            if hi == n_sites - 1 {
+                acc_u[n_sites - 1] -= hertz_force(u[n_sites - 1]);
+            }
         }
         for (j, r) in self.resonators().iter().enumerate() {
+            if r.site < lo || r.site > hi {
+                continue;
+            }
             let f = r.coupling.at(t) * odd_power(u[r.site] - v[j], r.p);
             acc_u[r.site] -= f;
             acc_v[j] = f / r.eps;
         }
         if let Some(masses) = self.site_masses() {
-            for (a, m) in acc_u.iter_mut().zip(masses) {
+            for (a, m) in acc_u[lo..=hi].iter_mut().zip(&masses[lo..=hi]) {
                 *a /= m;
             }
         }
@@ -74,11 +90,18 @@ impl Model {
 
     /// First-order form `y' = (q', q'')` of the equations of motion, for Runge–Kutta methods.
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
+        self.rhs_in(t, y, dy, Window::full(self));
+    }
+
+    /// [`Model::rhs`] for the sites of `window`; entries outside it are left untouched.
+    pub fn rhs_in(&self, t: f64, y: &[f64], dy: &mut [f64], window: Window) {
         let n_dof = self.n_dof();
         let (q, qdot) = y.split_at(n_dof);
         let (dq, dqdot) = dy.split_at_mut(n_dof);
-        dq.copy_from_slice(qdot);
-        self.accelerations(t, q, dqdot);
+        for range in window.dof_ranges(self) {
+            dq[range.clone()].copy_from_slice(&qdot[range]);
+        }
+        self.accelerations_in(t, q, dqdot, window);
     }
 }
 

@@ -51,6 +51,7 @@ fn run_state(stepper: &mut dyn Stepper, control: StepControl) -> (f64, f64, Vec<
         control,
         max_steps: 10_000_000,
         energy_drift_limit: None,
+        active_window: true,
     };
     let stats = drive(&model, stepper, &mut y, &cfg, &mut ()).unwrap();
     (trapped(&model, &y, region), stats.max_energy_drift, y)
@@ -170,6 +171,7 @@ fn energy_is_conserved_within_stated_bounds() {
             control: StepControl::Fixed { dt: 0.02 },
             max_steps: 10_000_000,
             energy_drift_limit: None,
+            active_window: true,
         };
         drive(
             &model,
@@ -206,6 +208,7 @@ fn blow_up_is_an_error() {
         control: StepControl::Fixed { dt: 0.5 },
         max_steps: 1_000_000,
         energy_drift_limit: Some(1e-3),
+        active_window: true,
     };
     let err = drive(
         &model,
@@ -276,6 +279,7 @@ fn free_chain_conserves_momentum() {
         control: StepControl::Fixed { dt: 0.01 },
         max_steps: 1_000_000,
         energy_drift_limit: Some(1e-5),
+        active_window: true,
     };
     drive(
         &model,

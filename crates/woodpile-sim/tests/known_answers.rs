@@ -8,7 +8,7 @@ use woodpile_sim::integrate::{
     drive, Dop853, DriveConfig, ExplicitRk, Rk4, StepControl, Stepper, SymplecticStepper, VERLET,
     YOSHIDA4, YOSHIDA6,
 };
-use woodpile_sim::model::Model;
+use woodpile_sim::model::{Model, Window};
 use woodpile_sim::testing::{fitted_order, linear_oscillator, two_bead_collision};
 
 fn fixed(t_end: f64, dt: f64) -> DriveConfig {
@@ -18,6 +18,7 @@ fn fixed(t_end: f64, dt: f64) -> DriveConfig {
         control: StepControl::Fixed { dt },
         max_steps: 10_000_000,
         energy_drift_limit: None,
+        active_window: true,
     }
 }
 
@@ -94,7 +95,7 @@ fn resonator_linear_frequency() {
     let mut t = 0.0;
     let mut prev = y[0] - y[1];
     while crossings.len() < 5 {
-        stepper.step(&model, t, &mut y, dt);
+        stepper.step(&model, t, &mut y, dt, Window::full(&model));
         t += dt;
         let x = y[0] - y[1];
         if prev.signum() != x.signum() {

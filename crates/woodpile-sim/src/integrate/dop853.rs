@@ -13,7 +13,7 @@
 
 use super::rk::rk_stages;
 use super::{StepOutcome, Stepper};
-use crate::model::Model;
+use crate::model::{Model, Window};
 
 const STAGES: usize = 12;
 
@@ -208,7 +208,14 @@ impl Stepper for Dop853 {
     }
 
     #[allow(clippy::needless_range_loop)] // one pass over components, reading 12 stage rows
-    fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64) -> StepOutcome {
+    fn step(
+        &mut self,
+        model: &Model,
+        t: f64,
+        y: &mut [f64],
+        h: f64,
+        window: Window,
+    ) -> StepOutcome {
         let len = y.len();
         let reuse = self.fsal_at == Some(t);
         rk_stages(
@@ -216,11 +223,11 @@ impl Stepper for Dop853 {
             t,
             y,
             h,
-            &A,
-            &C,
+            (&A, &C),
             &mut self.stages,
             &mut self.scratch,
             !reuse,
+            window,
         );
         self.evals += if reuse {
             STAGES as u64 - 1
@@ -228,10 +235,13 @@ impl Stepper for Dop853 {
             STAGES as u64
         };
 
+        // Outside the window every stage is zero, so y_new = y there and the error terms are
+        // zero: summing only the window's terms, in state order, gives the same sums bit for bit.
+        let ranges = window.state_ranges(model);
         self.y_new.copy_from_slice(y);
         let mut err5 = 0.0;
         let mut err3 = 0.0;
-        for i in 0..len {
+        for i in ranges.clone().into_iter().flatten() {
             let mut inc = 0.0;
             let mut e5 = 0.0;
             let mut e3 = 0.0;
@@ -258,9 +268,11 @@ impl Stepper for Dop853 {
             return StepOutcome::Rejected { h_next: 0.2 * h };
         }
         if err <= 1.0 {
-            y.copy_from_slice(&self.y_new);
+            for range in ranges {
+                y[range.clone()].copy_from_slice(&self.y_new[range]);
+            }
             // The derivative at the accepted point opens the next step.
-            model.rhs(t + h, y, &mut self.stages[..len]);
+            model.rhs_in(t + h, y, &mut self.stages[..len], window);
             self.evals += 1;
             self.fsal_at = Some(t + h);
             let factor = if err == 0.0 {
@@ -278,6 +290,10 @@ impl Stepper for Dop853 {
 
     fn rhs_evals(&self) -> u64 {
         self.evals
+    }
+
+    fn reach(&self) -> usize {
+        STAGES + 1
     }
 
     /// Hairer's starting-step heuristic (HNW I, Section II.4).

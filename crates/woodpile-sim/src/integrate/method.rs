@@ -274,7 +274,8 @@ impl Plan {
         }
     }
 
-    /// Runs the plan: builds the stepper for `model` and drives `y` to `t_end`.
+    /// Runs the plan: builds the stepper for `model` and drives `y` to `t_end`, working only on
+    /// the sites the wave has reached.
     pub fn run<O: Observer + ?Sized>(
         &self,
         model: &Model,
@@ -283,12 +284,26 @@ impl Plan {
         sample_every: f64,
         observer: &mut O,
     ) -> Result<Stats, SimError> {
+        self.run_model(model, y, (t_end, sample_every), observer, true)
+    }
+
+    /// [`Plan::run`], choosing whether to skip the sites at rest (`active_window`) or to work
+    /// on the full chain. Both give the same bits; the full model is for tests and benchmarks.
+    pub fn run_model<O: Observer + ?Sized>(
+        &self,
+        model: &Model,
+        y: &mut [f64],
+        (t_end, sample_every): (f64, f64),
+        observer: &mut O,
+        active_window: bool,
+    ) -> Result<Stats, SimError> {
         let cfg = DriveConfig {
             t_end,
             sample_every,
             control: self.control,
             max_steps: 50_000_000,
             energy_drift_limit: Some(self.drift_limit),
+            active_window,
         };
         match self.method {
             Method::Rk4 => drive(model, &mut ExplicitRk::<Rk4>::new(model), y, &cfg, observer),

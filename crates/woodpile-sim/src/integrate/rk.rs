@@ -6,7 +6,7 @@
 use std::marker::PhantomData;
 
 use super::{StepOutcome, Stepper};
-use crate::model::Model;
+use crate::model::{Model, Window};
 
 /// A Butcher tableau with `STAGES` stages: `A` (strictly lower triangular, row i has i
 /// entries), weights `B`, nodes `C`.
@@ -62,29 +62,43 @@ impl<T: Tableau> Stepper for ExplicitRk<T> {
         T::NAME
     }
 
-    fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64) -> StepOutcome {
+    fn step(
+        &mut self,
+        model: &Model,
+        t: f64,
+        y: &mut [f64],
+        h: f64,
+        window: Window,
+    ) -> StepOutcome {
         let len = y.len();
         rk_stages(
             model,
             t,
             y,
             h,
-            T::A,
-            T::C,
+            (T::A, T::C),
             &mut self.stages,
             &mut self.scratch,
             true,
+            window,
         );
         self.evals += T::B.len() as u64;
+        let ranges = window.state_ranges(model);
         for (i, &b) in T::B.iter().enumerate() {
             if b != 0.0 {
                 let k = &self.stages[i * len..(i + 1) * len];
-                for (yi, ki) in y.iter_mut().zip(k) {
-                    *yi += h * b * ki;
+                for range in ranges.clone() {
+                    for (yi, ki) in y[range.clone()].iter_mut().zip(&k[range]) {
+                        *yi += h * b * ki;
+                    }
                 }
             }
         }
         StepOutcome::Accepted { h_next: h }
+    }
+
+    fn reach(&self) -> usize {
+        T::B.len()
     }
 
     fn rhs_evals(&self) -> u64 {
@@ -93,36 +107,42 @@ impl<T: Tableau> Stepper for ExplicitRk<T> {
 }
 
 /// Computes the stage derivatives k_i = f(t + c_i h, y + h sum_j a_ij k_j) into `stages`
-/// (row-major, `a.len()` rows of `y.len()`). With `first_stage = false`, row 0 is assumed to
-/// already hold f(t, y) (first-same-as-last reuse).
+/// (row-major, `a.len()` rows of `y.len()`), for the state entries of `window` only (the rest
+/// are at rest and stay zero). With `first_stage = false`, row 0 is assumed to already hold
+/// f(t, y) (first-same-as-last reuse).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn rk_stages(
     model: &Model,
     t: f64,
     y: &[f64],
     h: f64,
-    a: &[&[f64]],
-    c: &[f64],
+    (a, c): (&[&[f64]], &[f64]),
     stages: &mut [f64],
     scratch: &mut [f64],
     first_stage: bool,
+    window: Window,
 ) {
     let len = y.len();
+    let ranges = window.state_ranges(model);
     if first_stage {
-        model.rhs(t, y, &mut stages[..len]);
+        model.rhs_in(t, y, &mut stages[..len], window);
     }
     for i in 1..a.len() {
-        scratch.copy_from_slice(y);
+        for range in ranges.clone() {
+            scratch[range.clone()].copy_from_slice(&y[range]);
+        }
         let (done, rest) = stages.split_at_mut(i * len);
         for (j, &aij) in a[i].iter().enumerate() {
             if aij != 0.0 {
                 let k = &done[j * len..(j + 1) * len];
                 let w = h * aij;
-                for (s, kj) in scratch.iter_mut().zip(k) {
-                    *s += w * kj;
+                for range in ranges.clone() {
+                    for (s, kj) in scratch[range.clone()].iter_mut().zip(&k[range]) {
+                        *s += w * kj;
+                    }
                 }
             }
         }
-        model.rhs(t + c[i] * h, scratch, &mut rest[..len]);
+        model.rhs_in(t + c[i] * h, scratch, &mut rest[..len], window);
     }
 }

@@ -11,7 +11,7 @@
 //! the next sub-step (first-same-as-last).
 
 use super::{StepOutcome, Stepper};
-use crate::model::Model;
+use crate::model::{Model, Window};
 
 /// A symmetric composition of Verlet sub-steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,26 +85,38 @@ impl Stepper for SymplecticStepper {
         self.composition.name
     }
 
-    fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64) -> StepOutcome {
+    fn step(
+        &mut self,
+        model: &Model,
+        t: f64,
+        y: &mut [f64],
+        h: f64,
+        window: Window,
+    ) -> StepOutcome {
         let n_dof = model.n_dof();
         let (q, v) = y.split_at_mut(n_dof);
+        let ranges = window.dof_ranges(model);
         if self.cached_at != Some(t) {
-            model.accelerations(t, q, &mut self.acc);
+            model.accelerations_in(t, q, &mut self.acc, window);
             self.evals += 1;
         }
         let mut time = t;
         for &gamma in self.composition.gammas {
             let sub = gamma * h;
-            for (vi, ai) in v.iter_mut().zip(&self.acc) {
-                *vi += 0.5 * sub * ai;
-            }
-            for (qi, vi) in q.iter_mut().zip(v.iter()) {
-                *qi += sub * vi;
+            for range in ranges.clone() {
+                for (vi, ai) in v[range.clone()].iter_mut().zip(&self.acc[range.clone()]) {
+                    *vi += 0.5 * sub * ai;
+                }
+                for (qi, vi) in q[range.clone()].iter_mut().zip(&v[range]) {
+                    *qi += sub * vi;
+                }
             }
             time += sub;
-            model.accelerations(time, q, &mut self.acc);
-            for (vi, ai) in v.iter_mut().zip(&self.acc) {
-                *vi += 0.5 * sub * ai;
+            model.accelerations_in(time, q, &mut self.acc, window);
+            for range in ranges.clone() {
+                for (vi, ai) in v[range.clone()].iter_mut().zip(&self.acc[range]) {
+                    *vi += 0.5 * sub * ai;
+                }
             }
         }
         self.evals += self.composition.gammas.len() as u64;
@@ -112,6 +124,10 @@ impl Stepper for SymplecticStepper {
         // sum is irrelevant to a cache keyed by that value.
         self.cached_at = Some(t + h);
         StepOutcome::Accepted { h_next: h }
+    }
+
+    fn reach(&self) -> usize {
+        self.composition.gammas.len() + 1
     }
 
     fn rhs_evals(&self) -> u64 {
