@@ -5,8 +5,8 @@
 
 use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::{
-    drive, Dop853, DriveConfig, ExplicitRk, Rk4, StepControl, Stepper, SymplecticStepper, VERLET,
-    YOSHIDA4, YOSHIDA6,
+    drive, Dop853, DriveConfig, ExplicitRk, Rk4, Rk4Fused, StepControl, Stepper, SymplecticStepper,
+    VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
@@ -102,6 +102,7 @@ fn steppers(model: &Model) -> Vec<(Box<dyn Stepper>, StepControl)> {
             Box::new(Dop853::new(model, 1e-9, 1e-9)),
             StepControl::Adaptive { h_min: 1e-12 },
         ),
+        (Box::new(Rk4Fused::new(model)), fixed),
     ]
 }
 
@@ -131,7 +132,7 @@ fn run(
 #[test]
 fn the_active_window_changes_no_bit_of_the_result() {
     for (scene, model, striker) in scenes() {
-        for index in 0..5 {
+        for index in 0..6 {
             let (y_window, series_window, steps_window) = run(&model, striker, index, true);
             let (y_full, series_full, steps_full) = run(&model, striker, index, false);
             let name = steppers(&model)[index].0.name();
@@ -152,5 +153,24 @@ fn the_active_window_changes_no_bit_of_the_result() {
                 "{scene}, {name}: fraction series differ"
             );
         }
+    }
+}
+
+/// The fused RK4 (the one `rk4` and `auto` run) is the tableau RK4 in another loop order: the
+/// same bits.
+#[test]
+fn fused_rk4_is_the_tableau_rk4_bit_for_bit() {
+    for (scene, model, striker) in scenes() {
+        let (y_tableau, series_tableau, _) = run(&model, striker, 0, true);
+        let (y_fused, series_fused, _) = run(&model, striker, 5, true);
+        let first_difference = y_tableau
+            .iter()
+            .zip(&y_fused)
+            .position(|(a, b)| a.to_bits() != b.to_bits());
+        assert_eq!(first_difference, None, "{scene}: final states differ");
+        assert_eq!(
+            series_tableau, series_fused,
+            "{scene}: fraction series differ"
+        );
     }
 }

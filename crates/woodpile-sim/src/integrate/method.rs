@@ -2,8 +2,8 @@
 //! and step control for one model. `method = "auto"` lives here.
 
 use super::{
-    drive, Dop853, DriveConfig, ExplicitRk, Observer, Rk4, Stats, StepControl, SymplecticStepper,
-    VERLET, YOSHIDA4, YOSHIDA6,
+    drive, Dop853, DriveConfig, Observer, Rk4Fused, Stats, StepControl, SymplecticStepper, VERLET,
+    YOSHIDA4, YOSHIDA6,
 };
 use crate::error::SimError;
 use crate::model::Model;
@@ -306,7 +306,7 @@ impl Plan {
             active_window,
         };
         match self.method {
-            Method::Rk4 => drive(model, &mut ExplicitRk::<Rk4>::new(model), y, &cfg, observer),
+            Method::Rk4 => drive(model, &mut Rk4Fused::new(model), y, &cfg, observer),
             Method::Verlet => drive(
                 model,
                 &mut SymplecticStepper::new(model, VERLET),
