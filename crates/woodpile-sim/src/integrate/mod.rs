@@ -349,11 +349,12 @@ fn validate(cfg: &DriveConfig) -> Result<(), SimError> {
 }
 
 fn check_finite(y: &[f64], t: f64) -> Result<(), SimError> {
-    check_finite_in(y, t, &[0..y.len()])
+    check_finite_in(y, t, std::slice::from_ref(&(0..y.len())))
 }
 
 /// Fails if any entry of `y` in `ranges` is NaN or infinite. x - x is 0 for a finite x and NaN
 /// otherwise, and never overflows; eight independent partial sums let the loop vectorise.
+#[allow(clippy::eq_op)] // x - x is the point: it is NaN exactly when x is not finite
 fn check_finite_in(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {
     let mut lanes = [0.0f64; 8];
     for range in ranges {
