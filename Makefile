@@ -5,7 +5,7 @@ WOODPILE := $(or $(CARGO_TARGET_DIR),target)/release/woodpile
 SCRATCH := scratch/check
 CHECK_TOL := --abs 1e-9 --rel 1e-9
 
-.PHONY: help build test figures stage status check read-check bench lint slurm-test
+.PHONY: help build test figures stage status check read-check bench work-precision lint slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -14,7 +14,7 @@ build: ## Build the woodpile binary (release)
 	$(CARGO) build --release -p woodpile-cli
 
 test: ## Run the whole test suite (what CI runs; release profile, shared with `figures`)
-	$(CARGO) test --workspace --release
+	$(CARGO) test --workspace --release --exclude woodpile-bench
 
 figures: build ## Bring every stale stage up to date (nothing runs when all are fresh)
 	$(WOODPILE) run
@@ -35,7 +35,16 @@ check: build ## Recompute every stage into scratch/ and diff against the committ
 read-check: ## Open every result table with pyarrow, pandas and polars
 	python3 scripts/read_results.py results
 
-bench: ## Error in E_tr against wall time for every method (README table)
+BASELINE := $(or $(CARGO_TARGET_DIR),target)/baseline
+
+bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, then divan benchmarks
+	mkdir -p $(BASELINE)
+	gcc -O3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
+	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
+	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py
+	$(CARGO) bench -p woodpile-bench
+
+work-precision: ## Error in E_tr against wall time for every method and step (README table)
 	$(CARGO) run --release -p woodpile-sim --example work_precision
 
 lint: ## rustfmt check and clippy with warnings as errors

@@ -1,0 +1,58 @@
+//! `cargo bench -p woodpile-bench`: the standard scene (N = 100, one defect eps = 10, t = 150)
+//! by the methods and steps that reach |ΔE_tr| <= 1e-7, with and without the active window.
+#![allow(clippy::unwrap_used)]
+
+use woodpile_bench::{fixed, run};
+use woodpile_sim::integrate::{Method, MethodChoice, Plan};
+use woodpile_sim::testing::fixed_dt;
+
+fn main() {
+    divan::main();
+}
+
+/// RK4 at the step of the C and numba baselines (dt = 0.01, |ΔE_tr| = 2.3e-8).
+#[divan::bench]
+fn rk4_dt_0_01() -> f64 {
+    run(&fixed(Method::Rk4, 0.01)).unwrap().fractions.trapped
+}
+
+/// The same on the full chain, every site every step: what the active window saves.
+#[divan::bench]
+fn rk4_dt_0_01_full_chain() -> f64 {
+    let scene = fixed(Method::Rk4, 0.01);
+    let plan = Plan::choose(
+        &scene.model,
+        MethodChoice::Named(Method::Rk4),
+        fixed_dt(0.01),
+    )
+    .unwrap();
+    let mut y = scene.model.rest_state();
+    scene
+        .model
+        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
+        .unwrap();
+    plan.run_model(
+        &scene.model,
+        &mut y,
+        (scene.t_end, scene.sample_every),
+        &mut (),
+        false,
+    )
+    .unwrap();
+    y[0]
+}
+
+/// RK4 at dt = 0.02 (|ΔE_tr| = 6.4e-8): the cheapest RK4 within 1e-7.
+#[divan::bench]
+fn rk4_dt_0_02() -> f64 {
+    run(&fixed(Method::Rk4, 0.02)).unwrap().fractions.trapped
+}
+
+/// Yoshida's fourth-order composition at dt = 0.01 (|ΔE_tr| = 1.3e-8).
+#[divan::bench]
+fn yoshida4_dt_0_01() -> f64 {
+    run(&fixed(Method::Yoshida4, 0.01))
+        .unwrap()
+        .fractions
+        .trapped
+}

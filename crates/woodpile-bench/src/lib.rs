@@ -1,0 +1,24 @@
+//! The scene every speed claim is measured on, shared by the divan benchmarks and the
+//! comparison binary: the paper's standard chain (N = 100, fixed walls, impulse at -25, t = 150)
+//! with one linear defect eps = 10, kappa = 1 at site 0, the scene of SPEC §4's C and numba
+//! timings (`baseline/`).
+
+use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
+use woodpile_sim::run::{simulate, Outcome, Scenario};
+use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
+use woodpile_sim::SimError;
+
+/// The standard scene integrated by `method` with `accuracy`.
+pub fn standard_scene(method: MethodChoice, accuracy: Accuracy) -> Scenario {
+    paper_scene(&[PaperDefect::linear(0, 10.0, 1.0)], method, accuracy)
+}
+
+/// The standard scene by a named fixed-step method at step `dt`.
+pub fn fixed(method: Method, dt: f64) -> Scenario {
+    standard_scene(MethodChoice::Named(method), fixed_dt(dt))
+}
+
+/// Simulates `scenario` without observers.
+pub fn run(scenario: &Scenario) -> Result<Outcome, SimError> {
+    simulate(scenario, &mut ())
+}

@@ -1,0 +1,191 @@
+//! `make bench`: woodpile's RK4 and its other methods on the standard scene, timed in the same
+//! run as the C and numba RK4 baselines of `baseline/`, with the ratios. Prints a Markdown table
+//! (the README's) and one JSON line per row on stderr.
+//!
+//! ```text
+//! woodpile-bench [--c PATH_TO_C_BINARY] [--numba PATH_TO_SCRIPT] [--repeats N]
+//! ```
+//!
+//! Accuracy is |ΔE_tr| against a reference (Yoshida-6 at dt = 2.5e-4, whose own error is about
+//! 1e-11: it agrees with RK4 at dt = 5e-4 to that). Wall time is the best of `repeats` runs.
+#![allow(clippy::print_stdout)]
+
+use std::process::Command;
+use std::time::Instant;
+
+use serde_json::Value;
+use woodpile_bench::{fixed, run};
+use woodpile_sim::integrate::{Method, MethodChoice, Plan};
+use woodpile_sim::run::Scenario;
+use woodpile_sim::testing::fixed_dt;
+
+struct Row {
+    implementation: String,
+    setting: String,
+    error: f64,
+    ms: f64,
+}
+
+fn best_ms(repeats: usize, mut f: impl FnMut() -> f64) -> (f64, f64) {
+    let mut best = f64::INFINITY;
+    let mut value = f64::NAN;
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        value = f();
+        best = best.min(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    (best, value)
+}
+
+fn trapped(scene: &Scenario) -> f64 {
+    run(scene).map_or(f64::NAN, |o| o.fractions.trapped)
+}
+
+fn full_chain(scene: &Scenario, method: Method, dt: f64) -> f64 {
+    let Ok(plan) = Plan::choose(&scene.model, MethodChoice::Named(method), fixed_dt(dt)) else {
+        return f64::NAN;
+    };
+    let mut y = scene.model.rest_state();
+    if scene
+        .model
+        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
+        .is_err()
+    {
+        return f64::NAN;
+    }
+    let sampled = (scene.t_end, scene.sample_every);
+    if plan
+        .run_model(&scene.model, &mut y, sampled, &mut (), false)
+        .is_err()
+    {
+        return f64::NAN;
+    }
+    let mut density = vec![0.0; scene.model.n_sites()];
+    woodpile_sim::energy::energy_density(&scene.model, scene.t_end, &y, &mut density);
+    woodpile_sim::energy::Fractions::from_density(&density, scene.region).trapped
+}
+
+/// Runs a baseline command that prints one JSON line with `E_tr` and `ms`.
+fn baseline(program: &str, args: &[&str]) -> Result<(f64, f64, String), String> {
+    let out = Command::new(program)
+        .args(args)
+        .output()
+        .map_err(|e| format!("{program}: {e}"))?;
+    if !out.status.success() {
+        return Err(format!(
+            "{program} failed: {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let line = text.lines().last().unwrap_or_default();
+    let v: Value = serde_json::from_str(line).map_err(|e| format!("{program}: {e}: {line}"))?;
+    let get = |k: &str| {
+        v.get(k)
+            .and_then(Value::as_f64)
+            .ok_or(format!("{program}: no `{k}`"))
+    };
+    let name = v
+        .get("implementation")
+        .and_then(Value::as_str)
+        .unwrap_or(program)
+        .to_string();
+    Ok((get("E_tr")?, get("ms")?, name))
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let option = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1).cloned())
+    };
+    let c_binary = option("--c");
+    let numba_script = option("--numba");
+    let repeats: usize = option("--repeats")
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(10);
+
+    let reference = trapped(&fixed(Method::Yoshida6, 2.5e-4));
+    let check = trapped(&fixed(Method::Rk4, 5e-4));
+    println!(
+        "standard scene (N = 100, eps = 10, t = 150): reference E_tr = {reference:.12} \
+         (yoshida6, dt = 2.5e-4; |ref - rk4(dt = 5e-4)| = {:.1e}); best of {repeats} runs\n",
+        (reference - check).abs()
+    );
+
+    let mut rows = Vec::new();
+    let mut ours = |setting: &str, ms_value: (f64, f64)| {
+        rows.push(Row {
+            implementation: "woodpile".into(),
+            setting: setting.into(),
+            error: (ms_value.1 - reference).abs(),
+            ms: ms_value.0,
+        });
+    };
+    for (method, dt) in [
+        (Method::Rk4, 0.01),
+        (Method::Rk4, 0.02),
+        (Method::Yoshida4, 0.01),
+        (Method::Yoshida6, 0.02),
+        (Method::Verlet, 0.005),
+    ] {
+        let scene = fixed(method, dt);
+        ours(
+            &format!("{} dt = {dt}", method.name()),
+            best_ms(repeats, || trapped(&scene)),
+        );
+    }
+    let scene = fixed(Method::Rk4, 0.01);
+    ours(
+        "rk4 dt = 0.01, full chain (no active window)",
+        best_ms(repeats, || full_chain(&scene, Method::Rk4, 0.01)),
+    );
+
+    let mut baselines = Vec::new();
+    let repeats_text = repeats.to_string();
+    if let Some(c) = &c_binary {
+        baselines.push(baseline(c, &["0.01", &repeats_text]));
+    }
+    if let Some(script) = &numba_script {
+        baselines.push(baseline("python3", &[script, "0.01", &repeats_text]));
+    }
+    let mut reference_ms: Vec<(String, f64)> = Vec::new();
+    for b in baselines {
+        match b {
+            Ok((e_tr, ms, name)) => {
+                reference_ms.push((name.clone(), ms));
+                rows.push(Row {
+                    implementation: name,
+                    setting: "rk4 dt = 0.01, full chain".into(),
+                    error: (e_tr - reference).abs(),
+                    ms,
+                });
+            }
+            Err(e) => eprintln!("baseline skipped: {e}"),
+        }
+    }
+
+    let mut header = "| implementation | setting | abs error E_tr | wall ms |".to_string();
+    let mut rule = "|---|---|---|---|".to_string();
+    for (name, _) in &reference_ms {
+        header.push_str(&format!(" time / {name} |"));
+        rule.push_str("---|");
+    }
+    println!("{header}\n{rule}");
+    for r in &rows {
+        let mut line = format!(
+            "| {} | {} | {:.1e} | {:.2} |",
+            r.implementation, r.setting, r.error, r.ms
+        );
+        for (_, ms) in &reference_ms {
+            line.push_str(&format!(" {:.2} |", r.ms / ms));
+        }
+        println!("{line}");
+        eprintln!(
+            "{}",
+            serde_json::json!({"implementation": r.implementation, "setting": r.setting,
+                "abs_error_E_tr": r.error, "ms": r.ms})
+        );
+    }
+}
