@@ -45,6 +45,7 @@ pub mod status;
 pub mod sweep;
 pub mod table;
 pub mod template;
+pub mod workprecision;
 
 pub use error::{PipelineError, Result};
 pub use pipeline::Pipeline;

@@ -187,13 +187,15 @@ fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
     let kind_of = |name: &str| &by_name[name].spec;
     let error = |key: &str, reason: String| Err(definition_error(stage, key, reason));
     match &stage.spec {
-        Spec::Sweep(_) | Spec::SpaceTime(_) => match stage.inputs.is_empty() {
-            true => Ok(()),
-            false => error(
-                "inputs",
-                format!("a {} stage reads no other stage", stage.spec.kind()),
-            ),
-        },
+        Spec::Sweep(_) | Spec::SpaceTime(_) | Spec::WorkPrecision(_) => {
+            match stage.inputs.is_empty() {
+                true => Ok(()),
+                false => error(
+                    "inputs",
+                    format!("a {} stage reads no other stage", stage.spec.kind()),
+                ),
+            }
+        }
         Spec::Reduce(reduce) => {
             let [input] = stage.inputs.as_slice() else {
                 return error("inputs", "a reduce stage reads exactly one sweep".into());

@@ -14,7 +14,9 @@
 //! y_label = "energy fraction at t = 150"
 //! ```
 //!
-//! An optional `where = { column = value }` draws only the matching rows.
+//! An optional `where = { column = value }` draws only the matching rows. In `[lines]`,
+//! `series = "column"` draws one curve of the single `y` per value of that column, named by
+//! the string column `series_label` when given (work-precision charts: one curve per method).
 //! `[heatmap]` takes `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`,
 //! optionally `panels` and `mark_max = true` (circle and label the largest z).
 
@@ -26,7 +28,7 @@ use woodpile_plot::{Figure, HeatPanel, LinePanel, Panel, Series};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::table::{f64_column, matching_rows, Columns};
+use crate::table::{f64_column, matching_rows, str_column, Columns};
 use crate::Output;
 
 /// A parsed render stage.
@@ -53,6 +55,10 @@ pub enum Plot {
         y: Vec<String>,
         /// Optional panel column.
         panels: Option<String>,
+        /// Optional column splitting the single y into one curve per value.
+        series: Option<String>,
+        /// String column naming each curve of `series`.
+        series_label: Option<String>,
         /// Axis labels.
         x_label: String,
         /// Axis labels.
@@ -96,9 +102,25 @@ impl Render {
                     x: f.required("x")?,
                     y: f.required("y")?,
                     panels: f.optional("panels")?,
+                    series: f.optional("series")?,
+                    series_label: f.optional("series_label")?,
                     x_label: f.required("x_label")?,
                     y_label: f.required("y_label")?,
                 };
+                if let Plot::Lines {
+                    y,
+                    series,
+                    series_label,
+                    ..
+                } = &plot
+                {
+                    if series.is_some() && y.len() != 1 {
+                        return Err(f.error("y", "with `series`, give exactly one y column"));
+                    }
+                    if series.is_none() && series_label.is_some() {
+                        return Err(f.error("series_label", "needs `series`"));
+                    }
+                }
                 f.finish()?;
                 plot
             }
@@ -162,9 +184,16 @@ impl Render {
             Ok(keep.iter().map(|&r| values[r]).collect())
         };
         let (panel_name, mut used): (Option<&String>, Vec<&String>) = match &self.plot {
-            Plot::Lines { x, y, panels, .. } => {
-                (panels.as_ref(), std::iter::once(x).chain(y).collect())
-            }
+            Plot::Lines {
+                x,
+                y,
+                panels,
+                series,
+                ..
+            } => (
+                panels.as_ref(),
+                std::iter::once(x).chain(y).chain(series).collect(),
+            ),
             Plot::Heatmap {
                 x, y, z, panels, ..
             } => (panels.as_ref(), vec![x, y, z]),
@@ -177,6 +206,16 @@ impl Render {
         keys.sort_by(f64::total_cmp);
         keys.dedup();
         let data: Vec<Vec<Option<f64>>> = used.iter().map(|c| column(c)).collect::<Result<_>>()?;
+        let labels: Option<Vec<Option<String>>> = match &self.plot {
+            Plot::Lines {
+                series_label: Some(l),
+                ..
+            } => {
+                let all = str_column(input, l).map_err(fail)?;
+                Some(keep.iter().map(|&r| all[r].clone()).collect())
+            }
+            _ => None,
+        };
         let panel_values = &panel_values;
         let height = keep.len();
         let rows_of = move |key: f64| -> Vec<usize> {
@@ -196,6 +235,7 @@ impl Render {
                     y,
                     x_label,
                     y_label,
+                    series: None,
                     ..
                 } => Panel::Lines(LinePanel {
                     title: title_of(key),
@@ -218,6 +258,46 @@ impl Render {
                         })
                         .collect(),
                 }),
+                Plot::Lines {
+                    x_label,
+                    y_label,
+                    series: Some(series),
+                    ..
+                } => {
+                    // data = [x, y, series]; curves in order of first appearance.
+                    let rows = rows_of(key);
+                    let mut curves: Vec<(f64, Vec<usize>)> = Vec::new();
+                    for r in rows {
+                        let Some(id) = data[2][r] else { continue };
+                        match curves.iter_mut().find(|(v, _)| *v == id) {
+                            Some((_, members)) => members.push(r),
+                            None => curves.push((id, vec![r])),
+                        }
+                    }
+                    Panel::Lines(LinePanel {
+                        title: title_of(key),
+                        x_label: x_label.clone(),
+                        y_label: y_label.clone(),
+                        series: curves
+                            .into_iter()
+                            .map(|(id, members)| Series {
+                                label: labels
+                                    .as_ref()
+                                    .and_then(|l| l[members[0]].clone())
+                                    .unwrap_or_else(|| format!("{series} = {id}")),
+                                points: members
+                                    .iter()
+                                    .map(|&r| {
+                                        (
+                                            data[0][r].unwrap_or(f64::NAN),
+                                            data[1][r].unwrap_or(f64::NAN),
+                                        )
+                                    })
+                                    .collect(),
+                            })
+                            .collect(),
+                    })
+                }
                 Plot::Heatmap {
                     x_label,
                     y_label,

@@ -142,6 +142,7 @@ fn execute(
             render.run(&stage.name, &frame, &options.figures)?
         }
         Spec::Report(report) => report.run(&stage.name, results)?,
+        Spec::WorkPrecision(wp) => wp.run(&stage.name)?,
     };
     let manifest = manifest_for(pipeline, stage, output.summary.clone());
     let rows = output.frame.height();

@@ -24,6 +24,7 @@ use crate::render::Render;
 use crate::report::Report;
 use crate::spacetime::SpaceTime;
 use crate::sweep::Sweep;
+use crate::workprecision::WorkPrecision;
 
 /// The kinds of stage, in pipeline order.
 pub const KINDS: &[&str] = &[
@@ -34,6 +35,7 @@ pub const KINDS: &[&str] = &[
     "approximate",
     "render",
     "report",
+    "workprecision",
 ];
 
 /// What a stage does, with its kind-specific parameters.
@@ -55,6 +57,8 @@ pub enum Spec {
     Render(Render),
     /// The reproduction report: the paper's numbers against ours.
     Report(Report),
+    /// Speed against accuracy for every method on a few scenes.
+    WorkPrecision(WorkPrecision),
 }
 
 impl Spec {
@@ -69,6 +73,7 @@ impl Spec {
             Spec::Approximate(_) => "approximate",
             Spec::Render(_) => "render",
             Spec::Report(_) => "report",
+            Spec::WorkPrecision(_) => "workprecision",
         }
     }
 }
@@ -124,6 +129,7 @@ impl Stage {
             "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),
             "render" => Spec::Render(Render::parse(&mut fields)?),
             "report" => Spec::Report(Report::parse(&mut fields)?),
+            "workprecision" => Spec::WorkPrecision(WorkPrecision::parse(&mut fields)?),
             other => {
                 return Err(fields.error(
                     "kind",

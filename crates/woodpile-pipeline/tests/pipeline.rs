@@ -901,3 +901,60 @@ fn a_kinetic_sweep_starts_with_the_impact_energy_left_of_the_region() {
     // Later on potential energy exists, so the two series differ.
     assert!((0..frame.height()).any(|i| (r[i].unwrap() - r_energy[i].unwrap()).abs() > 1e-3));
 }
+
+const WORK_PRECISION: &str = r#"
+kind = "workprecision"
+repeats = 1
+reference_tolerance = 1e-12
+[[scene]]
+name = "tiny"
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0 }
+defect = [{ site = 0, eps = 2.0 }]
+[[method]]
+name = "rk4"
+dt = [0.2, 0.1, 0.05]
+[[method]]
+name = "dop853"
+tolerance = [1e-6]
+"#;
+
+const WORK_PRECISION_CHART: &str = r#"
+kind = "render"
+inputs = ["wp"]
+title = "work-precision"
+where = { scene = 0 }
+[lines]
+x = "log10_wall_ms"
+y = ["log10_error"]
+series = "method_index"
+series_label = "method"
+x_label = "log10 ms"
+y_label = "log10 error"
+"#;
+
+/// A work-precision stage measures every setting against its reference: RK4's error falls
+/// with its step at about its order on a smooth enough scene, and the chart draws one curve per
+/// method.
+#[test]
+fn work_precision_measures_error_against_the_reference() {
+    let p = Project::new(&[("wp", WORK_PRECISION), ("chart", WORK_PRECISION_CHART)]);
+    p.run(&[]);
+    let frame = table::read(&p.output("wp")).unwrap();
+    assert_eq!(frame.height(), 4);
+    let error = table::f64_column(&frame, "error").unwrap();
+    let wall = table::f64_column(&frame, "wall_ms").unwrap();
+    let e = |i: usize| error[i].unwrap();
+    assert!(e(0) > e(1) && e(1) > e(2), "{error:?}");
+    // Halving dt divides RK4's error by at least 2^2.5 (the contact-limited order) on this scene.
+    assert!(e(1) / e(2) > 5.0, "{error:?}");
+    assert!(wall.iter().all(|w| w.is_some_and(|w| w > 0.0)));
+    let manifest = table::read_manifest(&p.output("wp")).unwrap().unwrap();
+    let reference = manifest.summary["references"][0]["E_tr"].as_f64().unwrap();
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    assert!(((e_tr[2].unwrap() - reference).abs() - e(2)).abs() < 1e-15);
+    assert_eq!(manifest.summary["runs"].as_u64(), Some(4));
+    assert!(p.results.join("figures").join("chart.png").exists());
+    assert_eq!(p.state("chart"), State::Fresh);
+}

@@ -1,0 +1,334 @@
+//! `kind = "workprecision"`: speed against accuracy. Every method over a range of steps or
+//! tolerances, on a few representative scenes: the error in E_tr against a tight reference, the
+//! energy drift, and the wall time (SciML's DiffEqDevTools work-precision charts are the model).
+//!
+//! ```toml
+//! kind = "workprecision"
+//! repeats = 3                      # wall time is the best of this many runs
+//! reference_tolerance = 1e-13      # the reference: dop853 at this tolerance
+//! [[scene]]
+//! name = "one defect, eps = 10"
+//! defect = [{ site = 0, eps = 10.0 }]   # the rest of the table is a scene file
+//! [[method]]
+//! name = "rk4"
+//! dt = [0.1, 0.05, 0.02, 0.01]          # fixed-step methods take dt,
+//! [[method]]
+//! name = "dop853"
+//! tolerance = [1e-6, 1e-8, 1e-10]       # adaptive ones and `auto` take tolerance
+//! ```
+//!
+//! One row per scene, method and setting. Runs are sequential (one thread) so that wall times
+//! are comparable; a run that fails (blow-up, drift beyond its bound) is a row with its reason in
+//! `failure` and null numbers. The manifest notes the reference values, the machine (CPU model
+//! and cores) and the runs counted. Wall times differ between machines and runs: `make check`
+//! compares every other column exactly and the `wall_ms` columns not at all.
+
+use std::path::Path;
+use std::time::Instant;
+
+use serde_json::json;
+use woodpile_scene::{Scene, SceneError};
+use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
+use woodpile_sim::run::{simulate, Outcome};
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::table::Columns;
+use crate::Output;
+
+/// A parsed work-precision stage.
+#[derive(Debug, Clone)]
+pub struct WorkPrecision {
+    /// Runs per setting; the best wall time is kept.
+    pub repeats: usize,
+    /// Tolerance of the DOP853 reference.
+    pub reference_tolerance: f64,
+    /// The scenes, named.
+    pub scenes: Vec<(String, Scene)>,
+    /// The method settings, in order.
+    pub settings: Vec<Setting>,
+}
+
+/// One method at one step or tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Setting {
+    /// Method name as in scene files (`auto` included).
+    pub method: String,
+    /// Index of the method among the stage's `[[method]]` tables (a curve of the chart).
+    pub method_index: usize,
+    /// The method.
+    pub choice: MethodChoice,
+    /// Step or tolerance.
+    pub accuracy: Accuracy,
+}
+
+impl WorkPrecision {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<WorkPrecision> {
+        let repeats = fields.optional::<i64>("repeats")?.unwrap_or(3);
+        if !(1..=100).contains(&repeats) {
+            return Err(fields.error("repeats", "expected 1 to 100"));
+        }
+        let reference_tolerance = fields
+            .optional::<f64>("reference_tolerance")?
+            .unwrap_or(1e-13);
+        if !(reference_tolerance > 0.0) {
+            return Err(fields.error("reference_tolerance", "must be > 0"));
+        }
+        let file = fields.file().to_path_buf();
+        let Some(toml::Value::Array(scene_tables)) = fields.take("scene") else {
+            return Err(fields.error("scene", "expected one or more [[scene]] tables"));
+        };
+        let mut scenes = Vec::new();
+        for (i, entry) in scene_tables.into_iter().enumerate() {
+            let key = format!("scene[{i}]");
+            let toml::Value::Table(mut table) = entry else {
+                return Err(fields.error(&key, "expected a table"));
+            };
+            let name = match table.remove("name") {
+                Some(toml::Value::String(s)) => s,
+                _ => return Err(fields.error(&format!("{key}.name"), "expected a string")),
+            };
+            let scene = woodpile_scene::from_table(table, &file).map_err(|e| match e {
+                SceneError::Invalid { key: k, reason, .. } => {
+                    fields.error(&format!("{key}.{k}"), reason)
+                }
+                SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
+                    fields.error(&key, reason)
+                }
+            })?;
+            scenes.push((name, scene));
+        }
+        let Some(toml::Value::Array(method_tables)) = fields.take("method") else {
+            return Err(fields.error("method", "expected one or more [[method]] tables"));
+        };
+        let mut settings = Vec::new();
+        for (i, entry) in method_tables.into_iter().enumerate() {
+            let key = format!("method[{i}]");
+            let toml::Value::Table(table) = entry else {
+                return Err(fields.error(&key, "expected a table"));
+            };
+            let mut f = fields.nested(&key, table);
+            let name: String = f.required("name")?;
+            let choice = match name.as_str() {
+                "auto" => MethodChoice::Auto,
+                other => MethodChoice::Named(
+                    Method::from_name(other)
+                        .ok_or_else(|| f.error("name", format!("unknown method `{other}`")))?,
+                ),
+            };
+            let adaptive = match choice {
+                MethodChoice::Auto => true,
+                MethodChoice::Named(m) => m.is_adaptive(),
+            };
+            let values: Vec<f64> = if adaptive {
+                f.required("tolerance")?
+            } else {
+                f.required("dt")?
+            };
+            f.finish()?;
+            if values.is_empty() || values.iter().any(|v| !(*v > 0.0)) {
+                let what = if adaptive { "tolerance" } else { "dt" };
+                return Err(fields.error(&format!("{key}.{what}"), "expected positive numbers"));
+            }
+            for v in values {
+                let accuracy = if adaptive {
+                    Accuracy {
+                        tolerance: v,
+                        tolerance_explicit: true,
+                        dt: None,
+                    }
+                } else {
+                    Accuracy {
+                        tolerance: 1e-8,
+                        tolerance_explicit: false,
+                        dt: Some(v),
+                    }
+                };
+                settings.push(Setting {
+                    method: name.clone(),
+                    method_index: i,
+                    choice,
+                    accuracy,
+                });
+            }
+        }
+        Ok(WorkPrecision {
+            repeats: repeats as usize,
+            reference_tolerance,
+            scenes,
+            settings,
+        })
+    }
+
+    pub(crate) fn run(&self, stage: &str) -> Result<Output> {
+        let mut rows = Rows::default();
+        let mut references = Vec::new();
+        for (index, (name, scene)) in self.scenes.iter().enumerate() {
+            let mut reference = scene.scenario.clone();
+            reference.method = MethodChoice::Named(Method::Dop853);
+            reference.accuracy = Accuracy {
+                tolerance: self.reference_tolerance,
+                tolerance_explicit: true,
+                dt: None,
+            };
+            let e_ref = simulate(&reference, &mut ())
+                .map_err(|e| {
+                    PipelineError::stage(stage, format!("scene `{name}`: reference failed: {e}"))
+                })?
+                .fractions
+                .trapped;
+            references.push(json!({"scene": index, "name": name, "E_tr": e_ref}));
+            for setting in &self.settings {
+                let mut scenario = scene.scenario.clone();
+                scenario.method = setting.choice;
+                scenario.accuracy = setting.accuracy;
+                let mut best = f64::INFINITY;
+                let mut outcome: Option<std::result::Result<Outcome, String>> = None;
+                for _ in 0..self.repeats {
+                    let t0 = Instant::now();
+                    let result = simulate(&scenario, &mut ()).map_err(|e| e.to_string());
+                    best = best.min(t0.elapsed().as_secs_f64() * 1e3);
+                    let failed = result.is_err();
+                    outcome = Some(result);
+                    if failed {
+                        break;
+                    }
+                }
+                if let Some(o) = outcome {
+                    rows.push(index, name, setting, e_ref, best, &o, &scenario);
+                }
+            }
+        }
+        Ok(Output {
+            frame: rows.into_columns().into_frame()?,
+            summary: json!({
+                "reference": {"method": "dop853", "tolerance": self.reference_tolerance},
+                "references": references,
+                "repeats": self.repeats,
+                "machine": machine(),
+                "runs": self.scenes.len() * self.settings.len() * self.repeats,
+            }),
+        })
+    }
+}
+
+/// CPU model and core count, for the record.
+fn machine() -> serde_json::Value {
+    let cpu = std::fs::read_to_string(Path::new("/proc/cpuinfo"))
+        .ok()
+        .and_then(|text| {
+            text.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|s| s.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    json!({"cpu": cpu, "cores": cores})
+}
+
+/// log10 of a positive number, floored at 1e-16 (an exact match would be minus infinity).
+fn log10_floor(x: f64) -> f64 {
+    x.max(1e-16).log10()
+}
+
+#[derive(Default)]
+struct Rows {
+    scene: Vec<Option<i64>>,
+    scene_name: Vec<Option<String>>,
+    method: Vec<Option<String>>,
+    method_index: Vec<Option<i64>>,
+    dt: Vec<Option<f64>>,
+    tolerance: Vec<Option<f64>>,
+    e_tr: Vec<Option<f64>>,
+    error: Vec<Option<f64>>,
+    log10_error: Vec<Option<f64>>,
+    energy_drift: Vec<Option<f64>>,
+    log10_energy_drift: Vec<Option<f64>>,
+    steps: Vec<Option<i64>>,
+    rhs_evals: Vec<Option<i64>>,
+    wall_ms: Vec<Option<f64>>,
+    log10_wall_ms: Vec<Option<f64>>,
+    failure: Vec<Option<String>>,
+}
+
+impl Rows {
+    #[allow(clippy::too_many_arguments)]
+    fn push(
+        &mut self,
+        scene: usize,
+        name: &str,
+        setting: &Setting,
+        e_ref: f64,
+        wall_ms: f64,
+        outcome: &std::result::Result<Outcome, String>,
+        scenario: &woodpile_sim::run::Scenario,
+    ) {
+        self.scene.push(Some(scene as i64));
+        self.scene_name.push(Some(name.to_string()));
+        self.method.push(Some(setting.method.clone()));
+        self.method_index.push(Some(setting.method_index as i64));
+        self.dt.push(setting.accuracy.dt);
+        self.tolerance.push(
+            setting
+                .accuracy
+                .dt
+                .is_none()
+                .then_some(setting.accuracy.tolerance),
+        );
+        match outcome {
+            Ok(o) => {
+                let error = (o.fractions.trapped - e_ref).abs();
+                let drift =
+                    (!scenario.model.is_time_dependent()).then_some(o.stats.max_energy_drift);
+                self.e_tr.push(Some(o.fractions.trapped));
+                self.error.push(Some(error));
+                self.log10_error.push(Some(log10_floor(error)));
+                self.energy_drift.push(drift);
+                self.log10_energy_drift.push(drift.map(log10_floor));
+                self.steps.push(Some(o.stats.steps as i64));
+                self.rhs_evals.push(Some(o.total_rhs_evals as i64));
+                self.wall_ms.push(Some(wall_ms));
+                self.log10_wall_ms.push(Some(wall_ms.log10()));
+                self.failure.push(None);
+            }
+            Err(reason) => {
+                for column in [
+                    &mut self.e_tr,
+                    &mut self.error,
+                    &mut self.log10_error,
+                    &mut self.energy_drift,
+                    &mut self.log10_energy_drift,
+                    &mut self.wall_ms,
+                    &mut self.log10_wall_ms,
+                ] {
+                    column.push(None);
+                }
+                self.steps.push(None);
+                self.rhs_evals.push(None);
+                self.failure.push(Some(reason.clone()));
+            }
+        }
+    }
+
+    fn into_columns(self) -> Columns {
+        let mut c = Columns::new();
+        c.i64("scene", self.scene)
+            .str("scene_name", self.scene_name)
+            .str("method", self.method)
+            .i64("method_index", self.method_index)
+            .f64("dt", self.dt)
+            .f64("tolerance", self.tolerance)
+            .f64("E_tr", self.e_tr)
+            .f64("error", self.error)
+            .f64("log10_error", self.log10_error)
+            .f64("energy_drift", self.energy_drift)
+            .f64("log10_energy_drift", self.log10_energy_drift)
+            .i64("steps", self.steps)
+            .i64("rhs_evals", self.rhs_evals)
+            .f64("wall_ms", self.wall_ms)
+            .f64("log10_wall_ms", self.log10_wall_ms)
+            .str("failure", self.failure);
+        c
+    }
+}
