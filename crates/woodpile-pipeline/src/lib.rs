@@ -40,6 +40,7 @@ pub mod run;
 pub mod shard;
 pub mod slurm;
 pub mod spacetime;
+pub mod stability;
 pub mod stage;
 pub mod status;
 pub mod sweep;

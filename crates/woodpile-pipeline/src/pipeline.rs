@@ -187,7 +187,7 @@ fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
     let kind_of = |name: &str| &by_name[name].spec;
     let error = |key: &str, reason: String| Err(definition_error(stage, key, reason));
     match &stage.spec {
-        Spec::Sweep(_) | Spec::SpaceTime(_) | Spec::WorkPrecision(_) => {
+        Spec::Sweep(_) | Spec::SpaceTime(_) | Spec::WorkPrecision(_) | Spec::Stability(_) => {
             match stage.inputs.is_empty() {
                 true => Ok(()),
                 false => error(

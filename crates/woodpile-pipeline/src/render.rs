@@ -14,7 +14,8 @@
 //! y_label = "energy fraction at t = 150"
 //! ```
 //!
-//! An optional `where = { column = value }` draws only the matching rows. In `[lines]`,
+//! An optional `where = { column = value }` draws only the matching rows, and
+//! `panel_label = "column"` titles each panel by that string column instead of `panel = value`. In `[lines]`,
 //! `series = "column"` draws one curve of the single `y` per value of that column, named by
 //! the string column `series_label` when given (work-precision charts: one curve per method).
 //! `[heatmap]` takes `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`,
@@ -36,6 +37,8 @@ use crate::Output;
 pub struct Render {
     /// Figure title.
     pub title: String,
+    /// String column whose value titles each panel (instead of `column = value`).
+    pub panel_label: Option<String>,
     /// Panels per row.
     pub columns: usize,
     /// Row filter: draw only rows where these columns equal these values.
@@ -93,6 +96,7 @@ impl Render {
             return Err(fields.error("columns", "expected 1 to 8 panels per row"));
         }
         let filter = fields.equality_filter("where")?;
+        let panel_label = fields.optional::<String>("panel_label")?;
         let lines = fields.optional::<toml::Table>("lines")?;
         let heat = fields.optional::<toml::Table>("heatmap")?;
         let plot = match (lines, heat) {
@@ -159,6 +163,7 @@ impl Render {
         };
         Ok(Render {
             title,
+            panel_label,
             columns: columns as usize,
             filter,
             plot,
@@ -223,10 +228,24 @@ impl Render {
                 .filter(|&r| panel_values[r] == Some(key))
                 .collect()
         };
+        let panel_labels: Option<Vec<Option<String>>> = match &self.panel_label {
+            Some(l) => {
+                let all = str_column(input, l).map_err(fail)?;
+                Some(keep.iter().map(|&r| all[r].clone()).collect())
+            }
+            None => None,
+        };
         let title_of = |key: f64| {
-            panel_name
-                .map(|p| format!("{p} = {key}"))
-                .unwrap_or_default()
+            let labelled = panel_labels.as_ref().and_then(|labels| {
+                (0..height)
+                    .find(|&r| panel_values[r] == Some(key))
+                    .and_then(|r| labels[r].clone())
+            });
+            labelled.unwrap_or_else(|| {
+                panel_name
+                    .map(|p| format!("{p} = {key}"))
+                    .unwrap_or_default()
+            })
         };
         let panels: Vec<Panel> = keys
             .iter()

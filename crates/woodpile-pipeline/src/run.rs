@@ -143,6 +143,7 @@ fn execute(
         }
         Spec::Report(report) => report.run(&stage.name, results)?,
         Spec::WorkPrecision(wp) => wp.run(&stage.name)?,
+        Spec::Stability(map) => map.run(&stage.name)?,
     };
     let manifest = manifest_for(pipeline, stage, output.summary.clone());
     let rows = output.frame.height();

@@ -23,6 +23,7 @@ use crate::reduce::Reduce;
 use crate::render::Render;
 use crate::report::Report;
 use crate::spacetime::SpaceTime;
+use crate::stability::Stability;
 use crate::sweep::Sweep;
 use crate::workprecision::WorkPrecision;
 
@@ -36,6 +37,7 @@ pub const KINDS: &[&str] = &[
     "render",
     "report",
     "workprecision",
+    "stability",
 ];
 
 /// What a stage does, with its kind-specific parameters.
@@ -59,6 +61,8 @@ pub enum Spec {
     Report(Report),
     /// Speed against accuracy for every method on a few scenes.
     WorkPrecision(WorkPrecision),
+    /// Where each fixed-step method blows up or misses the tolerance.
+    Stability(Stability),
 }
 
 impl Spec {
@@ -74,6 +78,7 @@ impl Spec {
             Spec::Render(_) => "render",
             Spec::Report(_) => "report",
             Spec::WorkPrecision(_) => "workprecision",
+            Spec::Stability(_) => "stability",
         }
     }
 }
@@ -130,6 +135,7 @@ impl Stage {
             "render" => Spec::Render(Render::parse(&mut fields)?),
             "report" => Spec::Report(Report::parse(&mut fields)?),
             "workprecision" => Spec::WorkPrecision(WorkPrecision::parse(&mut fields)?),
+            "stability" => Spec::Stability(Stability::parse(&mut fields)?),
             other => {
                 return Err(fields.error(
                     "kind",

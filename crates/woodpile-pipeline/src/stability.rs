@@ -1,0 +1,334 @@
+//! `kind = "stability"`: where each fixed-step method fails. For every method, step and value
+//! of one defect parameter (eps or p), a run of the scene is classified: 0 it meets the
+//! tolerance on E_tr, 1 it runs but misses it, 2 it is unstable (non-finite state, or the
+//! energy drifts by more than 100%). The runs have no drift guard, so an inaccurate but stable
+//! step is told apart from an unstable one.
+//!
+//! ```toml
+//! kind = "stability"
+//! tolerance = 1e-6                  # |ΔE_tr| allowed, against `auto` at tolerance / 100
+//! methods = ["rk4", "verlet", "yoshida4", "yoshida6"]
+//! vary = "eps"                      # the first defect's eps, or "p"
+//! values = [0.01, 0.1, 1.0, 10.0]
+//! step = "dt_omega"                 # steps given as dt·ω (ω² = kappa (1 + 1/eps)), or "dt"
+//! steps = [0.5, 1.0, 2.0, 3.0]
+//! [scene]                           # a scene file; its first defect is varied
+//! defect = [{ site = 0, eps = 1.0 }]
+//! ```
+//!
+//! With `step = "dt_omega"` the linear stability bound of each method (dt·ω = 2√2 for RK4, 2 for
+//! Verlet, ...) is a vertical line on the map, and `auto`'s largest step (dt·ω = 0.5, never above
+//! 0.9 of the bound) can be read off against it. Output: one row per run with the method, the
+//! value (and its log10), the requested `step` (the map's grid), the step dt actually taken
+//! (t_end tiled by equal steps, within 1% of the request) and its dt·ω, the method's linear
+//! bound as a dt, `auto`'s first step, the status, the error and the failure's reason.
+
+use rayon::prelude::*;
+use serde_json::json;
+use woodpile_scene::SceneError;
+use woodpile_sim::energy::{energy_density, Fractions};
+use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
+use woodpile_sim::run::{simulate, Scenario};
+
+use crate::error::{PipelineError, Result};
+use crate::fields::Fields;
+use crate::table::Columns;
+use crate::Output;
+
+/// The defect parameter a stability map varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Vary {
+    /// The mass ratio of the first defect.
+    Eps,
+    /// The coupling exponent of the first defect.
+    P,
+}
+
+/// A parsed stability stage.
+#[derive(Debug, Clone)]
+pub struct Stability {
+    /// |ΔE_tr| allowed.
+    pub tolerance: f64,
+    /// The fixed-step methods.
+    pub methods: Vec<Method>,
+    /// What is varied.
+    pub vary: Vary,
+    /// Its values.
+    pub values: Vec<f64>,
+    /// Steps as dt·ω (true) or dt (false).
+    pub steps_are_dt_omega: bool,
+    /// The steps.
+    pub steps: Vec<f64>,
+    scene: toml::Table,
+    file: std::path::PathBuf,
+}
+
+impl Stability {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Stability> {
+        let tolerance: f64 = fields.required("tolerance")?;
+        if !(tolerance > 0.0) {
+            return Err(fields.error("tolerance", "must be > 0"));
+        }
+        let names: Vec<String> = fields.required("methods")?;
+        let mut methods = Vec::new();
+        for name in names {
+            match Method::from_name(&name) {
+                Some(m) if !m.is_adaptive() => methods.push(m),
+                _ => {
+                    return Err(fields.error(
+                        "methods",
+                        format!(
+                            "`{name}` is not a fixed-step method (rk4, verlet, yoshida4, yoshida6)"
+                        ),
+                    ))
+                }
+            }
+        }
+        let vary = match fields.required::<String>("vary")?.as_str() {
+            "eps" => Vary::Eps,
+            "p" => Vary::P,
+            other => {
+                return Err(fields.error(
+                    "vary",
+                    format!("expected \"eps\" or \"p\", got \"{other}\""),
+                ))
+            }
+        };
+        let values: Vec<f64> = fields.required("values")?;
+        let steps_are_dt_omega = match fields.required::<String>("step")?.as_str() {
+            "dt_omega" => true,
+            "dt" => false,
+            other => {
+                return Err(fields.error(
+                    "step",
+                    format!("expected \"dt_omega\" or \"dt\", got \"{other}\""),
+                ))
+            }
+        };
+        let steps: Vec<f64> = fields.required("steps")?;
+        if values.is_empty() || steps.is_empty() || steps.iter().any(|s| !(*s > 0.0)) {
+            return Err(fields.error("steps", "expected non-empty `values` and positive `steps`"));
+        }
+        let scene: toml::Table = fields.required("scene")?;
+        let stage = Stability {
+            tolerance,
+            methods,
+            vary,
+            values,
+            steps_are_dt_omega,
+            steps,
+            scene,
+            file: fields.file().to_path_buf(),
+        };
+        for &v in &stage.values {
+            stage.scene_at(v)?;
+        }
+        Ok(stage)
+    }
+
+    /// The scene with the first defect's parameter set to `value`.
+    fn scene_at(&self, value: f64) -> Result<woodpile_scene::Scene> {
+        let mut table = self.scene.clone();
+        let invalid = |key: &str, reason: String| PipelineError::Definition {
+            file: self.file.clone(),
+            key: key.to_string(),
+            reason,
+        };
+        let defect = table
+            .get_mut("defect")
+            .and_then(|d| d.as_array_mut())
+            .and_then(|a| a.first_mut())
+            .and_then(|d| d.as_table_mut())
+            .ok_or_else(|| {
+                invalid(
+                    "scene.defect",
+                    "the scene needs a first [[defect]] to vary".into(),
+                )
+            })?;
+        match self.vary {
+            Vary::Eps => defect.insert("eps".into(), toml::Value::Float(value)),
+            Vary::P => defect.insert("p".into(), toml::Value::Integer(value as i64)),
+        };
+        woodpile_scene::from_table(table, &self.file).map_err(|e| match e {
+            SceneError::Invalid { key, reason, .. } => {
+                invalid(&format!("scene.{key}"), format!("{reason} (at {value})"))
+            }
+            SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
+                invalid("scene", reason)
+            }
+        })
+    }
+
+    pub(crate) fn run(&self, stage: &str) -> Result<Output> {
+        // One reference per value: `auto` a hundred times tighter than the tolerance.
+        let references: Vec<(woodpile_scene::Scene, f64)> = self
+            .values
+            .par_iter()
+            .map(|&v| {
+                let scene = self.scene_at(v)?;
+                let mut reference = scene.scenario.clone();
+                reference.method = MethodChoice::Auto;
+                reference.accuracy = Accuracy {
+                    tolerance: self.tolerance / 100.0,
+                    tolerance_explicit: true,
+                    dt: None,
+                };
+                let e_ref = simulate(&reference, &mut ())
+                    .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
+                    .fractions
+                    .trapped;
+                Ok((scene, e_ref))
+            })
+            .collect::<Result<_>>()?;
+        let jobs: Vec<(usize, usize, usize)> = (0..self.values.len())
+            .flat_map(|v| {
+                (0..self.methods.len())
+                    .flat_map(move |m| (0..self.steps.len()).map(move |s| (v, m, s)))
+            })
+            .collect();
+        let runs: Vec<Run> = jobs
+            .par_iter()
+            .map(|&(v, m, s)| {
+                let (scene, e_ref) = &references[v];
+                let method = self.methods[m];
+                let omega = scene.scenario.model.max_linear_omega();
+                let requested = if self.steps_are_dt_omega {
+                    self.steps[s] / omega
+                } else {
+                    self.steps[s]
+                };
+                // The step the driver takes: t_end tiled by equal steps no longer than requested.
+                let t_end = scene.scenario.t_end;
+                let dt = t_end / (t_end / requested - 1e-9).ceil().max(1.0);
+                let auto_dt = Plan::dt_for(&scene.scenario.model, Method::Rk4, self.tolerance);
+                let (status, error, failure) =
+                    classify(&scene.scenario, method, dt, *e_ref, self.tolerance);
+                Run {
+                    method: method.name(),
+                    method_index: m as i64,
+                    value: self.values[v],
+                    dt,
+                    step: self.steps[s],
+                    dt_omega: (omega > 0.0).then_some(dt * omega),
+                    bound: (omega > 0.0).then_some(method.stability_limit() / omega),
+                    auto_dt,
+                    status,
+                    error,
+                    failure,
+                }
+            })
+            .collect();
+        let counts = |k: i64| runs.iter().filter(|r| r.status == k).count();
+        // `auto` runs RK4 at `auto_dt` or shorter: none of those steps may be unstable here.
+        let auto_unstable = runs
+            .iter()
+            .filter(|r| r.method == "rk4" && r.status == 2 && r.dt <= r.auto_dt)
+            .count();
+        let summary = json!({
+            "runs": runs.len(),
+            "meet_tolerance": counts(0),
+            "miss_tolerance": counts(1),
+            "fail": counts(2),
+            "unstable_at_or_below_auto_step": auto_unstable,
+            "tolerance": self.tolerance,
+            "reference": {"method": "auto", "tolerance": self.tolerance / 100.0},
+        });
+        let name = match self.vary {
+            Vary::Eps => "eps",
+            Vary::P => "p",
+        };
+        let mut c = Columns::new();
+        c.str(
+            "method",
+            runs.iter().map(|r| Some(r.method.to_string())).collect(),
+        )
+        .i64(
+            "method_index",
+            runs.iter().map(|r| Some(r.method_index)).collect(),
+        )
+        .f64(name, runs.iter().map(|r| Some(r.value)).collect())
+        .f64(
+            &format!("log10_{name}"),
+            runs.iter().map(|r| Some(r.value.log10())).collect(),
+        )
+        .f64("step", runs.iter().map(|r| Some(r.step)).collect())
+        .f64(
+            "log10_step",
+            runs.iter().map(|r| Some(r.step.log10())).collect(),
+        )
+        .f64("dt", runs.iter().map(|r| Some(r.dt)).collect())
+        .f64("dt_omega", runs.iter().map(|r| r.dt_omega).collect())
+        .f64("linear_bound_dt", runs.iter().map(|r| r.bound).collect())
+        .f64("auto_dt", runs.iter().map(|r| Some(r.auto_dt)).collect())
+        .i64("status", runs.iter().map(|r| Some(r.status)).collect())
+        .f64("error", runs.iter().map(|r| r.error).collect())
+        .str("failure", runs.iter().map(|r| r.failure.clone()).collect());
+        Ok(Output {
+            frame: c.into_frame()?,
+            summary,
+        })
+    }
+}
+
+/// Runs `method` at step `dt` with no drift guard and classifies it: 2 if the state becomes
+/// non-finite or the energy drifts by more than 100% (the method is unstable), 1 if it runs but
+/// misses `tolerance` on E_tr, 0 if it meets it.
+fn classify(
+    scenario: &Scenario,
+    method: Method,
+    dt: f64,
+    e_ref: f64,
+    tolerance: f64,
+) -> (i64, Option<f64>, Option<String>) {
+    let accuracy = Accuracy {
+        tolerance,
+        tolerance_explicit: false,
+        dt: Some(dt),
+    };
+    let model = &scenario.model;
+    let mut plan = match Plan::choose(model, MethodChoice::Named(method), accuracy) {
+        Ok(plan) => plan,
+        Err(e) => return (2, None, Some(e.to_string())),
+    };
+    plan.drift_limit = f64::INFINITY;
+    let mut y = model.rest_state();
+    if let Err(e) = model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity) {
+        return (2, None, Some(e.to_string()));
+    }
+    // One sample interval: the driver tiles each interval with equal steps no longer than dt,
+    // so a single interval keeps the step within 1% of dt (shorter intervals would shrink it).
+    let sampled = (scenario.t_end, scenario.t_end);
+    match plan.run_model(model, &mut y, sampled, &mut (), true) {
+        Err(e) => (2, None, Some(e.to_string())),
+        Ok(stats) if !(stats.max_energy_drift <= 1.0) => (
+            2,
+            None,
+            Some(format!(
+                "energy drift {:.3e}: unstable",
+                stats.max_energy_drift
+            )),
+        ),
+        Ok(_) => {
+            let mut density = vec![0.0; model.n_sites()];
+            energy_density(model, scenario.t_end, &y, &mut density);
+            let e_tr = Fractions::from_density(&density, scenario.region).trapped;
+            let error = (e_tr - e_ref).abs();
+            (i64::from(!(error <= tolerance)), Some(error), None)
+        }
+    }
+}
+
+struct Run {
+    /// The requested step (dt·ω or dt), exactly as listed: the map's grid.
+    step: f64,
+    method: &'static str,
+    method_index: i64,
+    value: f64,
+    dt: f64,
+    dt_omega: Option<f64>,
+    bound: Option<f64>,
+    auto_dt: f64,
+    status: i64,
+    error: Option<f64>,
+    failure: Option<String>,
+}
