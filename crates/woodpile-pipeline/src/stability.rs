@@ -23,6 +23,9 @@
 //! (t_end tiled by equal steps, within 1% of the request) and its dt·ω, the method's linear
 //! bound as a dt, `auto`'s first step, the status, the error and the failure's reason.
 
+// Comparisons are written `!(x > 0.0)` on purpose: a NaN must fail them.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use rayon::prelude::*;
 use serde_json::json;
 use woodpile_scene::SceneError;
