@@ -4,6 +4,7 @@
 
 use woodpile_bench::{fixed, run};
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
+use woodpile_sim::run::run_with_plan;
 use woodpile_sim::testing::fixed_dt;
 
 fn main() {
@@ -26,20 +27,10 @@ fn rk4_dt_0_01_full_chain() -> f64 {
         fixed_dt(0.01),
     )
     .unwrap();
-    let mut y = scene.model.rest_state();
-    scene
-        .model
-        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
-        .unwrap();
-    plan.run_model(
-        &scene.model,
-        &mut y,
-        (scene.t_end, scene.sample_every),
-        &mut (),
-        false,
-    )
-    .unwrap();
-    y[0]
+    run_with_plan(&scene, &plan, &mut (), false)
+        .unwrap()
+        .fractions
+        .trapped
 }
 
 /// RK4 at dt = 0.02 (|ΔE_tr| = 6.4e-8): the cheapest RK4 within 1e-7.

@@ -16,7 +16,7 @@ use std::time::Instant;
 use serde_json::Value;
 use woodpile_bench::{fixed, run};
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::run::Scenario;
+use woodpile_sim::run::{run_with_plan, Scenario};
 use woodpile_sim::testing::fixed_dt;
 
 struct Row {
@@ -42,27 +42,9 @@ fn trapped(scene: &Scenario) -> f64 {
 }
 
 fn full_chain(scene: &Scenario, method: Method, dt: f64) -> f64 {
-    let Ok(plan) = Plan::choose(&scene.model, MethodChoice::Named(method), fixed_dt(dt)) else {
-        return f64::NAN;
-    };
-    let mut y = scene.model.rest_state();
-    if scene
-        .model
-        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
-        .is_err()
-    {
-        return f64::NAN;
-    }
-    let sampled = (scene.t_end, scene.sample_every);
-    if plan
-        .run_model(&scene.model, &mut y, sampled, &mut (), false)
-        .is_err()
-    {
-        return f64::NAN;
-    }
-    let mut density = vec![0.0; scene.model.n_sites()];
-    woodpile_sim::energy::energy_density(&scene.model, scene.t_end, &y, &mut density);
-    woodpile_sim::energy::Fractions::from_density(&density, scene.region).trapped
+    Plan::choose(&scene.model, MethodChoice::Named(method), fixed_dt(dt))
+        .and_then(|plan| run_with_plan(scene, &plan, &mut (), false))
+        .map_or(f64::NAN, |o| o.fractions.trapped)
 }
 
 /// Runs a baseline command that prints one JSON line with `E_tr` and `ms`.

@@ -29,9 +29,8 @@
 use rayon::prelude::*;
 use serde_json::json;
 use woodpile_scene::SceneError;
-use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::run::{run_with_plan, simulate, Scenario};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
@@ -288,34 +287,29 @@ fn classify(
         tolerance_explicit: false,
         dt: Some(dt),
     };
-    let model = &scenario.model;
-    let mut plan = match Plan::choose(model, MethodChoice::Named(method), accuracy) {
+    let mut plan = match Plan::choose(&scenario.model, MethodChoice::Named(method), accuracy) {
         Ok(plan) => plan,
         Err(e) => return (2, None, Some(e.to_string())),
     };
     plan.drift_limit = f64::INFINITY;
-    let mut y = model.rest_state();
-    if let Err(e) = model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity) {
-        return (2, None, Some(e.to_string()));
-    }
     // One sample interval: the driver tiles each interval with equal steps no longer than dt,
     // so a single interval keeps the step within 1% of dt (shorter intervals would shrink it).
-    let sampled = (scenario.t_end, scenario.t_end);
-    match plan.run_model(model, &mut y, sampled, &mut (), true) {
+    let one_interval = Scenario {
+        sample_every: scenario.t_end,
+        ..scenario.clone()
+    };
+    match run_with_plan(&one_interval, &plan, &mut (), true) {
         Err(e) => (2, None, Some(e.to_string())),
-        Ok(stats) if !(stats.max_energy_drift <= 1.0) => (
+        Ok(o) if !(o.stats.max_energy_drift <= 1.0) => (
             2,
             None,
             Some(format!(
                 "energy drift {:.3e}: unstable",
-                stats.max_energy_drift
+                o.stats.max_energy_drift
             )),
         ),
-        Ok(_) => {
-            let mut density = vec![0.0; model.n_sites()];
-            energy_density(model, scenario.t_end, &y, &mut density);
-            let e_tr = Fractions::from_density(&density, scenario.region).trapped;
-            let error = (e_tr - e_ref).abs();
+        Ok(o) => {
+            let error = (o.fractions.trapped - e_ref).abs();
             (i64::from(!(error <= tolerance)), Some(error), None)
         }
     }

@@ -31,9 +31,8 @@ use std::time::Instant;
 
 use serde_json::json;
 use woodpile_scene::{Scene, SceneError};
-use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
-use woodpile_sim::run::{simulate, Outcome, Scenario};
+use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
@@ -216,35 +215,21 @@ fn reference(
     scenario: &Scenario,
     tolerance: f64,
 ) -> std::result::Result<(f64, Option<f64>), String> {
-    let model = &scenario.model;
     let accuracy = Accuracy {
         tolerance,
         tolerance_explicit: true,
         dt: None,
     };
-    let mut plan = Plan::choose(model, MethodChoice::Named(Method::Dop853), accuracy)
-        .map_err(|e| e.to_string())?;
+    let mut plan = Plan::choose(
+        &scenario.model,
+        MethodChoice::Named(Method::Dop853),
+        accuracy,
+    )
+    .map_err(|e| e.to_string())?;
     plan.drift_limit = f64::INFINITY;
-    let mut y = model.rest_state();
-    model
-        .apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)
-        .map_err(|e| e.to_string())?;
-    let stats = plan
-        .run_model(
-            model,
-            &mut y,
-            (scenario.t_end, scenario.sample_every),
-            &mut (),
-            true,
-        )
-        .map_err(|e| e.to_string())?;
-    let mut density = vec![0.0; model.n_sites()];
-    energy_density(model, scenario.t_end, &y, &mut density);
-    let drift = (!model.is_time_dependent()).then_some(stats.max_energy_drift);
-    Ok((
-        Fractions::from_density(&density, scenario.region).trapped,
-        drift,
-    ))
+    let outcome = run_with_plan(scenario, &plan, &mut (), true).map_err(|e| e.to_string())?;
+    let drift = (!scenario.model.is_time_dependent()).then_some(outcome.stats.max_energy_drift);
+    Ok((outcome.fractions.trapped, drift))
 }
 
 /// CPU model and core count, for the record.

@@ -148,16 +148,28 @@ fn run_plan<O: Observer + ?Sized>(
     plan: &Plan,
     observer: &mut O,
 ) -> Result<Outcome, SimError> {
+    run_with_plan(scenario, plan, observer, true)
+}
+
+/// Runs `scenario` with an explicit `plan` (no `auto` ladder): for tools that adjust a plan
+/// themselves, such as a reference run without a drift bound or a stability probe.
+/// `active_window = false` works on the full chain every step (same bits, more work).
+pub fn run_with_plan<O: Observer + ?Sized>(
+    scenario: &Scenario,
+    plan: &Plan,
+    observer: &mut O,
+    active_window: bool,
+) -> Result<Outcome, SimError> {
     let model: &Model = &scenario.model;
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)?;
     let e_initial = crate::energy::total_energy(model, 0.0, &y);
-    let stats = plan.run(
+    let stats = plan.run_model(
         model,
         &mut y,
-        scenario.t_end,
-        scenario.sample_every,
+        (scenario.t_end, scenario.sample_every),
         observer,
+        active_window,
     )?;
     let mut density = vec![0.0; model.n_sites()];
     energy_density(model, scenario.t_end, &y, &mut density);
