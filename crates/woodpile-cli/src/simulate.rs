@@ -74,12 +74,7 @@ fn report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
             "time_scale_s": p.scales.time_s(),
             "velocity_scale_m_per_s": p.scales.velocity,
             "t_end_s": scene.scenario.t_end * p.scales.time_s(),
-            "defects": p.defects.iter().map(|d| json!({
-                "site": d.site,
-                "host_mass_ratio": d.host_mass_ratio,
-                "eps": d.eps,
-                "kappa": d.kappa,
-            })).collect::<Vec<_>>(),
+            "defects": p.defects,
         });
     }
     report

@@ -1,6 +1,8 @@
 //! Everything that can stop the pipeline, each naming the file (and key) it concerns.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use woodpile_scene::SceneError;
 
 /// A pipeline failure.
 #[derive(Debug, thiserror::Error)]
@@ -56,6 +58,23 @@ impl PipelineError {
         Self::Io {
             path: path.into(),
             reason: e.to_string(),
+        }
+    }
+
+    /// A scene embedded in stage `file` under key `prefix` (`scene`, `scene[2]`) that
+    /// woodpile-scene rejects: the scene's own key is appended to the prefix, and `context`
+    /// (say, the grid point) to the reason. One mapping for every kind that embeds scenes.
+    pub fn scene(file: &Path, prefix: &str, e: SceneError, context: &str) -> Self {
+        let (key, reason) = match e {
+            SceneError::Invalid { key, reason, .. } => (format!("{prefix}.{key}"), reason),
+            SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
+                (prefix.to_string(), reason)
+            }
+        };
+        Self::Definition {
+            file: file.to_path_buf(),
+            key,
+            reason: reason + context,
         }
     }
 

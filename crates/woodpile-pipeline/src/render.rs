@@ -188,6 +188,12 @@ impl Render {
             let values = all(name)?;
             Ok(keep.iter().map(|&r| values[r]).collect())
         };
+        // An optional string column (curve or panel names), on the kept rows.
+        let text_column = |name: Option<&String>| -> Result<Option<Vec<Option<String>>>> {
+            let Some(name) = name else { return Ok(None) };
+            let values = str_column(input, name).map_err(fail)?;
+            Ok(Some(keep.iter().map(|&r| values[r].clone()).collect()))
+        };
         let (panel_name, mut used): (Option<&String>, Vec<&String>) = match &self.plot {
             Plot::Lines {
                 x,
@@ -211,15 +217,9 @@ impl Render {
         keys.sort_by(f64::total_cmp);
         keys.dedup();
         let data: Vec<Vec<Option<f64>>> = used.iter().map(|c| column(c)).collect::<Result<_>>()?;
-        let labels: Option<Vec<Option<String>>> = match &self.plot {
-            Plot::Lines {
-                series_label: Some(l),
-                ..
-            } => {
-                let all = str_column(input, l).map_err(fail)?;
-                Some(keep.iter().map(|&r| all[r].clone()).collect())
-            }
-            _ => None,
+        let labels = match &self.plot {
+            Plot::Lines { series_label, .. } => text_column(series_label.as_ref())?,
+            Plot::Heatmap { .. } => None,
         };
         let panel_values = &panel_values;
         let height = keep.len();
@@ -228,13 +228,7 @@ impl Render {
                 .filter(|&r| panel_values[r] == Some(key))
                 .collect()
         };
-        let panel_labels: Option<Vec<Option<String>>> = match &self.panel_label {
-            Some(l) => {
-                let all = str_column(input, l).map_err(fail)?;
-                Some(keep.iter().map(|&r| all[r].clone()).collect())
-            }
-            None => None,
-        };
+        let panel_labels = text_column(self.panel_label.as_ref())?;
         let title_of = |key: f64| {
             let labelled = panel_labels.as_ref().and_then(|labels| {
                 (0..height)

@@ -40,7 +40,8 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::table::{self, f64_column, str_column, Columns};
+use crate::status::output_path;
+use crate::table::{self, f64_column, matching_rows, str_column, Columns};
 use crate::Output;
 
 /// A parsed report stage.
@@ -399,7 +400,7 @@ struct Reader<'a> {
 impl Reader<'_> {
     fn frame(&mut self, stage: &str) -> Result<&DataFrame> {
         if !self.frames.contains_key(stage) {
-            let frame = table::read(&self.results.join(format!("{stage}.parquet")))?;
+            let frame = table::read(&output_path(self.results, stage))?;
             self.frames.insert(stage.to_string(), frame);
         }
         Ok(&self.frames[stage])
@@ -409,9 +410,8 @@ impl Reader<'_> {
         let fail = |reason: String| PipelineError::stage(&source.stage, reason);
         let column = match &source.read {
             Read::Manifest(pointer) => {
-                let path = self.results.join(format!("{}.parquet", source.stage));
-                let manifest =
-                    table::read_manifest(&path)?.ok_or_else(|| fail("no manifest".into()))?;
+                let manifest = table::read_manifest(&output_path(self.results, &source.stage))?
+                    .ok_or_else(|| fail("no manifest".into()))?;
                 let value = serde_json::to_value(&manifest)
                     .ok()
                     .and_then(|v| v.pointer(pointer).and_then(|x| x.as_f64()))
@@ -573,25 +573,24 @@ impl Reader<'_> {
     }
 }
 
+/// The rows where every equality holds: the numeric ones by [`matching_rows`] (the filter of
+/// fit and render), then the string ones.
 fn filtered_rows(frame: &DataFrame, filter: &[(String, Match)]) -> Result<Vec<usize>> {
-    let mut keep: Vec<bool> = vec![true; frame.height()];
+    let numeric: Vec<(String, f64)> = filter
+        .iter()
+        .filter_map(|(c, m)| match m {
+            Match::Number(x) => Some((c.clone(), *x)),
+            Match::Text(_) => None,
+        })
+        .collect();
+    let mut rows = matching_rows(frame, &numeric)?;
     for (column, m) in filter {
-        match m {
-            Match::Number(x) => {
-                let values = f64_column(frame, column)?;
-                for (k, v) in keep.iter_mut().zip(values) {
-                    *k &= v == Some(*x);
-                }
-            }
-            Match::Text(s) => {
-                let values = str_column(frame, column)?;
-                for (k, v) in keep.iter_mut().zip(values) {
-                    *k &= v.as_deref() == Some(s.as_str());
-                }
-            }
+        if let Match::Text(text) = m {
+            let values = str_column(frame, column)?;
+            rows.retain(|&r| values[r].as_deref() == Some(text.as_str()));
         }
     }
-    Ok((0..frame.height()).filter(|&r| keep[r]).collect())
+    Ok(rows)
 }
 
 /// Whether `m` reproduces the paper's number (None for a statement without a range).

@@ -28,7 +28,6 @@
 
 use rayon::prelude::*;
 use serde_json::json;
-use woodpile_scene::SceneError;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::run::{run_with_plan, simulate, Scenario};
 
@@ -131,39 +130,27 @@ impl Stability {
     /// The scene with the first defect's parameter set to `value`.
     fn scene_at(&self, value: f64) -> Result<woodpile_scene::Scene> {
         let mut table = self.scene.clone();
-        let invalid = |key: &str, reason: String| PipelineError::Definition {
-            file: self.file.clone(),
-            key: key.to_string(),
-            reason,
-        };
         let defect = table
             .get_mut("defect")
             .and_then(|d| d.as_array_mut())
             .and_then(|a| a.first_mut())
             .and_then(|d| d.as_table_mut())
-            .ok_or_else(|| {
-                invalid(
-                    "scene.defect",
-                    "the scene needs a first [[defect]] to vary".into(),
-                )
+            .ok_or_else(|| PipelineError::Definition {
+                file: self.file.clone(),
+                key: "scene.defect".into(),
+                reason: "the scene needs a first [[defect]] to vary".into(),
             })?;
         match self.vary {
             Vary::Eps => defect.insert("eps".into(), toml::Value::Float(value)),
             Vary::P => defect.insert("p".into(), toml::Value::Integer(value as i64)),
         };
-        woodpile_scene::from_table(table, &self.file).map_err(|e| match e {
-            SceneError::Invalid { key, reason, .. } => {
-                invalid(&format!("scene.{key}"), format!("{reason} (at {value})"))
-            }
-            SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
-                invalid("scene", reason)
-            }
-        })
+        woodpile_scene::from_table(table, &self.file)
+            .map_err(|e| PipelineError::scene(&self.file, "scene", e, &format!(" (at {value})")))
     }
 
     pub(crate) fn run(&self, stage: &str) -> Result<Output> {
         // One reference per value: `auto` a hundred times tighter than the tolerance.
-        let references: Vec<(woodpile_scene::Scene, f64)> = self
+        let references: Vec<(woodpile_scene::Scene, f64, f64)> = self
             .values
             .par_iter()
             .map(|&v| {
@@ -179,7 +166,8 @@ impl Stability {
                     .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
                     .fractions
                     .trapped;
-                Ok((scene, e_ref))
+                let auto_dt = Plan::dt_for(&scene.scenario.model, Method::Rk4, self.tolerance);
+                Ok((scene, e_ref, auto_dt))
             })
             .collect::<Result<_>>()?;
         let jobs: Vec<(usize, usize, usize)> = (0..self.values.len())
@@ -191,7 +179,7 @@ impl Stability {
         let runs: Vec<Run> = jobs
             .par_iter()
             .map(|&(v, m, s)| {
-                let (scene, e_ref) = &references[v];
+                let (scene, e_ref, auto_dt) = &references[v];
                 let method = self.methods[m];
                 let omega = scene.scenario.model.max_linear_omega();
                 let requested = if self.steps_are_dt_omega {
@@ -202,7 +190,6 @@ impl Stability {
                 // The step the driver takes: t_end tiled by equal steps no longer than requested.
                 let t_end = scene.scenario.t_end;
                 let dt = t_end / (t_end / requested - 1e-9).ceil().max(1.0);
-                let auto_dt = Plan::dt_for(&scene.scenario.model, Method::Rk4, self.tolerance);
                 let (status, error, failure) =
                     classify(&scene.scenario, method, dt, *e_ref, self.tolerance);
                 Run {
@@ -213,7 +200,7 @@ impl Stability {
                     step: self.steps[s],
                     dt_omega: (omega > 0.0).then_some(dt * omega),
                     bound: (omega > 0.0).then_some(method.stability_limit() / omega),
-                    auto_dt,
+                    auto_dt: *auto_dt,
                     status,
                     error,
                     failure,

@@ -29,7 +29,7 @@ use std::path::{Path, PathBuf};
 use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde_json::{json, Value};
-use woodpile_scene::{Scene, SceneError};
+use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 
 use crate::canonical::{code_version, scene_json, Key};
@@ -128,14 +128,8 @@ impl Sweep {
                 run.insert("tolerance".into(), toml::Value::Float(tol));
             }
         }
-        woodpile_scene::from_table(table, &self.file).map_err(|e| match e {
-            SceneError::Invalid { key, reason, .. } => {
-                self.error(format!("scene.{key}"), reason + &at())
-            }
-            SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
-                self.error("scene".into(), reason + &at())
-            }
-        })
+        woodpile_scene::from_table(table, &self.file)
+            .map_err(|e| PipelineError::scene(&self.file, "scene", e, &at()))
     }
 
     fn error(&self, key: String, reason: String) -> PipelineError {
@@ -277,14 +271,9 @@ impl Sweep {
         let scene = self.scene_at(0)?;
         let physical = scene.physical.as_ref().map(|p| {
             json!({
-                "time_unit_s": p.scales.time_s(),
-                "length_unit_m": p.scales.length_m(),
-                "defects": p.defects.iter().map(|d| json!({
-                    "site": d.site,
-                    "host_mass_ratio": d.host_mass_ratio,
-                    "eps": d.eps,
-                    "kappa": d.kappa,
-                })).collect::<Vec<_>>(),
+                "time_scale_s": p.scales.time_s(),
+                "length_scale_m": p.scales.length_m(),
+                "defects": p.defects,
             })
         });
         let first = scene.scenario;
@@ -356,14 +345,11 @@ impl SweepStats {
 /// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
 /// that energy points keep their keys), the series.
 pub fn point_key(scene: &Scene, series: Series) -> Key {
-    match series {
-        Series::Energy => Key::of(&json!({"scene": scene_json(scene), "code": code_version()})),
-        Series::Kinetic => Key::of(&json!({
-            "scene": scene_json(scene),
-            "code": code_version(),
-            "series": "kinetic",
-        })),
+    let mut key = json!({"scene": scene_json(scene), "code": code_version()});
+    if series == Series::Kinetic {
+        key["series"] = json!("kinetic");
     }
+    Key::of(&key)
 }
 
 /// The per-row columns of a sweep output (everything but the point index and the axes).

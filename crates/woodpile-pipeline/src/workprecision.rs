@@ -30,7 +30,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use serde_json::json;
-use woodpile_scene::{Scene, SceneError};
+use woodpile_scene::Scene;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
 
@@ -91,14 +91,8 @@ impl WorkPrecision {
                 Some(toml::Value::String(s)) => s,
                 _ => return Err(fields.error(&format!("{key}.name"), "expected a string")),
             };
-            let scene = woodpile_scene::from_table(table, &file).map_err(|e| match e {
-                SceneError::Invalid { key: k, reason, .. } => {
-                    fields.error(&format!("{key}.{k}"), reason)
-                }
-                SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
-                    fields.error(&key, reason)
-                }
-            })?;
+            let scene = woodpile_scene::from_table(table, &file)
+                .map_err(|e| PipelineError::scene(&file, &key, e, ""))?;
             scenes.push((name, scene));
         }
         let Some(toml::Value::Array(method_tables)) = fields.take("method") else {

@@ -45,8 +45,9 @@ pub struct Physical {
     pub defects: Vec<DerivedDefect>,
 }
 
-/// Dimensionless parameters derived for one defect of a physical scene.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Dimensionless parameters derived for one defect of a physical scene. Serialised (field
+/// names as keys) by `woodpile simulate` and in sweep manifests.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct DerivedDefect {
     /// Paper site.
     pub site: i64,
