@@ -48,6 +48,33 @@ impl Model {
     /// `acc` outside the window are left untouched: the caller keeps them at zero, which is
     /// their exact value while those sites are at rest.
     pub fn accelerations_in(&self, t: f64, q: &[f64], acc: &mut [f64], window: Window) {
+        self.accelerations_impl(t, q, acc, window, None);
+    }
+
+    /// [`Model::accelerations_in`] that also writes every contact force of the window into
+    /// `bond_force` (length `n_sites + 1`): entry `b + 1` is the bond between sites `b` and
+    /// `b + 1`, entry 0 the left wall, entry `n_sites` the right wall (0 for free ends). The
+    /// contact-event correction of `rk4-contact` reads them.
+    pub(crate) fn accelerations_recording(
+        &self,
+        t: f64,
+        q: &[f64],
+        acc: &mut [f64],
+        window: Window,
+        bond_force: &mut [f64],
+    ) {
+        self.accelerations_impl(t, q, acc, window, Some(bond_force));
+    }
+
+    #[inline(always)]
+    fn accelerations_impl(
+        &self,
+        t: f64,
+        q: &[f64],
+        acc: &mut [f64],
+        window: Window,
+        bond_force: Option<&mut [f64]>,
+    ) {
         let n_sites = self.n_sites();
         debug_assert_eq!(q.len(), self.n_dof());
         debug_assert_eq!(acc.len(), self.n_dof());
@@ -56,22 +83,43 @@ impl Model {
         let (acc_u, acc_v) = acc.split_at_mut(n_sites);
         let (lo, hi) = (window.lo, window.hi);
 
-        {
-            // Each site's force is (left bond) - (right bond). Computing it in one pass with the
-            // previous bond's force in a register writes every acceleration once (no store to
-            // load chain), and max(d, 0)^{3/2} has no branch to mispredict on the many
-            // barely-touching contacts behind the wave. Same bits as accumulating bond by bond.
-            let u_w = &u[lo..=hi];
-            let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
-            let mut previous = 0.0;
-            for bond in 1..u_w.len() {
-                let d = (u_w[bond - 1] - u_w[bond]).max(0.0);
-                let f = d * d.sqrt();
-                acc_w[bond - 1] = previous - f;
-                previous = f;
+        // Each site's force is (left bond) - (right bond). Computing it in one pass with the
+        // previous bond's force in a register writes every acceleration once (no store to load
+        // chain), and max(d, 0)^{3/2} has no branch to mispredict on the many barely-touching
+        // contacts behind the wave. Same bits as accumulating bond by bond. The recording loop
+        // is a separate copy so that the plain one carries no extra store.
+        let u_w = &u[lo..=hi];
+        let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
+        let mut previous = 0.0;
+        match bond_force {
+            None => {
+                for bond in 1..u_w.len() {
+                    let d = (u_w[bond - 1] - u_w[bond]).max(0.0);
+                    let f = d * d.sqrt();
+                    acc_w[bond - 1] = previous - f;
+                    previous = f;
+                }
             }
-            acc_w[u_w.len() - 1] = previous;
+            Some(record) => {
+                let record_w = &mut record[lo + 1..=hi][..u_w.len() - 1];
+                for bond in 1..u_w.len() {
+                    let d = (u_w[bond - 1] - u_w[bond]).max(0.0);
+                    let f = d * d.sqrt();
+                    acc_w[bond - 1] = previous - f;
+                    record_w[bond - 1] = f;
+                    previous = f;
+                }
+                if self.boundary() == Boundary::Fixed {
+                    if lo == 0 {
+                        record[0] = hertz_force(-u[0]);
+                    }
+                    if hi == n_sites - 1 {
+                        record[n_sites] = hertz_force(u[n_sites - 1]);
+                    }
+                }
+            }
         }
+        acc_w[u_w.len() - 1] = previous;
         if self.boundary() == Boundary::Fixed {
             if lo == 0 {
                 acc_u[0] += hertz_force(-u[0]);

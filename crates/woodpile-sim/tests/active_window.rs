@@ -103,6 +103,7 @@ fn steppers(model: &Model) -> Vec<(Box<dyn Stepper>, StepControl)> {
             StepControl::Adaptive { h_min: 1e-12 },
         ),
         (Box::new(Rk4Fused::new(model)), fixed),
+        (Box::new(Rk4Fused::with_contact_events(model)), fixed),
     ]
 }
 
@@ -132,7 +133,7 @@ fn run(
 #[test]
 fn the_active_window_changes_no_bit_of_the_result() {
     for (scene, model, striker) in scenes() {
-        for index in 0..6 {
+        for index in 0..7 {
             let (y_window, series_window, steps_window) = run(&model, striker, index, true);
             let (y_full, series_full, steps_full) = run(&model, striker, index, false);
             let name = steppers(&model)[index].0.name();

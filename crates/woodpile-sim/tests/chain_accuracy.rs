@@ -8,8 +8,8 @@
 
 use woodpile_sim::energy::{energy_density, Fractions, Region};
 use woodpile_sim::integrate::{
-    drive, Accuracy, Dop853, DriveConfig, ExplicitRk, Method, MethodChoice, Plan, Rk4, StepControl,
-    Stepper, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6,
+    drive, Accuracy, Dop853, DriveConfig, ExplicitRk, Method, MethodChoice, Plan, Rk4, Rk4Fused,
+    StepControl, Stepper, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::testing::fitted_order;
@@ -60,6 +60,7 @@ fn run_state(stepper: &mut dyn Stepper, control: StepControl) -> (f64, f64, Vec<
 fn stepper(method: Method, model: &Model) -> Box<dyn Stepper> {
     match method {
         Method::Rk4 => Box::new(ExplicitRk::<Rk4>::new(model)),
+        Method::Rk4Contact => Box::new(Rk4Fused::with_contact_events(model)),
         Method::Verlet => Box::new(SymplecticStepper::new(model, VERLET)),
         Method::Yoshida4 => Box::new(SymplecticStepper::new(model, YOSHIDA4)),
         Method::Yoshida6 => Box::new(SymplecticStepper::new(model, YOSHIDA6)),
@@ -79,7 +80,8 @@ fn reference() -> f64 {
 
 /// Measured convergence orders of the state (max-norm error at t_end against a Yoshida-6 run at
 /// dt = 5e-4) on the chain: Verlet 2; RK4 and the compositions between 2 and 3, well below their
-/// classical 4 and 6, because of the contact singularity. A single scalar such as E_tr converges
+/// classical 4 and 6, because of the contact singularity. `rk4-contact`, which integrates each
+/// opening or closing contact along its path, recovers order 3.3 (between 3 and 4.2 asserted). A single scalar such as E_tr converges
 /// too irregularly (kink errors of either sign partly cancel) to fit a slope to.
 #[test]
 fn convergence_orders_on_the_hertz_chain() {
@@ -95,6 +97,7 @@ fn convergence_orders_on_the_hertz_chain() {
         (Method::Rk4, 2.0, 3.2),
         (Method::Yoshida4, 2.0, 3.2),
         (Method::Yoshida6, 2.0, 3.2),
+        (Method::Rk4Contact, 3.0, 4.2),
     ] {
         let errs: Vec<f64> = dts
             .iter()
@@ -112,6 +115,32 @@ fn convergence_orders_on_the_hertz_chain() {
             p > lo && p < hi,
             "{}: order {p:.2} outside [{lo}, {hi}]; errors {errs:?}",
             method.name()
+        );
+    }
+}
+
+/// The contact-event correction is worth its cost: at every step of the convergence test the
+/// state error of `rk4-contact` is at least 5 times smaller than plain RK4's.
+#[test]
+fn contact_events_beat_plain_rk4_at_every_step() {
+    let (model, ..) = short_scene();
+    let reference = run_state(
+        stepper(Method::Yoshida6, &model).as_mut(),
+        StepControl::Fixed { dt: 5e-4 },
+    )
+    .2;
+    let error = |method: Method, dt: f64| {
+        let y = run_state(stepper(method, &model).as_mut(), StepControl::Fixed { dt }).2;
+        y.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    };
+    for dt in [0.08, 0.04, 0.02] {
+        let (plain, corrected) = (error(Method::Rk4, dt), error(Method::Rk4Contact, dt));
+        assert!(
+            corrected * 5.0 < plain,
+            "dt = {dt}: rk4-contact {corrected:.2e}, rk4 {plain:.2e}"
         );
     }
 }

@@ -13,6 +13,9 @@ use crate::model::Model;
 pub enum Method {
     /// Classical Runge–Kutta of order 4, fixed step (the paper's method).
     Rk4,
+    /// RK4 whose step integrates each Hertz contact that opens or closes inside it along the
+    /// contact's path (see `integrate::contact_event`): the kink no longer limits the order.
+    Rk4Contact,
     /// Störmer–Verlet, order 2, symplectic, fixed step.
     Verlet,
     /// Triple-jump composition of Verlet, order 4, symplectic, fixed step.
@@ -25,8 +28,9 @@ pub enum Method {
 
 impl Method {
     /// Every method, in a stable order.
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Rk4,
+        Method::Rk4Contact,
         Method::Verlet,
         Method::Yoshida4,
         Method::Yoshida6,
@@ -37,6 +41,7 @@ impl Method {
     pub fn name(self) -> &'static str {
         match self {
             Method::Rk4 => "rk4",
+            Method::Rk4Contact => "rk4-contact",
             Method::Verlet => "verlet",
             Method::Yoshida4 => "yoshida4",
             Method::Yoshida6 => "yoshida6",
@@ -53,7 +58,7 @@ impl Method {
     pub fn order(self) -> u32 {
         match self {
             Method::Verlet => 2,
-            Method::Rk4 | Method::Yoshida4 => 4,
+            Method::Rk4 | Method::Rk4Contact | Method::Yoshida4 => 4,
             Method::Yoshida6 => 6,
             Method::Dop853 => 8,
         }
@@ -67,7 +72,7 @@ impl Method {
     /// Force evaluations per step (per accepted step for the adaptive method).
     pub fn evals_per_step(self) -> u32 {
         match self {
-            Method::Rk4 => 4,
+            Method::Rk4 | Method::Rk4Contact => 4,
             Method::Verlet => 1,
             Method::Yoshida4 => 3,
             Method::Yoshida6 => 7,
@@ -80,7 +85,7 @@ impl Method {
     /// compositions), used to keep fixed steps safe for stiff resonators.
     pub fn stability_limit(self) -> f64 {
         match self {
-            Method::Rk4 => 2.0 * std::f64::consts::SQRT_2,
+            Method::Rk4 | Method::Rk4Contact => 2.0 * std::f64::consts::SQRT_2,
             Method::Verlet => 2.0,
             Method::Yoshida4 => 1.57,
             Method::Yoshida6 => 1.0,
@@ -141,6 +146,10 @@ struct ErrorModel {
 
 fn error_model(method: Method) -> ErrorModel {
     match method {
+        Method::Rk4Contact => ErrorModel {
+            coef: 4.0e-3,
+            order: 3.0,
+        },
         Method::Verlet => ErrorModel {
             coef: 1.5e-2,
             order: 2.0,
@@ -307,6 +316,13 @@ impl Plan {
         };
         match self.method {
             Method::Rk4 => drive(model, &mut Rk4Fused::new(model), y, &cfg, observer),
+            Method::Rk4Contact => drive(
+                model,
+                &mut Rk4Fused::with_contact_events(model),
+                y,
+                &cfg,
+                observer,
+            ),
             Method::Verlet => drive(
                 model,
                 &mut SymplecticStepper::new(model, VERLET),

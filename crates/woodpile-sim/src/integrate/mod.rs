@@ -5,12 +5,14 @@
 //! and the statistics. Observers see the state at the sample times only, between steps, so the
 //! numerics never know who is watching.
 //!
-//! Methods (see [`Method`]): RK4 (the paper's), Störmer–Verlet and its symplectic compositions
+//! Methods (see [`Method`]): RK4 (the paper's), RK4 with exact contact events (`rk4-contact`,
+//! [`contact_event`]), Störmer–Verlet and its symplectic compositions
 //! of order 4 and 6, and the adaptive Dormand–Prince 8(5,3).
 //!
 //! Comparisons are written `!(x <= limit)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod contact_event;
 mod dop853;
 mod method;
 mod rk;
