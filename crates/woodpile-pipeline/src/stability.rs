@@ -7,7 +7,7 @@
 //! ```toml
 //! kind = "stability"
 //! tolerance = 1e-6                  # |ΔE_tr| allowed, against `auto` at tolerance / 100
-//! methods = ["rk4", "verlet", "yoshida4", "yoshida6"]
+//! methods = ["rk4", "rk4-contact", "verlet", "yoshida4", "yoshida6"]
 //! vary = "eps"                      # the first defect's eps, or "p"
 //! values = [0.01, 0.1, 1.0, 10.0]
 //! step = "dt_omega"                 # steps given as dt·ω (ω² = kappa (1 + 1/eps)), or "dt"
@@ -28,7 +28,7 @@
 
 use rayon::prelude::*;
 use serde_json::json;
-use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
+use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
 use woodpile_sim::run::{run_with_plan, simulate, Scenario};
 
 use crate::error::{PipelineError, Result};
@@ -79,7 +79,7 @@ impl Stability {
                     return Err(fields.error(
                         "methods",
                         format!(
-                            "`{name}` is not a fixed-step method (rk4, verlet, yoshida4, yoshida6)"
+                            "`{name}` is not a fixed-step method (rk4, rk4-contact, verlet, yoshida4, yoshida6)"
                         ),
                     ))
                 }
@@ -166,7 +166,7 @@ impl Stability {
                     .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
                     .fractions
                     .trapped;
-                let auto_dt = Plan::dt_for(&scene.scenario.model, Method::Rk4, self.tolerance);
+                let auto_dt = Plan::dt_for(&scene.scenario.model, AUTO_METHOD, self.tolerance);
                 Ok((scene, e_ref, auto_dt))
             })
             .collect::<Result<_>>()?;
@@ -208,10 +208,10 @@ impl Stability {
             })
             .collect();
         let counts = |k: i64| runs.iter().filter(|r| r.status == k).count();
-        // `auto` runs RK4 at `auto_dt` or shorter: none of those steps may be unstable here.
+        // `auto` runs its method at `auto_dt` or shorter: none of those steps may be unstable.
         let auto_unstable = runs
             .iter()
-            .filter(|r| r.method == "rk4" && r.status == 2 && r.dt <= r.auto_dt)
+            .filter(|r| r.method == AUTO_METHOD.name() && r.status == 2 && r.dt <= r.auto_dt)
             .count();
         let summary = json!({
             "runs": runs.len(),

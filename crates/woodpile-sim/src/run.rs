@@ -2,8 +2,9 @@
 //! `simulate`, every pipeline sweep, the tests) goes through [`simulate`].
 //!
 //! `method = "auto"` is verified, not trusted: it runs the calibrated step `dt` and its double
-//! `2 dt`, estimates the finer run's error by Richardson's rule for the observed order 2.5,
-//! |F(dt) - F(2 dt)| / (2^2.5 - 1), and accepts when that estimate is at most half the tolerance;
+//! `2 dt`, estimates the finer run's error by Richardson's rule for the method's observed order q
+//! (3 for `rk4-contact`, auto's method; 2.5 for the others), |F(dt) - F(2 dt)| / (2^q - 1), and
+//! accepts when that estimate is at most half the tolerance;
 //! otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
 //! without a stiffness model having to foresee them.
 
@@ -16,10 +17,6 @@ use crate::model::Model;
 
 /// Halvings `auto` tries before giving up.
 const MAX_HALVINGS: u32 = 6;
-
-/// Richardson denominator 2^q - 1 for the observed order q = 2.5 of the fixed-step methods on
-/// Hertzian chains (see `integrate::method`).
-const RICHARDSON: f64 = 4.656_854_249_492_38;
 
 /// A fully specified, validated simulation: model, initial impulse, horizon, region, method.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,7 +55,8 @@ pub struct Outcome {
     /// Cost of every run made, including `auto`'s verification runs.
     pub total_rhs_evals: u64,
     /// For `auto`: the Richardson estimate of the reported run's error, the largest change of
-    /// R, T or E_tr between it and the run at twice its step divided by 2^2.5 - 1.
+    /// R, T or E_tr between it and the run at twice its step divided by 2^q - 1 (q: the
+    /// method's observed order).
     pub error_estimate: Option<f64>,
     /// The state at t_end (`[q, q']`).
     pub final_state: Vec<f64>,
@@ -97,6 +95,8 @@ fn verified<O: Observer + ?Sized>(
         Err(SimError::NonFinite { .. } | SimError::EnergyDrift { .. }) => None,
         Err(e) => return Err(e),
     };
+    // Richardson denominator 2^q - 1 for the method's observed order on Hertzian chains.
+    let richardson = 2f64.powf(plan.method.observed_order()) - 1.0;
     let mut estimate = f64::INFINITY;
     for _ in 0..=MAX_HALVINGS {
         observer.reset();
@@ -112,7 +112,7 @@ fn verified<O: Observer + ?Sized>(
         };
         spent += fine.stats.rhs_evals;
         estimate = coarse.as_ref().map_or(f64::INFINITY, |c| {
-            largest_change(&c.fractions, &fine.fractions) / RICHARDSON
+            largest_change(&c.fractions, &fine.fractions) / richardson
         });
         let drift_ok = fine.stats.max_energy_drift <= (DRIFT_PER_TOL * tol).max(1e-12);
         if estimate <= 0.5 * tol && drift_ok {
