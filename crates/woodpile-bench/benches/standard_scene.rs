@@ -39,6 +39,16 @@ fn rk4_dt_0_02() -> f64 {
     run(&fixed(Method::Rk4, 0.02)).unwrap().fractions.trapped
 }
 
+/// RK4 with exact contact events at dt = 0.06 (|ΔE_tr| about 6e-8): the cheapest setting
+/// within 1e-7.
+#[divan::bench]
+fn rk4_contact_dt_0_06() -> f64 {
+    run(&fixed(Method::Rk4Contact, 0.06))
+        .unwrap()
+        .fractions
+        .trapped
+}
+
 /// Yoshida's fourth-order composition at dt = 0.01 (|ΔE_tr| = 1.3e-8).
 #[divan::bench]
 fn yoshida4_dt_0_01() -> f64 {

@@ -108,6 +108,9 @@ fn main() {
     for (method, dt) in [
         (Method::Rk4, 0.01),
         (Method::Rk4, 0.02),
+        (Method::Rk4Contact, 0.05),
+        (Method::Rk4Contact, 0.06),
+        (Method::Rk4Contact, 0.075),
         (Method::Yoshida4, 0.01),
         (Method::Yoshida6, 0.02),
         (Method::Verlet, 0.005),

@@ -19,13 +19,15 @@
 //! `series = "column"` draws one curve of the single `y` per value of that column, named by
 //! the string column `series_label` when given (work-precision charts: one curve per method).
 //! `[heatmap]` takes `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`,
-//! optionally `panels` and `mark_max = true` (circle and label the largest z).
+//! optionally `panels`, `mark_max = true` (circle and label the largest z), and
+//! `overlay = [{ x = "column", label = "text" }, ...]`: a line over each panel through
+//! (that column's value, y) for every row of the map, e.g. a stability bound against ε.
 
 use std::path::{Path, PathBuf};
 
 use polars::prelude::DataFrame;
 use serde_json::json;
-use woodpile_plot::{Figure, HeatPanel, LinePanel, Panel, Series};
+use woodpile_plot::{cell_edges, Figure, HeatPanel, LinePanel, Panel, Series};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
@@ -85,6 +87,8 @@ pub enum Plot {
         z_label: String,
         /// Mark the maximum.
         mark_max: bool,
+        /// Lines over the map: (x column, legend label).
+        overlays: Vec<(String, String)>,
     },
 }
 
@@ -135,7 +139,9 @@ impl Render {
                     Some(toml::Value::Boolean(b)) => b,
                     Some(_) => return Err(f.error("mark_max", "expected true or false")),
                 };
+                let overlays = parse_overlays(&mut f)?;
                 let plot = Plot::Heatmap {
+                    overlays,
                     x: f.required("x")?,
                     y: f.required("y")?,
                     z: f.required("z")?,
@@ -206,8 +212,19 @@ impl Render {
                 std::iter::once(x).chain(y).chain(series).collect(),
             ),
             Plot::Heatmap {
-                x, y, z, panels, ..
-            } => (panels.as_ref(), vec![x, y, z]),
+                x,
+                y,
+                z,
+                panels,
+                overlays,
+                ..
+            } => (
+                panels.as_ref(),
+                [x, y, z]
+                    .into_iter()
+                    .chain(overlays.iter().map(|(column, _)| column))
+                    .collect(),
+            ),
         };
         let panel_values = match panel_name {
             Some(p) => column(p)?,
@@ -316,17 +333,17 @@ impl Render {
                     y_label,
                     z_label,
                     mark_max,
+                    overlays,
                     ..
                 } => {
                     let rows = rows_of(key);
+                    let labels: Vec<&str> = overlays.iter().map(|(_, l)| l.as_str()).collect();
                     heat_panel(
                         &data,
                         &rows,
-                        title_of(key),
-                        x_label,
-                        y_label,
-                        z_label,
+                        (title_of(key), [x_label, y_label, z_label]),
                         *mark_max,
+                        &labels,
                     )
                 }
             })
@@ -359,14 +376,40 @@ impl Render {
     }
 }
 
+/// `overlay = [{ x = "column", label = "text" }, ...]` of a `[heatmap]`.
+fn parse_overlays(f: &mut Fields<'_>) -> Result<Vec<(String, String)>> {
+    let Some(value) = f.take("overlay") else {
+        return Ok(Vec::new());
+    };
+    let toml::Value::Array(items) = value else {
+        return Err(f.error("overlay", "expected an array of { x, label } tables"));
+    };
+    items
+        .into_iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let key = format!("overlay[{i}]");
+            let toml::Value::Table(table) = item else {
+                return Err(f.error(
+                    &key,
+                    "expected a table { x = \"column\", label = \"text\" }",
+                ));
+            };
+            let mut o = f.nested(&key, table);
+            let overlay = (o.required("x")?, o.required("label")?);
+            o.finish()?;
+            Ok(overlay)
+        })
+        .collect()
+}
+
+/// One heat-map panel from `data` = [x, y, z, overlay columns...] on `rows`.
 fn heat_panel(
     data: &[Vec<Option<f64>>],
     rows: &[usize],
-    title: String,
-    x_label: &str,
-    y_label: &str,
-    z_label: &str,
+    (title, [x_label, y_label, z_label]): (String, [&String; 3]),
     mark_max: bool,
+    overlay_labels: &[&str],
 ) -> Panel {
     let unique = |k: usize| {
         let mut v: Vec<f64> = rows.iter().filter_map(|&r| data[k][r]).collect();
@@ -390,11 +433,37 @@ fn heat_panel(
             }
         }
     }
+    // Each overlay: its x on every row of the map, as a step line over the row's cell.
+    let y_edges = cell_edges(&ys);
+    let overlays = overlay_labels
+        .iter()
+        .enumerate()
+        .map(|(k, label)| {
+            let column = &data[3 + k];
+            let points = ys
+                .iter()
+                .enumerate()
+                .filter_map(|(j, &y)| {
+                    let x = rows
+                        .iter()
+                        .find(|&&r| data[1][r] == Some(y))
+                        .and_then(|&r| column[r])?;
+                    Some([(x, y_edges[j]), (x, y_edges[j + 1])])
+                })
+                .flatten()
+                .collect();
+            Series {
+                label: (*label).to_string(),
+                points,
+            }
+        })
+        .collect();
     Panel::Heat(HeatPanel {
         title,
-        x_label: x_label.into(),
-        y_label: y_label.into(),
-        z_label: z_label.into(),
+        x_label: x_label.clone(),
+        y_label: y_label.clone(),
+        z_label: z_label.clone(),
+        overlays,
         xs,
         ys,
         z,

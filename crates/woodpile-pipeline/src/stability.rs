@@ -21,7 +21,9 @@
 //! 0.9 of the bound) can be read off against it. Output: one row per run with the method, the
 //! value (and its log10), the requested `step` (the map's grid), the step dt actually taken
 //! (t_end tiled by equal steps, within 1% of the request) and its dt·ω, the method's linear
-//! bound as a dt, `auto`'s first step, the status, the error and the failure's reason.
+//! bound as a dt, `auto`'s first step, both again in the map's step unit as `log10_bound_step`
+//! and `log10_auto_step` (the figure draws them as lines over the map), the status, the error
+//! and the failure's reason.
 
 // Comparisons are written `!(x > 0.0)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -201,6 +203,20 @@ impl Stability {
                     dt_omega: (omega > 0.0).then_some(dt * omega),
                     bound: (omega > 0.0).then_some(method.stability_limit() / omega),
                     auto_dt: *auto_dt,
+                    // The bound and auto's step in the map's own x unit, for the overlay lines.
+                    bound_step: (omega > 0.0).then(|| {
+                        let bound_dt = method.stability_limit() / omega;
+                        if self.steps_are_dt_omega {
+                            bound_dt * omega
+                        } else {
+                            bound_dt
+                        }
+                    }),
+                    auto_step: if self.steps_are_dt_omega {
+                        *auto_dt * omega
+                    } else {
+                        *auto_dt
+                    },
                     status,
                     error,
                     failure,
@@ -249,6 +265,14 @@ impl Stability {
         .f64("dt_omega", runs.iter().map(|r| r.dt_omega).collect())
         .f64("linear_bound_dt", runs.iter().map(|r| r.bound).collect())
         .f64("auto_dt", runs.iter().map(|r| Some(r.auto_dt)).collect())
+        .f64(
+            "log10_bound_step",
+            runs.iter().map(|r| r.bound_step.map(f64::log10)).collect(),
+        )
+        .f64(
+            "log10_auto_step",
+            runs.iter().map(|r| Some(r.auto_step.log10())).collect(),
+        )
         .i64("status", runs.iter().map(|r| Some(r.status)).collect())
         .f64("error", runs.iter().map(|r| r.error).collect())
         .str("failure", runs.iter().map(|r| r.failure.clone()).collect());
@@ -312,6 +336,10 @@ struct Run {
     dt_omega: Option<f64>,
     bound: Option<f64>,
     auto_dt: f64,
+    /// The linear bound in the map's step unit (dt·ω or dt).
+    bound_step: Option<f64>,
+    /// `auto`'s first step in the map's step unit.
+    auto_step: f64,
     status: i64,
     error: Option<f64>,
     failure: Option<String>,

@@ -341,7 +341,6 @@ impl SweepStats {
     }
 }
 
-/// The cache key of one scene: its canonical form and the code version.
 /// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
 /// that energy points keep their keys), the series.
 pub fn point_key(scene: &Scene, series: Series) -> Key {

@@ -132,7 +132,7 @@ fn lines<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &LinePanel) -> Re
 }
 
 /// Cell edges around increasing centres: midpoints inside, half a spacing beyond the ends.
-fn edges(centres: &[f64]) -> Vec<f64> {
+pub fn cell_edges(centres: &[f64]) -> Vec<f64> {
     match centres {
         [] => vec![0.0, 1.0],
         [c] => vec![c - 0.5, c + 0.5],
@@ -147,10 +147,13 @@ fn edges(centres: &[f64]) -> Vec<f64> {
     }
 }
 
+/// Overlay line colours: red and white stand out on every viridis shade.
+const OVERLAY_COLOURS: [RGBColor; 3] = [RGBColor(230, 30, 40), WHITE, RGBColor(255, 140, 0)];
+
 fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Result<(), String> {
     let width = area.dim_in_pixel().0;
     let (main, bar) = area.split_horizontally(width.saturating_sub(100));
-    let (ex, ey) = (edges(&h.xs), edges(&h.ys));
+    let (ex, ey) = (cell_edges(&h.xs), cell_edges(&h.ys));
     let (z0, z1) = {
         let (lo, hi) =
             h.z.iter()
@@ -207,6 +210,40 @@ fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Res
                 )])
             .map_err(text)?;
     }
+    // Overlay lines, clamped to the map, in colours that read on viridis, with a legend.
+    let (x_range, y_range) = (ex[0]..=ex[ex.len() - 1], ey[0]..=ey[ey.len() - 1]);
+    for (k, overlay) in h.overlays.iter().enumerate() {
+        let colour = OVERLAY_COLOURS[k % OVERLAY_COLOURS.len()];
+        let points: Vec<(f64, f64)> = overlay
+            .points
+            .iter()
+            .filter(|(x, y)| x.is_finite() && y.is_finite())
+            .map(|&(x, y)| {
+                (
+                    x.clamp(*x_range.start(), *x_range.end()),
+                    y.clamp(*y_range.start(), *y_range.end()),
+                )
+            })
+            .collect();
+        chart
+            .draw_series(LineSeries::new(
+                points,
+                ShapeStyle::from(&colour).stroke_width(3),
+            ))
+            .map_err(text)?
+            .label(overlay.label.clone())
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(3)));
+    }
+    if !h.overlays.is_empty() {
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 12))
+            .draw()
+            .map_err(text)?;
+    }
     // Colour bar: the map's scale as a strip with its own labelled axis.
     let mut bar_chart = ChartBuilder::on(&bar)
         .margin_top(40)
@@ -241,8 +278,8 @@ mod tests {
 
     #[test]
     fn edges_surround_the_centres() {
-        assert_eq!(edges(&[1.0, 2.0, 4.0]), vec![0.5, 1.5, 3.0, 5.0]);
-        assert_eq!(edges(&[3.0]), vec![2.5, 3.5]);
+        assert_eq!(cell_edges(&[1.0, 2.0, 4.0]), vec![0.5, 1.5, 3.0, 5.0]);
+        assert_eq!(cell_edges(&[3.0]), vec![2.5, 3.5]);
         assert_eq!(range([1.0, f64::NAN, 3.0].into_iter()), (0.9, 3.1));
     }
 }

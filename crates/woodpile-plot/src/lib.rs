@@ -15,6 +15,7 @@ use std::sync::OnceLock;
 use plotters::prelude::*;
 
 pub use colour::viridis;
+pub use draw::cell_edges;
 
 /// Drawing failed.
 #[derive(Debug, thiserror::Error)]
@@ -67,6 +68,8 @@ pub struct HeatPanel {
     pub z: Vec<Option<f64>>,
     /// A marked point (e.g. the maximum) and its label.
     pub marker: Option<(f64, f64, String)>,
+    /// Lines drawn over the map (e.g. a stability bound), each with a legend entry.
+    pub overlays: Vec<Series>,
 }
 
 /// A panel of either kind.
@@ -200,6 +203,10 @@ mod tests {
                     ys: vec![1.0, 2.0, 3.0],
                     z: vec![Some(0.1), Some(0.2), None, Some(0.4), Some(0.5), Some(0.6)],
                     marker: Some((2.0, 3.0, "max".into())),
+                    overlays: vec![Series {
+                        label: "bound".into(),
+                        points: vec![(1.5, 0.5), (1.5, 3.5)],
+                    }],
                 }),
             ],
         };
@@ -209,6 +216,7 @@ mod tests {
         assert_eq!(&bytes[1..4], b"PNG");
         let text = std::fs::read_to_string(&svg).unwrap();
         assert!(text.contains("<svg") && text.contains("E_tr") && text.contains("test"));
+        assert!(text.contains("bound"), "the overlay has a legend entry");
         assert_eq!(
             std::fs::read_dir(dir.path()).unwrap().count(),
             2,

@@ -66,6 +66,7 @@ fn main() {
     let mut rows: Vec<(MethodChoice, Accuracy, String)> = Vec::new();
     for m in [
         Method::Rk4,
+        Method::Rk4Contact,
         Method::Verlet,
         Method::Yoshida4,
         Method::Yoshida6,
