@@ -60,6 +60,8 @@ fn report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         "error_estimate": out.error_estimate,
         "rejected_steps": out.stats.rejected,
         "rhs_evals": out.stats.rhs_evals,
+        "site_steps": out.stats.site_steps,
+        "site_steps_full_chain": scene.scenario.model.n_sites() as u64 * (out.stats.steps + out.stats.rejected),
         "total_rhs_evals": out.total_rhs_evals,
         "energy_drift": if scene.scenario.model.is_time_dependent() { Value::Null } else { json!(out.stats.max_energy_drift) },
         "energy_conserved": !scene.scenario.model.is_time_dependent(),

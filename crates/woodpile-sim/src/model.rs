@@ -370,6 +370,16 @@ impl Window {
         }
     }
 
+    /// Number of sites covered.
+    pub fn len(&self) -> usize {
+        self.hi - self.lo + 1
+    }
+
+    /// Never empty: a window holds at least one site.
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
     /// The parts of a state `[q, q']` of `model` that the window covers, in state order:
     /// site positions, resonator positions, site velocities, resonator velocities.
     pub fn state_ranges(&self, model: &Model) -> [std::ops::Range<usize>; 4] {

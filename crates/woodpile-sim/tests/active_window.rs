@@ -175,3 +175,48 @@ fn fused_rk4_is_the_tableau_rk4_bit_for_bit() {
         );
     }
 }
+
+/// Chain length only as large as the fractions can feel: while the wave has not reached the
+/// walls of the shorter chain, a chain three times as long gives the same fraction series, bit
+/// for bit, for exactly the same work (site-steps), and that work is well under the full
+/// chain's. So a scene may be given a generous length at no cost.
+#[test]
+fn a_longer_chain_costs_nothing_until_the_wave_reaches_its_ends() {
+    let run = |half: usize| {
+        let n = 2 * half + 1;
+        let model = Model::new(n, Boundary::Fixed, vec![linear(half, 10.0, 1.0)]).unwrap();
+        let mut y = model.rest_state();
+        model.apply_impulse(&mut y, half - 25, 1.0).unwrap();
+        let cfg = DriveConfig {
+            t_end: 50.0,
+            sample_every: 1.0,
+            control: StepControl::Fixed { dt: 0.05 },
+            max_steps: 10_000_000,
+            energy_drift_limit: None,
+            active_window: true,
+        };
+        let region = Region::new(half as i64 - 1, half as i64 + 1, n).unwrap();
+        let mut series = FractionSeries::new(&model, region);
+        let mut stepper = Rk4Fused::with_contact_events(&model);
+        let stats = drive(&model, &mut stepper, &mut y, &cfg, &mut series).unwrap();
+        (series, stats)
+    };
+    let (short, short_stats) = run(100);
+    let (long, long_stats) = run(300);
+    for (name, a, b) in [
+        ("t", &short.t, &long.t),
+        ("R", &short.reflected, &long.reflected),
+        ("T", &short.transmitted, &long.transmitted),
+        ("E_tr", &short.trapped, &long.trapped),
+        ("E", &short.energy, &long.energy),
+    ] {
+        assert_eq!(a, b, "{name} differs between the 201- and 601-site chains");
+    }
+    assert_eq!(short_stats.site_steps, long_stats.site_steps);
+    let full_chain = 201 * short_stats.steps;
+    assert!(
+        2 * short_stats.site_steps < full_chain,
+        "the window worked on {} of {full_chain} site-steps",
+        short_stats.site_steps
+    );
+}

@@ -216,6 +216,10 @@ pub struct Stats {
     pub rhs_evals: u64,
     /// Largest relative energy drift seen at the samples (0 if not conservative).
     pub max_energy_drift: f64,
+    /// Sites worked on, summed over step attempts: the window's width each time. The full
+    /// model's count is `n_sites × attempts`; the ratio is what the active window saves, as a
+    /// machine-independent number.
+    pub site_steps: u64,
 }
 
 /// Integrates `y` from t = 0 to `cfg.t_end` with `stepper`, calling `observer` at the samples.
@@ -258,6 +262,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                 let h_eq = span / n_steps as f64;
                 for i in 0..n_steps {
                     let window = active.window();
+                    stats.site_steps += window.len() as u64;
                     stepper.step(model, t, y, h_eq, window);
                     active.update(model, y, window);
                     t = if i + 1 == n_steps { target } else { t + h_eq };
@@ -284,6 +289,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                         });
                     }
                     let window = active.window();
+                    stats.site_steps += window.len() as u64;
                     match stepper.step(model, t, y, h_try, window) {
                         StepOutcome::Accepted { h_next } => {
                             active.update(model, y, window);
