@@ -5,6 +5,10 @@
 //!
 //! With k_i = (v_i, a_i): q_{i+1} = q + (c h) v_i, v_{i+1} = v + (c h) a_i, a_{i+1} = a(q_{i+1});
 //! the new state accumulates y + (h b_1) k_1 + (h b_2) k_2 + ... in that order.
+//!
+//! The same stepper is `rk4-contact` when made by [`Rk4Fused::with_contact_events`]: it records
+//! each stage's bond forces and, after the step, replaces RK4's quadrature of every bond whose
+//! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
 use super::contact_event::{changes_contact, path_integrals, rk4_quadrature, BondPath};
 use super::{StepOutcome, Stepper};
@@ -258,7 +262,8 @@ impl Rk4Fused {
             &forces[3][bonds],
         );
         let (left_q, right_q) = (&new_q[lo..hi], &new_q[lo + 1..hi + 1]);
-        // A bond changed contact when between one and four of its five values say "touching".
+        // A bond changed contact when between one and four of its five values say "touching"
+        // (`changes_contact`, written out here so that it vectorises).
         // The test runs branch-free over blocks of eight bonds (it vectorises); only a block
         // holding a changed bond, which is rare, is looked at bond by bond.
         let changed_at = |i: usize| {
