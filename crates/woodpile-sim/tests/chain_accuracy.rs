@@ -78,19 +78,32 @@ fn reference() -> f64 {
     .0
 }
 
-/// Measured convergence orders of the state (max-norm error at t_end against a Yoshida-6 run at
-/// dt = 5e-4) on the chain: Verlet 2; RK4 and the compositions between 2 and 3, well below their
-/// classical 4 and 6, because of the contact singularity. `rk4-contact`, which integrates each
-/// opening or closing contact along its path, recovers order 3.3 (between 3 and 4.2 asserted). A single scalar such as E_tr converges
-/// too irregularly (kink errors of either sign partly cancel) to fit a slope to.
-#[test]
-fn convergence_orders_on_the_hertz_chain() {
+/// The max-norm error at t_end of the short scene's state for (method, dt), against a Yoshida-6
+/// run at dt = 5e-4 (made once).
+fn state_error_against_tight_run() -> impl Fn(Method, f64) -> f64 {
     let (model, ..) = short_scene();
     let reference = run_state(
         stepper(Method::Yoshida6, &model).as_mut(),
         StepControl::Fixed { dt: 5e-4 },
     )
     .2;
+    move |method, dt| {
+        let y = run_state(stepper(method, &model).as_mut(), StepControl::Fixed { dt }).2;
+        y.iter()
+            .zip(&reference)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Measured convergence orders of the state (max-norm error at t_end against a Yoshida-6 run at
+/// dt = 5e-4) on the chain: Verlet 2; RK4 and the compositions between 2 and 3, well below their
+/// classical 4 and 6, because of the contact singularity. `rk4-contact`, which integrates each
+/// opening or closing contact along its path, recovers order 3.3 (between 3 and 4.2 asserted).
+/// A single scalar such as E_tr converges too irregularly (kink errors of either sign partly cancel) to fit a slope to.
+#[test]
+fn convergence_orders_on_the_hertz_chain() {
+    let error = state_error_against_tight_run();
     let dts = [0.08, 0.04, 0.02, 0.01];
     for (method, lo, hi) in [
         (Method::Verlet, 1.8, 2.3),
@@ -99,16 +112,7 @@ fn convergence_orders_on_the_hertz_chain() {
         (Method::Yoshida6, 2.0, 3.2),
         (Method::Rk4Contact, 3.0, 4.2),
     ] {
-        let errs: Vec<f64> = dts
-            .iter()
-            .map(|&dt| {
-                let y = run_state(stepper(method, &model).as_mut(), StepControl::Fixed { dt }).2;
-                y.iter()
-                    .zip(&reference)
-                    .map(|(a, b)| (a - b).abs())
-                    .fold(0.0, f64::max)
-            })
-            .collect();
+        let errs: Vec<f64> = dts.iter().map(|&dt| error(method, dt)).collect();
         let p = fitted_order(&dts, &errs);
         eprintln!("{}: measured order {p:.2} (errors {errs:?})", method.name());
         assert!(
@@ -123,19 +127,7 @@ fn convergence_orders_on_the_hertz_chain() {
 /// state error of `rk4-contact` is at least 5 times smaller than plain RK4's.
 #[test]
 fn contact_events_beat_plain_rk4_at_every_step() {
-    let (model, ..) = short_scene();
-    let reference = run_state(
-        stepper(Method::Yoshida6, &model).as_mut(),
-        StepControl::Fixed { dt: 5e-4 },
-    )
-    .2;
-    let error = |method: Method, dt: f64| {
-        let y = run_state(stepper(method, &model).as_mut(), StepControl::Fixed { dt }).2;
-        y.iter()
-            .zip(&reference)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max)
-    };
+    let error = state_error_against_tight_run();
     for dt in [0.08, 0.04, 0.02] {
         let (plain, corrected) = (error(Method::Rk4, dt), error(Method::Rk4Contact, dt));
         assert!(
