@@ -40,7 +40,7 @@ BASELINE := $(or $(CARGO_TARGET_DIR),target)/baseline
 
 bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, then divan benchmarks
 	mkdir -p $(BASELINE)
-	gcc -O3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
+	gcc -O3 -march=x86-64-v3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
 	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py
 	$(CARGO) bench -p woodpile-bench
