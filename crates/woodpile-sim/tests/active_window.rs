@@ -5,8 +5,8 @@
 
 use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::{
-    drive, Dop853, DriveConfig, ExplicitRk, Rk4, Rk4Fused, StepControl, Stepper, SymplecticStepper,
-    VERLET, YOSHIDA4, YOSHIDA6,
+    drive, Dop853, DriveConfig, ExplicitRk, Rk4, Rk4Fused, Rkn4, StepControl, Stepper,
+    SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
@@ -104,6 +104,8 @@ fn steppers(model: &Model) -> Vec<(Box<dyn Stepper>, StepControl)> {
         ),
         (Box::new(Rk4Fused::new(model)), fixed),
         (Box::new(Rk4Fused::with_contact_events(model)), fixed),
+        (Box::new(Rkn4::new(model)), fixed),
+        (Box::new(Rkn4::with_contact_events(model)), fixed),
     ]
 }
 

@@ -9,7 +9,7 @@
 use woodpile_sim::energy::{energy_density, Fractions, Region};
 use woodpile_sim::integrate::{
     drive, Accuracy, Dop853, DriveConfig, ExplicitRk, Method, MethodChoice, Plan, Rk4, Rk4Fused,
-    StepControl, Stepper, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6,
+    Rkn4, StepControl, Stepper, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::testing::fitted_order;
@@ -61,6 +61,7 @@ fn stepper(method: Method, model: &Model) -> Box<dyn Stepper> {
     match method {
         Method::Rk4 => Box::new(ExplicitRk::<Rk4>::new(model)),
         Method::Rk4Contact => Box::new(Rk4Fused::with_contact_events(model)),
+        Method::Rkn4Contact => Box::new(Rkn4::with_contact_events(model)),
         Method::Verlet => Box::new(SymplecticStepper::new(model, VERLET)),
         Method::Yoshida4 => Box::new(SymplecticStepper::new(model, YOSHIDA4)),
         Method::Yoshida6 => Box::new(SymplecticStepper::new(model, YOSHIDA6)),
@@ -99,7 +100,10 @@ fn state_error_against_tight_run() -> impl Fn(Method, f64) -> f64 {
 /// Measured convergence orders of the state (max-norm error at t_end against a Yoshida-6 run at
 /// dt = 5e-4) on the chain: Verlet 2; RK4 and the compositions between 2 and 3, well below their
 /// classical 4 and 6, because of the contact singularity. `rk4-contact`, which integrates each
-/// opening or closing contact along its path, recovers order 3.3 (between 3 and 4.2 asserted).
+/// opening or closing contact along its path, recovers order 3.3 (between 3 and 4.2 asserted),
+/// `rkn4-contact`, the three-stage Nyström method with the same correction, measures 2.8 (slopes
+/// 2.9, 2.7, 3.0): its errors are 2.4 times smaller than `rk4-contact`'s at dt = 0.08 and equal
+/// at 0.01, with three force evaluations per step instead of four.
 /// A single scalar such as E_tr converges too irregularly (kink errors of either sign partly cancel) to fit a slope to.
 #[test]
 fn convergence_orders_on_the_hertz_chain() {
@@ -111,6 +115,7 @@ fn convergence_orders_on_the_hertz_chain() {
         (Method::Yoshida4, 2.0, 3.2),
         (Method::Yoshida6, 2.0, 3.2),
         (Method::Rk4Contact, 3.0, 4.2),
+        (Method::Rkn4Contact, 2.6, 4.2),
     ] {
         let errs: Vec<f64> = dts.iter().map(|&dt| error(method, dt)).collect();
         let p = fitted_order(&dts, &errs);

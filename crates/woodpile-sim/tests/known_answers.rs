@@ -5,8 +5,8 @@
 
 use woodpile_sim::energy::{total_energy, total_momentum};
 use woodpile_sim::integrate::{
-    drive, Dop853, DriveConfig, ExplicitRk, Rk4, StepControl, Stepper, SymplecticStepper, VERLET,
-    YOSHIDA4, YOSHIDA6,
+    drive, Dop853, DriveConfig, ExplicitRk, Rk4, Rkn4, StepControl, Stepper, SymplecticStepper,
+    VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Model, Window};
 use woodpile_sim::testing::{fitted_order, linear_oscillator, two_bead_collision};
@@ -25,6 +25,7 @@ fn fixed(t_end: f64, dt: f64) -> DriveConfig {
 fn fixed_steppers(model: &Model) -> Vec<(Box<dyn Stepper>, f64)> {
     vec![
         (Box::new(ExplicitRk::<Rk4>::new(model)), 4.0),
+        (Box::new(Rkn4::new(model)), 4.0),
         (Box::new(SymplecticStepper::new(model, VERLET)), 2.0),
         (Box::new(SymplecticStepper::new(model, YOSHIDA4)), 4.0),
         (Box::new(SymplecticStepper::new(model, YOSHIDA6)), 6.0),

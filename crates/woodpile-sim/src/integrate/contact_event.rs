@@ -179,21 +179,6 @@ pub(crate) fn rk4_quadrature(stage_forces: [f64; 4], h: f64) -> (f64, f64) {
     )
 }
 
-/// Whether a bond's contact changed state during a step: its stage forces and end overlap do
-/// not all agree on "touching". Bonds that stay open (the whole quiet chain) or stay closed
-/// (smooth force) need no correction.
-#[inline(always)]
-pub(crate) fn changes_contact(stage_forces: [f64; 4], d_end: f64) -> bool {
-    let touching = [
-        stage_forces[0] > 0.0,
-        stage_forces[1] > 0.0,
-        stage_forces[2] > 0.0,
-        stage_forces[3] > 0.0,
-        d_end > 0.0,
-    ];
-    touching.iter().any(|&t| t) && !touching.iter().all(|&t| t)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -269,13 +254,5 @@ mod tests {
             rate1: 0.0,
         };
         assert_eq!(path_integrals(&path, 0.1), (0.0, 0.0));
-    }
-
-    #[test]
-    fn contact_changes_are_detected_only_at_sign_changes() {
-        assert!(!changes_contact([0.0; 4], 0.0));
-        assert!(!changes_contact([1.0, 2.0, 2.0, 1.0], 0.5));
-        assert!(changes_contact([0.0, 0.1, 0.1, 0.2], 0.3));
-        assert!(changes_contact([0.1, 0.1, 0.1, 0.2], -0.3));
     }
 }

@@ -2,8 +2,8 @@
 //! and step control for one model. `method = "auto"` lives here.
 
 use super::{
-    drive, Dop853, DriveConfig, Observer, Rk4Fused, Stats, StepControl, SymplecticStepper, VERLET,
-    YOSHIDA4, YOSHIDA6,
+    drive, Dop853, DriveConfig, Observer, Rk4Fused, Rkn4, Stats, StepControl, SymplecticStepper,
+    VERLET, YOSHIDA4, YOSHIDA6,
 };
 use crate::error::SimError;
 use crate::model::Model;
@@ -16,6 +16,9 @@ pub enum Method {
     /// RK4 whose step integrates each Hertz contact that opens or closes inside it along the
     /// contact's path (see `integrate::contact_event`): the kink no longer limits the order.
     Rk4Contact,
+    /// Nyström's three-stage Runge–Kutta–Nyström method of order 4 with the same exact contact
+    /// events (`integrate::rkn4`): three force evaluations per step where RK4 needs four.
+    Rkn4Contact,
     /// Störmer–Verlet, order 2, symplectic, fixed step.
     Verlet,
     /// Triple-jump composition of Verlet, order 4, symplectic, fixed step.
@@ -28,9 +31,10 @@ pub enum Method {
 
 impl Method {
     /// Every method, in a stable order.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 7] = [
         Method::Rk4,
         Method::Rk4Contact,
+        Method::Rkn4Contact,
         Method::Verlet,
         Method::Yoshida4,
         Method::Yoshida6,
@@ -42,6 +46,7 @@ impl Method {
         match self {
             Method::Rk4 => "rk4",
             Method::Rk4Contact => "rk4-contact",
+            Method::Rkn4Contact => "rkn4-contact",
             Method::Verlet => "verlet",
             Method::Yoshida4 => "yoshida4",
             Method::Yoshida6 => "yoshida6",
@@ -58,7 +63,7 @@ impl Method {
     pub fn order(self) -> u32 {
         match self {
             Method::Verlet => 2,
-            Method::Rk4 | Method::Rk4Contact | Method::Yoshida4 => 4,
+            Method::Rk4 | Method::Rk4Contact | Method::Rkn4Contact | Method::Yoshida4 => 4,
             Method::Yoshida6 => 6,
             Method::Dop853 => 8,
         }
@@ -80,7 +85,7 @@ impl Method {
         match self {
             Method::Rk4 | Method::Rk4Contact => 4,
             Method::Verlet => 1,
-            Method::Yoshida4 => 3,
+            Method::Yoshida4 | Method::Rkn4Contact => 3,
             Method::Yoshida6 => 7,
             Method::Dop853 => 12,
         }
@@ -92,6 +97,8 @@ impl Method {
     pub fn stability_limit(self) -> f64 {
         match self {
             Method::Rk4 | Method::Rk4Contact => 2.0 * std::f64::consts::SQRT_2,
+            // The spectral radius of one step on the oscillator exceeds 1 past 2.5867 (computed).
+            Method::Rkn4Contact => 2.586,
             Method::Verlet => 2.0,
             Method::Yoshida4 => 1.57,
             Method::Yoshida6 => 1.0,
@@ -157,6 +164,12 @@ fn error_model(method: Method) -> ErrorModel {
     match method {
         Method::Rk4Contact => ErrorModel {
             coef: 1.56e-2,
+            order: 3.0,
+        },
+        // A third of rk4-contact's: its R and T errors on the standard scene are 3 to 4 times
+        // smaller at every step from 0.02 to 0.1.
+        Method::Rkn4Contact => ErrorModel {
+            coef: 5.2e-3,
             order: 3.0,
         },
         Method::Verlet => ErrorModel {
@@ -331,6 +344,13 @@ impl Plan {
             Method::Rk4Contact => drive(
                 model,
                 &mut Rk4Fused::with_contact_events(model),
+                y,
+                &cfg,
+                observer,
+            ),
+            Method::Rkn4Contact => drive(
+                model,
+                &mut Rkn4::with_contact_events(model),
                 y,
                 &cfg,
                 observer,

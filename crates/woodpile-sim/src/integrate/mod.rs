@@ -6,7 +6,8 @@
 //! numerics never know who is watching.
 //!
 //! Methods (see [`Method`]): RK4 (the paper's), RK4 with exact contact events (`rk4-contact`,
-//! [`contact_event`]), Störmer–Verlet and its symplectic compositions
+//! [`contact_event`]), Nyström's three-stage order-4 method with the same events
+//! (`rkn4-contact`), Störmer–Verlet and its symplectic compositions
 //! of order 4 and 6, and the adaptive Dormand–Prince 8(5,3).
 //!
 //! Comparisons are written `!(x <= limit)` on purpose: a NaN must fail them.
@@ -14,15 +15,18 @@
 
 mod contact_event;
 mod dop853;
+mod event_correction;
 mod method;
 mod rk;
 mod rk4_fused;
+mod rkn4;
 mod symplectic;
 
 pub use dop853::Dop853;
 pub use method::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD, BLOW_UP_DRIFT, DRIFT_PER_TOL};
 pub use rk::{ExplicitRk, Rk4, Tableau};
 pub use rk4_fused::Rk4Fused;
+pub use rkn4::Rkn4;
 pub use symplectic::{Composition, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6};
 
 use crate::energy::total_energy;

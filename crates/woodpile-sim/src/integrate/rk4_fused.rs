@@ -10,9 +10,10 @@
 //! each stage's bond forces and, after the step, replaces RK4's quadrature of every bond whose
 //! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
-use super::contact_event::{changes_contact, path_integrals, rk4_quadrature, BondPath};
+use super::contact_event::rk4_quadrature;
+use super::event_correction::{ContactEvents, StepEnds};
 use super::{StepOutcome, Stepper};
-use crate::model::{Boundary, Model, Window};
+use crate::model::{Model, Window};
 
 const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
 /// a_{i+1, i} of the tableau: the weight of stage i in stage i + 1.
@@ -32,21 +33,7 @@ pub struct Rk4Fused {
     y_new: Vec<f64>,
     evals: u64,
     /// For `rk4-contact`: the bond forces of each stage (see [`ContactEvents`]).
-    contact: Option<ContactEvents>,
-}
-
-/// What `rk4-contact` keeps per step to correct the bonds whose contact opened or closed:
-/// every bond force of the four stages (indexing of [`Model::accelerations_recording`]) and
-/// the corrections found, applied after the scan so that each uses the uncorrected step.
-#[derive(Debug, Clone)]
-struct ContactEvents {
-    stage_force: [Vec<f64>; 4],
-    /// (left site or None for a wall, right site or None, impulse, position) corrections.
-    pending: Vec<(Option<usize>, Option<usize>, f64, f64)>,
-    /// Bonds corrected so far.
-    events: u64,
-    /// Scratch: window offsets of the bonds that changed contact in this step.
-    changed: Vec<usize>,
+    contact: Option<ContactEvents<4>>,
 }
 
 impl Rk4Fused {
@@ -66,40 +53,22 @@ impl Rk4Fused {
     /// `rk4-contact`: the same RK4, plus the exact integral of every contact force across the
     /// step in which that contact opens or closes ([`super::contact_event`]).
     pub fn with_contact_events(model: &Model) -> Self {
-        let bonds = model.n_sites() + 1;
         Self {
-            contact: Some(ContactEvents {
-                stage_force: std::array::from_fn(|_| vec![0.0; bonds]),
-                pending: Vec::new(),
-                events: 0,
-                changed: Vec::new(),
-            }),
+            contact: Some(ContactEvents::new(model, rk4_quadrature)),
             ..Self::new(model)
         }
     }
 
     /// Bonds whose contact changed state inside a step and were corrected (0 for plain RK4).
     pub fn contact_events(&self) -> u64 {
-        self.contact.as_ref().map_or(0, |c| c.events)
+        self.contact.as_ref().map_or(0, ContactEvents::events)
     }
-}
-
-/// Largest contact force for which an opening or closing is left to RK4: the correction of
-/// such a bond is below |force| h, under 1e-15 in a dimensionless chain struck at unit
-/// velocity. Four in five contact changes on the paper's scenes are grazing touches of the
-/// quiet chain behind the wave, with forces below 1e-16; skipping them changes no fraction by
-/// more than 1e-16 and saves most of the correction's cost.
-const NEGLIGIBLE_FORCE: f64 = 1e-14;
-
-fn negligible(stage_forces: [f64; 4], d_end: f64) -> bool {
-    let end = d_end.max(0.0);
-    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end * end.sqrt() < NEGLIGIBLE_FORCE
 }
 
 /// Stage accelerations, recording the bond forces when `contact` events are corrected.
 fn stage_accelerations(
     model: &Model,
-    contact: &mut Option<ContactEvents>,
+    contact: &mut Option<ContactEvents<4>>,
     (q_stage, a_stage): (&[f64], &mut [f64]),
     (t, stage): (f64, usize),
     window: Window,
@@ -190,8 +159,12 @@ impl Stepper for Rk4Fused {
             }
         }
         self.evals += 4;
-        if self.contact.is_some() {
-            self.correct_contact_events(model, y, h, window);
+        if let Some(contact) = self.contact.as_mut() {
+            let ends = StepEnds {
+                start: y,
+                end: &mut self.y_new,
+            };
+            contact.correct(model, ends, h, window);
         }
         let (new_q, new_v) = self.y_new.split_at(n);
         let (q, v) = y.split_at_mut(n);
@@ -208,112 +181,5 @@ impl Stepper for Rk4Fused {
 
     fn rhs_evals(&self) -> u64 {
         self.evals
-    }
-}
-
-impl Rk4Fused {
-    /// Replaces RK4's quadrature by the path integral for every bond of `window` whose contact
-    /// opened or closed during the step from `y` to `self.y_new` (not yet copied back).
-    fn correct_contact_events(&mut self, model: &Model, y: &[f64], h: f64, window: Window) {
-        let Some(contact) = self.contact.as_mut() else {
-            return;
-        };
-        let n = model.n_dof();
-        let n_sites = model.n_sites();
-        let (q, v) = y.split_at(n);
-        let (new_q, new_v) = self.y_new.split_at_mut(n);
-        let forces = &contact.stage_force;
-        let stage_forces = |bond: usize| {
-            [
-                forces[0][bond],
-                forces[1][bond],
-                forces[2][bond],
-                forces[3][bond],
-            ]
-        };
-        // Overlap and rate of a bond from (positions, velocities): left minus right member.
-        let member = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
-        let mut pending = std::mem::take(&mut contact.pending);
-        pending.clear();
-        let mut correct = |bond: usize, left: Option<usize>, right: Option<usize>| {
-            let stage = stage_forces(bond);
-            let d_end = member(new_q, left) - member(new_q, right);
-            if !changes_contact(stage, d_end) || negligible(stage, d_end) {
-                return;
-            }
-            let path = BondPath {
-                d0: member(q, left) - member(q, right),
-                rate0: member(v, left) - member(v, right),
-                d1: d_end,
-                rate1: member(new_v, left) - member(new_v, right),
-            };
-            let (impulse, moment) = path_integrals(&path, h);
-            let (q0, q1) = rk4_quadrature(stage, h);
-            pending.push((left, right, impulse - q0, moment - q1));
-        };
-        // The scan over the window's bonds is the only per-bond cost; it touches the stage
-        // forces and end positions in order and calls out only for the rare bond that changed.
-        let (lo, hi) = (window.lo, window.hi);
-        let bonds = lo + 1..hi + 1;
-        let (f0, f1, f2, f3) = (
-            &forces[0][bonds.clone()],
-            &forces[1][bonds.clone()],
-            &forces[2][bonds.clone()],
-            &forces[3][bonds],
-        );
-        let (left_q, right_q) = (&new_q[lo..hi], &new_q[lo + 1..hi + 1]);
-        // A bond changed contact when between one and four of its five values say "touching"
-        // (`changes_contact`, written out here so that it vectorises).
-        // The test runs branch-free over blocks of eight bonds (it vectorises); only a block
-        // holding a changed bond, which is rare, is looked at bond by bond.
-        let changed_at = |i: usize| {
-            let touching = u8::from(f0[i] > 0.0)
-                + u8::from(f1[i] > 0.0)
-                + u8::from(f2[i] > 0.0)
-                + u8::from(f3[i] > 0.0)
-                + u8::from(left_q[i] - right_q[i] > 0.0);
-            touching.wrapping_sub(1) < 4
-        };
-        let changed = &mut contact.changed;
-        changed.clear();
-        let n_bonds = hi - lo;
-        const BLOCK: usize = 8;
-        let mut start = 0;
-        while start < n_bonds {
-            let end = (start + BLOCK).min(n_bonds);
-            let mut any = false;
-            for i in start..end {
-                any |= changed_at(i);
-            }
-            if any {
-                changed.extend((start..end).filter(|&i| changed_at(i)));
-            }
-            start = end;
-        }
-        for &i in changed.iter() {
-            correct(lo + i + 1, Some(lo + i), Some(lo + i + 1));
-        }
-        if model.boundary() == Boundary::Fixed {
-            if lo == 0 {
-                correct(0, None, Some(0));
-            }
-            if hi == n_sites - 1 {
-                correct(n_sites, Some(n_sites - 1), None);
-            }
-        }
-        // The bond pushes its left member back and its right member on.
-        let inv_mass = model.inv_mass();
-        for &(left, right, impulse, moment) in &pending {
-            if let Some(i) = left {
-                new_v[i] -= impulse * inv_mass[i];
-                new_q[i] -= moment * inv_mass[i];
-            }
-            if let Some(i) = right {
-                new_v[i] += impulse * inv_mass[i];
-                new_q[i] += moment * inv_mass[i];
-            }
-        }
-        contact.events += pending.len() as u64;
-        contact.pending = pending;
     }
 }

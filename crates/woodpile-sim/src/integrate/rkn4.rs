@@ -1,0 +1,177 @@
+//! Nyström's three-stage Runge–Kutta–Nyström method of order 4, for q'' = a(q):
+//!
+//! ```text
+//! Q1 = q,                      a1 = a(Q1)
+//! Q2 = q + h/2 v + h²/8 a1,    a2 = a(Q2)
+//! Q3 = q + h v + h²/2 a2,      a3 = a(Q3)
+//! q+ = q + h v + h² (a1/6 + a2/3)
+//! v+ = v + h (a1/6 + 2 a2/3 + a3/6)
+//! ```
+//!
+//! Why: the chain's equations have no velocity in the force, so a Nyström method reaches
+//! order 4 with three force evaluations where classical RK4 spends four. The force's square
+//! roots are what a step costs (README "Speed"), so a step is about a quarter cheaper, and on
+//! the paper's scenes its R and T errors are also smaller than RK4's at the same step.
+//!
+//! `rkn4-contact` ([`Rkn4::with_contact_events`]) adds the exact contact events of
+//! `rk4-contact` ([`super::contact_event`]), with this method's quadrature in place of RK4's.
+
+use super::event_correction::{ContactEvents, StepEnds};
+use super::{StepOutcome, Stepper};
+use crate::model::{Model, Window};
+
+/// Stage times c_i.
+const C: [f64; 3] = [0.0, 0.5, 1.0];
+
+/// RKN4 with its scratch (allocated once).
+#[derive(Debug, Clone)]
+pub struct Rkn4 {
+    /// The position at which the next force is evaluated.
+    q_stage: Vec<f64>,
+    /// The three stage accelerations.
+    a: [Vec<f64>; 3],
+    /// The new state being assembled, `[q, q']`.
+    y_new: Vec<f64>,
+    evals: u64,
+    /// For `rkn4-contact`: the bond forces of each stage.
+    contact: Option<ContactEvents<3>>,
+}
+
+/// RKN4's quadrature of a bond force from its stage values:
+/// `(h (F1/6 + 2 F2/3 + F3/6), h² (F1/6 + F2/3))`.
+pub(crate) fn rkn4_quadrature(stage_forces: [f64; 3], h: f64) -> (f64, f64) {
+    let [f1, f2, f3] = stage_forces;
+    (
+        h * (f1 / 6.0 + 2.0 * f2 / 3.0 + f3 / 6.0),
+        h * h * (f1 / 6.0 + f2 / 3.0),
+    )
+}
+
+impl Rkn4 {
+    /// A stepper for states of `model`.
+    pub fn new(model: &Model) -> Self {
+        let n = model.n_dof();
+        Self {
+            q_stage: vec![0.0; n],
+            a: std::array::from_fn(|_| vec![0.0; n]),
+            y_new: vec![0.0; 2 * n],
+            evals: 0,
+            contact: None,
+        }
+    }
+
+    /// `rkn4-contact`: the same method plus the exact integral of every contact force across
+    /// the step in which that contact opens or closes.
+    pub fn with_contact_events(model: &Model) -> Self {
+        Self {
+            contact: Some(ContactEvents::new(model, rkn4_quadrature)),
+            ..Self::new(model)
+        }
+    }
+
+    /// Bonds whose contact changed state inside a step and were corrected (0 for plain RKN4).
+    pub fn contact_events(&self) -> u64 {
+        self.contact.as_ref().map_or(0, ContactEvents::events)
+    }
+
+    /// Stage `stage`'s accelerations at `self.q_stage`, recording the bond forces when
+    /// contact events are corrected.
+    fn stage_accelerations(&mut self, model: &Model, t: f64, stage: usize, window: Window) {
+        let acc = &mut self.a[stage];
+        match &mut self.contact {
+            None => model.accelerations_in(t, &self.q_stage, acc, window),
+            Some(c) => model.accelerations_recording(
+                t,
+                &self.q_stage,
+                acc,
+                window,
+                &mut c.stage_force[stage],
+            ),
+        }
+    }
+}
+
+impl Stepper for Rkn4 {
+    fn name(&self) -> &'static str {
+        if self.contact.is_some() {
+            "rkn4-contact"
+        } else {
+            "rkn4"
+        }
+    }
+
+    fn step(
+        &mut self,
+        model: &Model,
+        t: f64,
+        y: &mut [f64],
+        h: f64,
+        window: Window,
+    ) -> StepOutcome {
+        let n = model.n_dof();
+        let ranges = window.dof_ranges(model);
+        for r in ranges.clone() {
+            self.q_stage[r.clone()].copy_from_slice(&y[r]);
+        }
+        self.stage_accelerations(model, t, 0, window);
+        // Q2 from a1, Q3 from a2: Q = q + (cv) v + (ca) a_previous.
+        for (stage, (cv, ca)) in [(0.5 * h, h * h / 8.0), (h, h * h / 2.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let (q, v) = y.split_at(n);
+            for r in ranges.clone() {
+                let len = r.len();
+                let qs = &mut self.q_stage[r.clone()][..len];
+                let (q0, v0) = (&q[r.clone()][..len], &v[r.clone()][..len]);
+                let a = &self.a[stage][r][..len];
+                for i in 0..len {
+                    qs[i] = q0[i] + cv * v0[i] + ca * a[i];
+                }
+            }
+            self.stage_accelerations(model, t + C[stage + 1] * h, stage + 1, window);
+        }
+        self.evals += 3;
+        let (q, v) = y.split_at(n);
+        let (new_q, new_v) = self.y_new.split_at_mut(n);
+        let (bq1, bq2) = (h * h / 6.0, h * h / 3.0);
+        let (bv1, bv2, bv3) = (h / 6.0, 2.0 * h / 3.0, h / 6.0);
+        for r in ranges.clone() {
+            let len = r.len();
+            let (a1, a2, a3) = (
+                &self.a[0][r.clone()][..len],
+                &self.a[1][r.clone()][..len],
+                &self.a[2][r.clone()][..len],
+            );
+            let (q0, v0) = (&q[r.clone()][..len], &v[r.clone()][..len]);
+            let nq = &mut new_q[r.clone()][..len];
+            let nv = &mut new_v[r][..len];
+            for i in 0..len {
+                nq[i] = q0[i] + h * v0[i] + (bq1 * a1[i] + bq2 * a2[i]);
+                nv[i] = v0[i] + (bv1 * a1[i] + bv2 * a2[i] + bv3 * a3[i]);
+            }
+        }
+        if let Some(contact) = self.contact.as_mut() {
+            let ends = StepEnds {
+                start: y,
+                end: &mut self.y_new,
+            };
+            contact.correct(model, ends, h, window);
+        }
+        let (new_q, new_v) = self.y_new.split_at(n);
+        let (q, v) = y.split_at_mut(n);
+        for r in ranges {
+            q[r.clone()].copy_from_slice(&new_q[r.clone()]);
+            v[r.clone()].copy_from_slice(&new_v[r]);
+        }
+        StepOutcome::Accepted { h_next: h }
+    }
+
+    fn reach(&self) -> usize {
+        3
+    }
+
+    fn rhs_evals(&self) -> u64 {
+        self.evals
+    }
+}
