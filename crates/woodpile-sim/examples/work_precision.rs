@@ -67,6 +67,7 @@ fn main() {
     for m in [
         Method::Rk4,
         Method::Rk4Contact,
+        Method::Rkn4Contact,
         Method::Verlet,
         Method::Yoshida4,
         Method::Yoshida6,

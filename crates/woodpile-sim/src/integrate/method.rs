@@ -170,7 +170,7 @@ fn error_model(method: Method) -> ErrorModel {
         // smaller at every step from 0.02 to 0.1.
         Method::Rkn4Contact => ErrorModel {
             coef: 5.2e-3,
-            order: 3.0,
+            order: 2.8,
         },
         Method::Verlet => ErrorModel {
             coef: 1.5e-2,
