@@ -50,7 +50,7 @@ pub(crate) struct ContactEvents<const S: usize> {
 }
 
 /// A step's start and end states, `[q, q']` each (the end not yet corrected).
-pub(crate) struct StepEnds<'a> {
+struct StepEnds<'a> {
     pub start: &'a [f64],
     pub end: &'a mut [f64],
 }
@@ -75,7 +75,7 @@ impl<const S: usize> ContactEvents<S> {
 
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
     /// contact opened or closed during the step of size `h` from `ends.start` to `ends.end`.
-    pub fn correct(&mut self, model: &Model, ends: StepEnds<'_>, h: f64, window: Window) {
+    fn correct(&mut self, model: &Model, ends: StepEnds<'_>, h: f64, window: Window) {
         let n = model.n_dof();
         let n_sites = model.n_sites();
         let (q, v) = ends.start.split_at(n);
@@ -160,6 +160,31 @@ impl<const S: usize> ContactEvents<S> {
         }
         self.events += pending.len() as u64;
         self.pending = pending;
+    }
+}
+
+/// Ends a step of a method that can correct contact events: corrects `y_new` (the new state,
+/// `[q, q']`) if `contact` events are kept, then copies it into `y` over `window`.
+pub(crate) fn finish_step<const S: usize>(
+    contact: Option<&mut ContactEvents<S>>,
+    model: &Model,
+    (y, y_new): (&mut [f64], &mut [f64]),
+    h: f64,
+    window: Window,
+) {
+    if let Some(contact) = contact {
+        let ends = StepEnds {
+            start: y,
+            end: y_new,
+        };
+        contact.correct(model, ends, h, window);
+    }
+    let n = model.n_dof();
+    let (new_q, new_v) = y_new.split_at(n);
+    let (q, v) = y.split_at_mut(n);
+    for r in window.dof_ranges(model) {
+        q[r.clone()].copy_from_slice(&new_q[r.clone()]);
+        v[r.clone()].copy_from_slice(&new_v[r]);
     }
 }
 

@@ -11,7 +11,7 @@
 //! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
 use super::contact_event::rk4_quadrature;
-use super::event_correction::{ContactEvents, StepEnds};
+use super::event_correction::{finish_step, ContactEvents};
 use super::{StepOutcome, Stepper};
 use crate::model::{Model, Window};
 
@@ -159,19 +159,13 @@ impl Stepper for Rk4Fused {
             }
         }
         self.evals += 4;
-        if let Some(contact) = self.contact.as_mut() {
-            let ends = StepEnds {
-                start: y,
-                end: &mut self.y_new,
-            };
-            contact.correct(model, ends, h, window);
-        }
-        let (new_q, new_v) = self.y_new.split_at(n);
-        let (q, v) = y.split_at_mut(n);
-        for r in ranges {
-            q[r.clone()].copy_from_slice(&new_q[r.clone()]);
-            v[r.clone()].copy_from_slice(&new_v[r]);
-        }
+        finish_step(
+            self.contact.as_mut(),
+            model,
+            (y, &mut self.y_new),
+            h,
+            window,
+        );
         StepOutcome::Accepted { h_next: h }
     }
 

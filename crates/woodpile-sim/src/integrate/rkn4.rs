@@ -16,7 +16,7 @@
 //! `rkn4-contact` ([`Rkn4::with_contact_events`]) adds the exact contact events of
 //! `rk4-contact` ([`super::contact_event`]), with this method's quadrature in place of RK4's.
 
-use super::event_correction::{ContactEvents, StepEnds};
+use super::event_correction::{finish_step, ContactEvents};
 use super::{StepOutcome, Stepper};
 use crate::model::{Model, Window};
 
@@ -151,19 +151,13 @@ impl Stepper for Rkn4 {
                 nv[i] = v0[i] + (bv1 * a1[i] + bv2 * a2[i] + bv3 * a3[i]);
             }
         }
-        if let Some(contact) = self.contact.as_mut() {
-            let ends = StepEnds {
-                start: y,
-                end: &mut self.y_new,
-            };
-            contact.correct(model, ends, h, window);
-        }
-        let (new_q, new_v) = self.y_new.split_at(n);
-        let (q, v) = y.split_at_mut(n);
-        for r in ranges {
-            q[r.clone()].copy_from_slice(&new_q[r.clone()]);
-            v[r.clone()].copy_from_slice(&new_v[r]);
-        }
+        finish_step(
+            self.contact.as_mut(),
+            model,
+            (y, &mut self.y_new),
+            h,
+            window,
+        );
         StepOutcome::Accepted { h_next: h }
     }
 
