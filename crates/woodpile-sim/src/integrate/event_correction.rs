@@ -39,7 +39,7 @@ fn negligible<const S: usize>(stage_forces: [f64; S], d_end: f64) -> bool {
 #[derive(Debug, Clone)]
 pub(crate) struct ContactEvents<const S: usize> {
     /// The bond forces of each stage, written by [`Model::accelerations_recording`].
-    pub stage_force: [Vec<f64>; S],
+    stage_force: [Vec<f64>; S],
     quadrature: Quadrature<S>,
     /// (left site or None for a wall, right site or None, impulse, position) corrections.
     pending: Vec<(Option<usize>, Option<usize>, f64, f64)>,
@@ -47,12 +47,6 @@ pub(crate) struct ContactEvents<const S: usize> {
     events: u64,
     /// Scratch: window offsets of the bonds that changed contact in this step.
     changed: Vec<usize>,
-}
-
-/// A step's start and end states, `[q, q']` each (the end not yet corrected).
-struct StepEnds<'a> {
-    pub start: &'a [f64],
-    pub end: &'a mut [f64],
 }
 
 impl<const S: usize> ContactEvents<S> {
@@ -74,12 +68,19 @@ impl<const S: usize> ContactEvents<S> {
     }
 
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
-    /// contact opened or closed during the step of size `h` from `ends.start` to `ends.end`.
-    fn correct(&mut self, model: &Model, ends: StepEnds<'_>, h: f64, window: Window) {
+    /// contact opened or closed during the step of size `h` from `start` to `end` (states
+    /// `[q, q']`, the end not yet corrected).
+    fn correct(
+        &mut self,
+        model: &Model,
+        (start, end): (&[f64], &mut [f64]),
+        h: f64,
+        window: Window,
+    ) {
         let n = model.n_dof();
         let n_sites = model.n_sites();
-        let (q, v) = ends.start.split_at(n);
-        let (new_q, new_v) = ends.end.split_at_mut(n);
+        let (q, v) = start.split_at(n);
+        let (new_q, new_v) = end.split_at_mut(n);
         let forces = &self.stage_force;
         let quadrature = self.quadrature;
         let stage_forces = |bond: usize| -> [f64; S] { std::array::from_fn(|s| forces[s][bond]) };
@@ -163,6 +164,21 @@ impl<const S: usize> ContactEvents<S> {
     }
 }
 
+/// Stage `stage`'s accelerations `acc` at positions `q`, recording every bond force into
+/// `contact` when a contact-event method keeps them.
+pub(crate) fn stage_accelerations<const S: usize>(
+    model: &Model,
+    contact: Option<&mut ContactEvents<S>>,
+    (q, acc): (&[f64], &mut [f64]),
+    (t, stage): (f64, usize),
+    window: Window,
+) {
+    match contact {
+        None => model.accelerations_in(t, q, acc, window),
+        Some(c) => model.accelerations_recording(t, q, acc, window, &mut c.stage_force[stage]),
+    }
+}
+
 /// Ends a step of a method that can correct contact events: corrects `y_new` (the new state,
 /// `[q, q']`) if `contact` events are kept, then copies it into `y` over `window`.
 pub(crate) fn finish_step<const S: usize>(
@@ -173,11 +189,7 @@ pub(crate) fn finish_step<const S: usize>(
     window: Window,
 ) {
     if let Some(contact) = contact {
-        let ends = StepEnds {
-            start: y,
-            end: y_new,
-        };
-        contact.correct(model, ends, h, window);
+        contact.correct(model, (y, y_new), h, window);
     }
     let n = model.n_dof();
     let (new_q, new_v) = y_new.split_at(n);

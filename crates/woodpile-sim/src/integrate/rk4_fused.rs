@@ -11,7 +11,7 @@
 //! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
 use super::contact_event::rk4_quadrature;
-use super::event_correction::{finish_step, ContactEvents};
+use super::event_correction::{finish_step, stage_accelerations, ContactEvents};
 use super::{StepOutcome, Stepper};
 use crate::model::{Model, Window};
 
@@ -65,22 +65,6 @@ impl Rk4Fused {
     }
 }
 
-/// Stage accelerations, recording the bond forces when `contact` events are corrected.
-fn stage_accelerations(
-    model: &Model,
-    contact: &mut Option<ContactEvents<4>>,
-    (q_stage, a_stage): (&[f64], &mut [f64]),
-    (t, stage): (f64, usize),
-    window: Window,
-) {
-    match contact {
-        None => model.accelerations_in(t, q_stage, a_stage, window),
-        Some(c) => {
-            model.accelerations_recording(t, q_stage, a_stage, window, &mut c.stage_force[stage])
-        }
-    }
-}
-
 impl Stepper for Rk4Fused {
     fn name(&self) -> &'static str {
         if self.contact.is_some() {
@@ -113,7 +97,7 @@ impl Stepper for Rk4Fused {
         }
         stage_accelerations(
             model,
-            &mut self.contact,
+            self.contact.as_mut(),
             (&self.q_stage, &mut self.a_stage),
             (t, 0),
             window,
@@ -151,7 +135,7 @@ impl Stepper for Rk4Fused {
             if stage < 3 {
                 stage_accelerations(
                     model,
-                    &mut self.contact,
+                    self.contact.as_mut(),
                     (&self.q_stage, &mut self.a_stage),
                     (t + C[stage + 1] * h, stage + 1),
                     window,

@@ -16,7 +16,7 @@
 //! `rkn4-contact` ([`Rkn4::with_contact_events`]) adds the exact contact events of
 //! `rk4-contact` ([`super::contact_event`]), with this method's quadrature in place of RK4's.
 
-use super::event_correction::{finish_step, ContactEvents};
+use super::event_correction::{finish_step, stage_accelerations, ContactEvents};
 use super::{StepOutcome, Stepper};
 use crate::model::{Model, Window};
 
@@ -73,22 +73,6 @@ impl Rkn4 {
     pub fn contact_events(&self) -> u64 {
         self.contact.as_ref().map_or(0, ContactEvents::events)
     }
-
-    /// Stage `stage`'s accelerations at `self.q_stage`, recording the bond forces when
-    /// contact events are corrected.
-    fn stage_accelerations(&mut self, model: &Model, t: f64, stage: usize, window: Window) {
-        let acc = &mut self.a[stage];
-        match &mut self.contact {
-            None => model.accelerations_in(t, &self.q_stage, acc, window),
-            Some(c) => model.accelerations_recording(
-                t,
-                &self.q_stage,
-                acc,
-                window,
-                &mut c.stage_force[stage],
-            ),
-        }
-    }
 }
 
 impl Stepper for Rkn4 {
@@ -113,7 +97,13 @@ impl Stepper for Rkn4 {
         for r in ranges.clone() {
             self.q_stage[r.clone()].copy_from_slice(&y[r]);
         }
-        self.stage_accelerations(model, t, 0, window);
+        stage_accelerations(
+            model,
+            self.contact.as_mut(),
+            (&self.q_stage, &mut self.a[0]),
+            (t, 0),
+            window,
+        );
         // Q2 from a1, Q3 from a2: Q = q + (cv) v + (ca) a_previous.
         for (stage, (cv, ca)) in [(0.5 * h, h * h / 8.0), (h, h * h / 2.0)]
             .into_iter()
@@ -129,7 +119,13 @@ impl Stepper for Rkn4 {
                     qs[i] = q0[i] + cv * v0[i] + ca * a[i];
                 }
             }
-            self.stage_accelerations(model, t + C[stage + 1] * h, stage + 1, window);
+            stage_accelerations(
+                model,
+                self.contact.as_mut(),
+                (&self.q_stage, &mut self.a[stage + 1]),
+                (t + C[stage + 1] * h, stage + 1),
+                window,
+            );
         }
         self.evals += 3;
         let (q, v) = y.split_at(n);
