@@ -1,68 +1,161 @@
-//! `method = "auto"` on one scene of each of the paper's kinds, against a tight reference
-//! (`rk4-contact` at dt = 0.002, which agrees with RK4 at 0.001 and Yoshida-6 at 5e-4 to about
-//! 1e-10): the step auto accepted, its Richardson estimate, the true error (largest over R, T
-//! and E_tr), whether it met the tolerance, the force evaluations of the whole verification
-//! ladder, and the wall time.
+//! `method = "auto"` against a tight reference, on one scene of each of the paper's kinds or,
+//! with `--survey N`, on N scenes of each sweep kind drawn from the sweeps' grids
+//! ([`sampled_sweep_scenes`]): the step auto accepted, its Richardson estimate, the true error
+//! (largest over R, T and E_tr), whether it met the tolerance, the force evaluations of the whole
+//! verification ladder, and the wall time. The reference is `rk4-contact` at dt = 0.001
+//! (0.00025 for nonlinear resonators), which agrees with RK4 at 0.001 and Yoshida-6 at 5e-4 to
+//! about 1e-10 on the linear scenes.
 //!
 //! ```text
-//! cargo run --release -p woodpile-bench --example auto_accuracy [-- TOLERANCE]
+//! cargo run --release -p woodpile-bench --example auto_accuracy [-- TOL...] [--survey N]
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use std::time::Instant;
+use woodpile_sim::energy::Fractions;
 use woodpile_sim::integrate::{Method, MethodChoice};
-use woodpile_sim::model::Coupling;
 use woodpile_sim::run::simulate;
-use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
-fn pd(site: i64, eps: f64, p: u32) -> PaperDefect {
-    PaperDefect {
-        site,
-        eps,
-        coupling: Coupling::Constant(1.0),
+use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, tolerance, PaperDefect};
+
+fn hand_picked() -> Vec<(String, Vec<PaperDefect>)> {
+    let pd = |site, eps, p| PaperDefect {
         p,
-    }
+        ..PaperDefect::linear(site, eps, 1.0)
+    };
+    vec![
+        ("standard eps=10".into(), vec![pd(0, 10.0, 1)]),
+        (
+            "F4 L=2 eps=0.5".into(),
+            (0..=2).map(|s| pd(s, 0.5, 1)).collect(),
+        ),
+        (
+            "F5 L=9 eps=30".into(),
+            (0..=9).map(|s| pd(s, 30.0, 1)).collect(),
+        ),
+        (
+            "F7 fine (0.1,0.1)".into(),
+            vec![pd(0, 0.1, 1), pd(20, 0.1, 1)],
+        ),
+        (
+            "F7 fine (0.67,0.54)".into(),
+            vec![pd(0, 0.67, 1), pd(20, 0.54, 1)],
+        ),
+        (
+            "F7 coarse (13,100)".into(),
+            vec![pd(0, 13.0, 1), pd(20, 100.0, 1)],
+        ),
+        ("F6 p=3 eps=0.16".into(), vec![pd(0, 0.16, 3)]),
+        ("F6 p=19 eps=0.01".into(), vec![pd(0, 0.01, 19)]),
+    ]
 }
+
+fn largest_difference(a: &Fractions, b: &Fractions) -> f64 {
+    (a.reflected - b.reflected)
+        .abs()
+        .max((a.transmitted - b.transmitted).abs())
+        .max((a.trapped - b.trapped).abs())
+}
+
+/// One auto run against the reference.
+struct Verdict {
+    line: String,
+    missed: bool,
+    error_per_tol: f64,
+    evals: u64,
+    ms: f64,
+}
+
+/// One scene at every tolerance.
+fn survey_scene(name: &str, d: &[PaperDefect], tols: &[f64]) -> Vec<Verdict> {
+    let ref_dt = if d.iter().any(|x| x.p > 1) {
+        0.00025
+    } else {
+        0.001
+    };
+    let reference = simulate(
+        &paper_scene(d, MethodChoice::Named(Method::Rk4Contact), fixed_dt(ref_dt)),
+        &mut (),
+    )
+    .unwrap()
+    .fractions;
+    tols.iter()
+        .map(|&tol| {
+            let t0 = Instant::now();
+            let o = simulate(&paper_scene(d, MethodChoice::Auto, tolerance(tol)), &mut ()).unwrap();
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            let err = largest_difference(&o.fractions, &reference);
+            let line = format!(
+                "tol={tol:.0e} {name:24} dt={:.4} est={:.1e} err={err:.1e} {} evals={} {ms:.1} ms",
+                o.plan.dt().unwrap_or(0.0),
+                o.error_estimate.unwrap_or(0.0),
+                if err <= tol { "ok  " } else { "MISS" },
+                o.total_rhs_evals
+            );
+            Verdict {
+                line,
+                missed: err > tol,
+                error_per_tol: err / tol,
+                evals: o.total_rhs_evals,
+                ms,
+            }
+        })
+        .collect()
+}
+
 fn main() {
-    let tol: f64 = std::env::args()
-        .nth(1)
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(1e-6);
-    let scenes: Vec<(&str, Vec<PaperDefect>)> = vec![
-        ("standard eps=10", vec![pd(0, 10.0, 1)]),
-        ("F4 L=2 eps=0.5", (0..=2).map(|s| pd(s, 0.5, 1)).collect()),
-        ("F5 L=9 eps=30", (0..=9).map(|s| pd(s, 30.0, 1)).collect()),
-        ("F7 fine (0.1,0.1)", vec![pd(0, 0.1, 1), pd(20, 0.1, 1)]),
-        ("F7 fine (0.67,0.54)", vec![pd(0, 0.67, 1), pd(20, 0.54, 1)]),
-        ("F7 coarse (13,100)", vec![pd(0, 13.0, 1), pd(20, 100.0, 1)]),
-        ("F6 p=3 eps=0.16", vec![pd(0, 0.16, 3)]),
-        ("F6 p=19 eps=0.01", vec![pd(0, 0.01, 19)]),
-    ];
-    let (mut tot_ms, mut tot_ev) = (0.0, 0u64);
-    for (name, d) in scenes {
-        let r = simulate(
-            &paper_scene(&d, MethodChoice::Named(Method::Rk4Contact), fixed_dt(0.002)),
-            &mut (),
-        )
-        .unwrap()
-        .fractions;
-        let s = paper_scene(&d, MethodChoice::Auto, tolerance(tol));
-        let t0 = Instant::now();
-        let o = simulate(&s, &mut ()).unwrap();
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
-        let f = o.fractions;
-        let err = (f.reflected - r.reflected)
-            .abs()
-            .max((f.transmitted - r.transmitted).abs())
-            .max((f.trapped - r.trapped).abs());
-        tot_ms += ms;
-        tot_ev += o.total_rhs_evals;
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let survey = args
+        .iter()
+        .position(|a| a == "--survey")
+        .map(|i| args[i + 1].parse::<usize>().unwrap());
+    let mut tols: Vec<f64> = args
+        .iter()
+        .enumerate()
+        .filter(|(i, a)| *a != "--survey" && (*i == 0 || args[i - 1] != "--survey"))
+        .map(|(_, a)| a.parse().unwrap())
+        .collect();
+    if tols.is_empty() {
+        tols.push(1e-6);
+    }
+    let scenes = match survey {
+        Some(n) => sampled_sweep_scenes(n),
+        None => hand_picked(),
+    };
+    // Two workers: the scenes are independent and the machine has two cores.
+    let results: Vec<Vec<Verdict>> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..2)
+            .map(|w| {
+                let (scenes, tols) = (&scenes, &tols);
+                s.spawn(move || {
+                    scenes
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| i % 2 == w)
+                        .map(|(i, (name, d))| (i, survey_scene(name, d, tols)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        let mut all: Vec<_> = workers
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect();
+        all.sort_by_key(|(i, _)| *i);
+        all.into_iter().map(|(_, r)| r).collect()
+    });
+    for (k, tol) in tols.iter().enumerate() {
+        let (mut misses, mut worst, mut evals, mut ms) = (0, 0.0f64, 0u64, 0.0);
+        for r in &results {
+            let v = &r[k];
+            println!("{}", v.line);
+            misses += usize::from(v.missed);
+            worst = worst.max(v.error_per_tol);
+            evals += v.evals;
+            ms += v.ms;
+        }
         println!(
-            "{name:22} dt={:.4} est={:.1e} err={err:.1e} {} evals={} {ms:.1} ms",
-            o.plan.dt().unwrap_or(0.0),
-            o.error_estimate.unwrap_or(0.0),
-            if err <= tol { "ok  " } else { "MISS" },
-            o.total_rhs_evals
+            "tol={tol:.0e}: {} scenes, {misses} missed, worst error {worst:.2} x tol, {evals} evals, {ms:.0} ms\n",
+            results.len()
         );
     }
-    println!("total {tot_ms:.1} ms, {tot_ev} evals");
 }

@@ -31,7 +31,7 @@
 use rayon::prelude::*;
 use serde_json::json;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
-use woodpile_sim::run::{run_with_plan, simulate, Scenario};
+use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
@@ -168,7 +168,16 @@ impl Stability {
                     .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
                     .fractions
                     .trapped;
-                let auto_dt = Plan::dt_for(&scene.scenario.model, AUTO_METHOD, self.tolerance);
+                let auto_plan = Plan::choose(
+                    &scene.scenario.model,
+                    MethodChoice::Auto,
+                    Accuracy {
+                        tolerance: self.tolerance,
+                        ..reference.accuracy
+                    },
+                )
+                .map_err(|e| PipelineError::stage(stage, format!("auto at {v}: {e}")))?;
+                let auto_dt = auto_first_step(&scene.scenario, &auto_plan);
                 Ok((scene, e_ref, auto_dt))
             })
             .collect::<Result<_>>()?;

@@ -89,6 +89,23 @@ impl Resonator {
     pub fn linear_omega(&self, host_mass: f64) -> f64 {
         (self.coupling.max_value() * (1.0 / host_mass + 1.0 / self.eps)).sqrt()
     }
+
+    /// The fastest the pair can vibrate in a motion of total energy `energy`. For p = 1 this
+    /// is [`Resonator::linear_omega`]. For p > 1 the stiffness p kappa a^(p-1) grows with the
+    /// stretch a, and a is bounded by the energy: kappa a^(p+1) / (p+1) <= energy. So this is
+    /// the stiffness at that largest stretch: a bound the run cannot exceed.
+    pub fn omega_within(&self, host_mass: f64, energy: f64) -> f64 {
+        if self.p == 1 {
+            return self.linear_omega(host_mass);
+        }
+        let kappa = self.coupling.max_value();
+        if kappa <= 0.0 {
+            return 0.0;
+        }
+        let p = f64::from(self.p);
+        let stretch = ((p + 1.0) * energy / kappa).powf(1.0 / (p + 1.0));
+        (p * kappa * stretch.powf(p - 1.0) * (1.0 / host_mass + 1.0 / self.eps)).sqrt()
+    }
 }
 
 /// A validated chain with its resonators. Construct with [`Model::new`].
@@ -211,6 +228,16 @@ impl Model {
             .fold(0.0, f64::max)
     }
 
+    /// The fastest resonator frequency a motion of total energy `energy` can reach
+    /// ([`Resonator::omega_within`]): equal to [`Model::max_linear_omega`] when every resonator
+    /// is linear, and a bound on the stiffest moment of a nonlinear one.
+    pub fn max_resonator_omega(&self, energy: f64) -> f64 {
+        self.resonators
+            .iter()
+            .map(|r| r.omega_within(self.site_mass(r.site), energy))
+            .fold(0.0, f64::max)
+    }
+
     /// A state vector at rest: all displacements and velocities zero.
     pub fn rest_state(&self) -> Vec<f64> {
         vec![0.0; self.state_len()]
@@ -304,6 +331,24 @@ mod tests {
             coupling: Coupling::Constant(1.0),
             p,
         }
+    }
+
+    #[test]
+    fn resonator_frequency_within_an_energy() {
+        // Linear: the energy does not matter.
+        let linear = res(0, 0.5, 1);
+        assert_eq!(linear.omega_within(1.0, 123.0), linear.linear_omega(1.0));
+        // p = 3, kappa = 1, eps = 1, host mass 1: the largest stretch holds all the energy,
+        // a^4 / 4 = E, and there the stiffness is 3 a^2, so omega^2 = 3 a^2 (1 + 1).
+        let cubic = res(0, 1.0, 3);
+        let a = (4.0_f64 * 0.5).powf(0.25);
+        let expected = (3.0 * a * a * 2.0).sqrt();
+        assert!((cubic.omega_within(1.0, 0.5) - expected).abs() < 1e-12 * expected);
+        // More energy, a stiffer moment; the model takes the fastest resonator.
+        assert!(cubic.omega_within(1.0, 2.0) > cubic.omega_within(1.0, 0.5));
+        let model = Model::new(5, Boundary::Fixed, vec![linear, res(3, 1.0, 3)]).unwrap();
+        let fastest = linear.linear_omega(1.0).max(expected);
+        assert_eq!(model.max_resonator_omega(0.5), fastest);
     }
 
     #[test]

@@ -39,6 +39,15 @@ pub struct Scenario {
     pub sample_every: f64,
 }
 
+impl Scenario {
+    /// The energy the impulse gives the chain, (1/2) m V^2: all the energy the run has.
+    pub fn impact_energy(&self) -> f64 {
+        0.5 * self.model.site_mass(self.impulse_site)
+            * self.impulse_velocity
+            * self.impulse_velocity
+    }
+}
+
 /// What a successful run produced.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outcome {
@@ -85,7 +94,7 @@ fn verified<O: Observer + ?Sized>(
         drift_limit: BLOW_UP_DRIFT,
         ..plan
     };
-    let mut dt = plan.dt().unwrap_or(0.01);
+    let mut dt = auto_first_step(scenario, &plan);
     let mut spent = 0;
     let mut coarse = match run_plan(scenario, &guarded.with_dt(2.0 * dt), &mut ()) {
         Ok(out) => {
@@ -134,6 +143,15 @@ fn verified<O: Observer + ?Sized>(
         estimate,
         dt: 2.0 * dt,
     })
+}
+
+/// The first (finest) step of `auto`'s ladder: the calibrated step for the tolerance, capped so
+/// that every resonator stays resolved at the stiffest moment the impact's energy allows.
+pub fn auto_first_step(scenario: &Scenario, plan: &Plan) -> f64 {
+    plan.dt().unwrap_or(0.01).min(Plan::resolving_dt(
+        &scenario.model,
+        scenario.impact_energy(),
+    ))
 }
 
 fn largest_change(a: &Fractions, b: &Fractions) -> f64 {

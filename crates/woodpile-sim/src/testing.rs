@@ -131,3 +131,67 @@ pub fn fitted_order(dts: &[f64], errors: &[f64]) -> f64 {
     let sxx: f64 = xs.iter().map(|x| (x - mx) * (x - mx)).sum();
     sxy / sxx
 }
+
+/// `per_kind` scenes of each of the paper's sweep kinds (F4, F5, F6, F7 coarse, F7 fine), their
+/// parameters drawn from the sweeps' own grids by a fixed-seed generator: scenes the
+/// calibration did not choose, for surveying a method's or `auto`'s accuracy. Each comes with a
+/// label naming its sweep and parameters.
+pub fn sampled_sweep_scenes(per_kind: usize) -> Vec<(String, Vec<PaperDefect>)> {
+    /// A 64-bit linear congruential generator (Knuth's MMIX constants): reproducible on every
+    /// machine without a dependency.
+    struct Lcg(u64);
+    impl Lcg {
+        fn uniform(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        /// A point of the grid lo, lo + step, ..., hi.
+        fn grid(&mut self, lo: f64, hi: f64, step: f64) -> f64 {
+            let n = ((hi - lo) / step).round();
+            (self.uniform() * (n + 1.0)).floor().min(n) * step + lo
+        }
+        fn pick<T: Copy>(&mut self, from: &[T]) -> T {
+            from[((self.uniform() * from.len() as f64) as usize).min(from.len() - 1)]
+        }
+    }
+    let linear = |site, eps| PaperDefect::linear(site, eps, 1.0);
+    let mut rng = Lcg(20_261_123);
+    let mut scenes = Vec::with_capacity(5 * per_kind);
+    for _ in 0..per_kind {
+        let l = rng.pick(&[0, 2, 5, 6]);
+        let eps = rng.grid(0.1, 60.0, 0.1);
+        scenes.push((
+            format!("F4 L={l} eps={eps:.1}"),
+            (0..=l).map(|s| linear(s, eps)).collect(),
+        ));
+        let l = rng.pick(&[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]);
+        let eps = rng.grid(0.1, 60.0, 0.1);
+        scenes.push((
+            format!("F5 L={l} eps={eps:.1}"),
+            (0..=l).map(|s| linear(s, eps)).collect(),
+        ));
+        let p = rng.pick(&[3, 5, 7, 9, 11, 13, 15, 17, 19]);
+        let eps = rng.grid(0.01, 0.5, 0.01);
+        scenes.push((
+            format!("F6 p={p} eps={eps:.2}"),
+            vec![PaperDefect {
+                p,
+                ..linear(0, eps)
+            }],
+        ));
+        let (e1, e2) = (rng.grid(1.0, 100.0, 1.0), rng.grid(1.0, 100.0, 1.0));
+        scenes.push((
+            format!("F7 coarse ({e1:.0}, {e2:.0})"),
+            vec![linear(0, e1), linear(20, e2)],
+        ));
+        let (e1, e2) = (rng.grid(0.1, 1.0, 0.01), rng.grid(0.1, 1.0, 0.01));
+        scenes.push((
+            format!("F7 fine ({e1:.2}, {e2:.2})"),
+            vec![linear(0, e1), linear(20, e2)],
+        ));
+    }
+    scenes
+}

@@ -292,6 +292,22 @@ impl Plan {
             .min(0.25)
     }
 
+    /// The largest step that keeps every resonator of `model` resolved (omega * dt at most
+    /// 0.5) in a motion of total energy `energy`, at the stiffest moment the energy allows
+    /// ([`Model::max_resonator_omega`]). For linear resonators [`Plan::dt_for`] already
+    /// applies this cap; for nonlinear ones (p > 1) it is what keeps `auto`'s verification
+    /// pair out of the regime where both runs miss the resonator's stiff moments by the same
+    /// amount and agree (p = 19, eps = 0.09 at tolerance 1e-5: both runs off by 3e-5, their
+    /// difference 2.6e-6).
+    pub fn resolving_dt(model: &Model, energy: f64) -> f64 {
+        let omega = model.max_resonator_omega(energy);
+        if omega > 0.0 {
+            MAX_OMEGA_DT / omega
+        } else {
+            f64::INFINITY
+        }
+    }
+
     /// The same plan with a fixed step `dt` (for the verification ladder).
     pub fn with_dt(&self, dt: f64) -> Plan {
         Plan {

@@ -1,0 +1,73 @@
+//! Raw data for designing `auto`'s verification ladder: the fractions of sampled sweep scenes
+//! ([`sampled_sweep_scenes`]) at a geometric ladder of fixed steps (ratio 0.85) for
+//! `rk4-contact` and `rkn4-contact`, with the reference (`rk4-contact` at dt = 0.001). CSV on
+//! stdout, the label quoted.
+//!
+//! ```text
+//! cargo run --release -p woodpile-bench --example ladder_data [-- PER_KIND] > ladder.csv
+//! ```
+#![allow(clippy::print_stdout, clippy::unwrap_used)]
+
+use woodpile_sim::integrate::{Method, MethodChoice};
+use woodpile_sim::run::simulate;
+use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, PaperDefect};
+
+fn scene_rows(i: usize, label: &str, d: &[PaperDefect]) -> Vec<String> {
+    let nonlinear = d.iter().any(|x| x.p > 1);
+    let mut runs = vec![(Method::Rk4Contact, 0.001, "ref")];
+    let mut dt = 0.25;
+    while dt >= if nonlinear { 0.0015 } else { 0.004 } {
+        runs.push((Method::Rk4Contact, dt, "rk4c"));
+        runs.push((Method::Rkn4Contact, dt, "rkn4c"));
+        dt *= 0.85;
+    }
+    runs.into_iter()
+        .map(|(m, dt, name)| {
+            match simulate(
+                &paper_scene(d, MethodChoice::Named(m), fixed_dt(dt)),
+                &mut (),
+            ) {
+                Ok(o) => {
+                    let f = o.fractions;
+                    format!(
+                        "{i},\"{label}\",{name},{},{:.17e},{:.17e},{:.17e},{}",
+                        o.plan.dt().unwrap(),
+                        f.reflected,
+                        f.transmitted,
+                        f.trapped,
+                        o.total_rhs_evals
+                    )
+                }
+                Err(_) => format!("{i},\"{label}\",{name},{dt},nan,nan,nan,0"),
+            }
+        })
+        .collect()
+}
+
+fn main() {
+    let per_kind = std::env::args().nth(1).map_or(10, |s| s.parse().unwrap());
+    let scenes = sampled_sweep_scenes(per_kind);
+    println!("scene,label,method,dt,R,T,E_tr,evals");
+    let rows: Vec<String> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..2)
+            .map(|w| {
+                let scenes = &scenes;
+                s.spawn(move || {
+                    scenes
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| i % 2 == w)
+                        .flat_map(|(i, (label, d))| scene_rows(i, label, d))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect()
+    });
+    for row in rows {
+        println!("{row}");
+    }
+}
