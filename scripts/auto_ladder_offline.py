@@ -1,0 +1,97 @@
+"""Replays `auto`'s verification ladder offline on the fractions that the `ladder_data` example
+records, for several companion ratios, and reports misses (true error above the tolerance),
+the worst error / tolerance and the force evaluations: a cheap way to try a ladder design
+before changing `run.rs`.
+
+    cargo run --release -p woodpile-bench --example ladder_data > ladder.csv
+    python3 scripts/auto_ladder_offline.py ladder.csv
+
+The recorded steps form a geometric ladder of ratio 0.85, so a companion k rungs up has ratio
+0.85^-k (k = 4: 1.92, close to auto's 2). The first step follows `Plan::dt_for` (error model,
+omega * dt <= 0.5, 0.9 of the stability bound, at most 0.25), snapped to the nearest rung; the
+estimate is Richardson's |F(coarse) - F(fine)| / (r^q - 1), accepted at half the tolerance.
+Nonlinear resonators' energy cap is not modelled.
+"""
+import csv
+import math
+import re
+import sys
+from collections import defaultdict
+
+MODEL = {"rk4c": (1.56e-2, 3.0, 2.828), "rkn4c": (5.2e-3, 2.8, 2.586)}
+
+
+def load(path):
+    runs = defaultdict(list)
+    refs, labels = {}, {}
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            scene = int(row["scene"])
+            labels[scene] = row["label"]
+            values = tuple(float(row[k]) for k in ("R", "T", "E_tr"))
+            if row["method"] == "ref":
+                refs[scene] = values
+            else:
+                runs[(scene, row["method"])].append((float(row["dt"]), values, int(row["evals"])))
+    for key in runs:
+        runs[key].sort(key=lambda r: -r[0])
+    return runs, refs, labels
+
+
+def largest_omega(label):
+    eps = [float(x) for x in re.findall(r"eps=([\d.]+)", label)]
+    eps += [float(x) for x in re.findall(r"\(([\d.]+), ([\d.]+)\)", label)[0]] if "F7" in label else []
+    return max(math.sqrt(1 + 1 / e) for e in eps)
+
+
+def first_step(method, label, tol):
+    coef, order, stability = MODEL[method]
+    omega = largest_omega(label)
+    return min((tol / coef) ** (1 / order), 0.5 / omega, 0.9 * stability / omega, 0.25)
+
+
+def replay(ladder, reference, method, label, tol, rungs):
+    dts = [r[0] for r in ladder]
+    h = first_step(method, label, tol)
+    i = min(range(len(dts)), key=lambda k: abs(math.log(dts[k] / h)))
+    used = set()
+
+    def fractions(k):
+        if k < 0 or k >= len(ladder):
+            return None
+        used.add(k)
+        f = ladder[k][1]
+        return None if any(math.isnan(x) for x in f) else f
+
+    order = MODEL[method][1]
+    while i < len(ladder):
+        fine, coarse = fractions(i), fractions(i - rungs)
+        if fine is not None and coarse is not None:
+            r = dts[i - rungs] / dts[i]
+            estimate = max(abs(a - b) for a, b in zip(coarse, fine)) / (r**order - 1)
+            if estimate <= 0.5 * tol:
+                error = max(abs(a - b) for a, b in zip(fine, reference))
+                return error / tol, sum(ladder[k][2] for k in used)
+        i += rungs
+    return None, sum(ladder[k][2] for k in used)
+
+
+def main():
+    runs, refs, labels = load(sys.argv[1] if len(sys.argv) > 1 else "ladder.csv")
+    print("method rungs ratio tolerance scenes not_converged missed worst_err/tol evals")
+    for method in MODEL:
+        for rungs in (2, 3, 4):
+            for tol in (1e-5, 1e-6, 1e-7):
+                results = [
+                    replay(runs[(s, method)], refs[s], method, labels[s], tol, rungs) for s in labels
+                ]
+                ratios = [r for r, _ in results if r is not None]
+                print(
+                    f"{method} {rungs} {0.85 ** -rungs:.2f} {tol:.0e} {len(results)}"
+                    f" {sum(r is None for r, _ in results)} {sum(r > 1 for r in ratios)}"
+                    f" {max(ratios):.2f} {sum(e for _, e in results)}"
+                )
+
+
+if __name__ == "__main__":
+    main()
