@@ -86,19 +86,13 @@ impl Stepper for Rk4Fused {
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);
         let (new_q, new_v) = self.y_new.split_at_mut(n);
-        // Stage 1: (q, v), a(q).
-        for r in ranges.clone() {
-            new_q[r.clone()].copy_from_slice(&q[r.clone()]);
-            new_v[r.clone()].copy_from_slice(&v[r.clone()]);
-            self.v_stage[r.clone()].copy_from_slice(&v[r]);
-        }
-        for r in ranges.clone() {
-            self.q_stage[r.clone()].copy_from_slice(&q[r]);
-        }
+        // Stage 1 is the state itself: its accelerations are taken at q directly, and the
+        // first pass below writes y + (h b_1) k_1 and stage 2 from (q, v) instead of copying
+        // (q, v) into four buffers first. Same operations on the same operands, same bits.
         stage_accelerations(
             model,
             self.contact.as_mut(),
-            (&self.q_stage, &mut self.a_stage),
+            (q, &mut self.a_stage),
             (t, 0),
             window,
         );
@@ -114,8 +108,16 @@ impl Stepper for Rk4Fused {
                 let nv = &mut new_v[r.clone()][..len];
                 let q0 = &q[r.clone()][..len];
                 let v0 = &v[r][..len];
-                // Two loops rather than a branch inside one, so that both vectorise.
+                // Separate loops rather than a branch inside one, so that each vectorises.
                 match next {
+                    Some(w) if stage == 0 => {
+                        for i in 0..len {
+                            nq[i] = q0[i] + hb * v0[i];
+                            nv[i] = v0[i] + hb * as_[i];
+                            qs[i] = q0[i] + w * v0[i];
+                            vs[i] = v0[i] + w * as_[i];
+                        }
+                    }
                     Some(w) => {
                         for i in 0..len {
                             nq[i] += hb * vs[i];

@@ -94,13 +94,11 @@ impl Stepper for Rkn4 {
     ) -> StepOutcome {
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
-        for r in ranges.clone() {
-            self.q_stage[r.clone()].copy_from_slice(&y[r]);
-        }
+        // Stage 1 is the state itself: its accelerations are taken at q, with no copy.
         stage_accelerations(
             model,
             self.contact.as_mut(),
-            (&self.q_stage, &mut self.a[0]),
+            (&y[..n], &mut self.a[0]),
             (t, 0),
             window,
         );
