@@ -12,7 +12,6 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use std::time::Instant;
-use woodpile_sim::energy::Fractions;
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::run::simulate;
 use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, tolerance, PaperDefect};
@@ -49,13 +48,6 @@ fn hand_picked() -> Vec<(String, Vec<PaperDefect>)> {
     ]
 }
 
-fn largest_difference(a: &Fractions, b: &Fractions) -> f64 {
-    (a.reflected - b.reflected)
-        .abs()
-        .max((a.transmitted - b.transmitted).abs())
-        .max((a.trapped - b.trapped).abs())
-}
-
 /// One auto run against the reference.
 struct Verdict {
     line: String,
@@ -83,7 +75,7 @@ fn survey_scene(name: &str, d: &[PaperDefect], tols: &[f64]) -> Vec<Verdict> {
             let t0 = Instant::now();
             let o = simulate(&paper_scene(d, MethodChoice::Auto, tolerance(tol)), &mut ()).unwrap();
             let ms = t0.elapsed().as_secs_f64() * 1e3;
-            let err = largest_difference(&o.fractions, &reference);
+            let err = o.fractions.largest_difference(&reference);
             let line = format!(
                 "tol={tol:.0e} {name:24} dt={:.4} est={:.1e} err={err:.1e} {} evals={} {ms:.1} ms",
                 o.plan.dt().unwrap_or(0.0),

@@ -72,6 +72,15 @@ impl Fractions {
             total,
         }
     }
+
+    /// The largest difference in R, T or E_tr between two runs' fractions: the error measure
+    /// of `auto`'s verification and of every accuracy check against a reference.
+    pub fn largest_difference(&self, other: &Fractions) -> f64 {
+        (self.reflected - other.reflected)
+            .abs()
+            .max((self.transmitted - other.transmitted).abs())
+            .max((self.trapped - other.trapped).abs())
+    }
 }
 
 /// Energy density per site (length `n_sites`) of state `y` at time `t`, written into `density`.

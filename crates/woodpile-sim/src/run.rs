@@ -121,7 +121,7 @@ fn verified<O: Observer + ?Sized>(
         };
         spent += fine.stats.rhs_evals;
         estimate = coarse.as_ref().map_or(f64::INFINITY, |c| {
-            largest_change(&c.fractions, &fine.fractions) / richardson
+            c.fractions.largest_difference(&fine.fractions) / richardson
         });
         let drift_ok = fine.stats.max_energy_drift <= (DRIFT_PER_TOL * tol).max(1e-12);
         if estimate <= 0.5 * tol && drift_ok {
@@ -152,13 +152,6 @@ pub fn auto_first_step(scenario: &Scenario, plan: &Plan) -> f64 {
         &scenario.model,
         scenario.impact_energy(),
     ))
-}
-
-fn largest_change(a: &Fractions, b: &Fractions) -> f64 {
-    (a.reflected - b.reflected)
-        .abs()
-        .max((a.transmitted - b.transmitted).abs())
-        .max((a.trapped - b.trapped).abs())
 }
 
 fn run_plan<O: Observer + ?Sized>(

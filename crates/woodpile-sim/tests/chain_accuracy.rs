@@ -377,7 +377,7 @@ fn auto_halves_past_a_first_step_that_blows_up() {
         &mut (),
     )
     .unwrap();
-    assert!(largest_difference(&out.fractions, &exact.fractions) <= 1e-2);
+    assert!(out.fractions.largest_difference(&exact.fractions) <= 1e-2);
 }
 
 /// A strongly nonlinear resonator (p = 19, eps = 0.09) is stiffest at its largest stretch. Before
@@ -407,16 +407,9 @@ fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
         &mut (),
     )
     .unwrap();
-    let error = largest_difference(&out.fractions, &exact.fractions);
+    let error = out.fractions.largest_difference(&exact.fractions);
     assert!(
         error <= 1e-5,
         "auto is off by {error:.1e} at tolerance 1e-5"
     );
-}
-
-fn largest_difference(a: &Fractions, b: &Fractions) -> f64 {
-    (a.reflected - b.reflected)
-        .abs()
-        .max((a.transmitted - b.transmitted).abs())
-        .max((a.trapped - b.trapped).abs())
 }

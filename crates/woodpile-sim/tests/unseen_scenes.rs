@@ -30,11 +30,7 @@ fn auto_meets_its_tolerance_on_sampled_sweep_scenes() {
             &mut (),
         )
         .unwrap();
-        let f = out.fractions;
-        let error = (f.reflected - reference.reflected)
-            .abs()
-            .max((f.transmitted - reference.transmitted).abs())
-            .max((f.trapped - reference.trapped).abs());
+        let error = out.fractions.largest_difference(&reference);
         assert!(
             error <= tol,
             "{label}: auto is off by {error:.1e} at tolerance {tol:.0e}"
