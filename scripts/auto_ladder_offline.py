@@ -50,7 +50,7 @@ def first_step(method, label, tol):
     return min((tol / coef) ** (1 / order), 0.5 / omega, 0.9 * stability / omega, 0.25)
 
 
-def replay(ladder, reference, method, label, tol, rungs):
+def replay(ladder, reference, method, label, tol, rungs, min_ratio=0.0):
     dts = [r[0] for r in ladder]
     h = first_step(method, label, tol)
     i = min(range(len(dts)), key=lambda k: abs(math.log(dts[k] / h)))
@@ -68,8 +68,15 @@ def replay(ladder, reference, method, label, tol, rungs):
         fine, coarse = fractions(i), fractions(i - rungs)
         if fine is not None and coarse is not None:
             r = dts[i - rungs] / dts[i]
-            estimate = max(abs(a - b) for a, b in zip(coarse, fine)) / (r**order - 1)
-            if estimate <= 0.5 * tol:
+            change = max(abs(a - b) for a, b in zip(coarse, fine))
+            estimate = change / (r**order - 1)
+            # With a coarser run already made by the ladder, the changes must shrink by at
+            # least `min_ratio` per rung pair (a plateau of equal errors otherwise passes).
+            coarser = fractions(i - 2 * rungs) if (i - 2 * rungs) in used else None
+            shrinks = coarser is None or max(
+                abs(a - b) for a, b in zip(coarser, coarse)
+            ) >= min_ratio * change
+            if estimate <= 0.5 * tol and shrinks:
                 error = max(abs(a - b) for a, b in zip(fine, reference))
                 return error / tol, sum(ladder[k][2] for k in used)
         i += rungs
@@ -78,16 +85,17 @@ def replay(ladder, reference, method, label, tol, rungs):
 
 def main():
     runs, refs, labels = load(sys.argv[1] if len(sys.argv) > 1 else "ladder.csv")
-    print("method rungs ratio tolerance scenes not_converged missed worst_err/tol evals")
+    print("method rungs ratio min_shrink tolerance scenes not_converged missed worst_err/tol evals")
     for method in MODEL:
-        for rungs in (2, 3, 4):
+        for rungs, min_ratio in ((2, 0), (3, 0), (4, 0), (4, 2), (4, 3), (4, 4)):
             for tol in (1e-5, 1e-6, 1e-7):
                 results = [
-                    replay(runs[(s, method)], refs[s], method, labels[s], tol, rungs) for s in labels
+                    replay(runs[(s, method)], refs[s], method, labels[s], tol, rungs, min_ratio)
+                    for s in labels
                 ]
                 ratios = [r for r, _ in results if r is not None]
                 print(
-                    f"{method} {rungs} {0.85 ** -rungs:.2f} {tol:.0e} {len(results)}"
+                    f"{method} {rungs} {0.85 ** -rungs:.2f} {min_ratio} {tol:.0e} {len(results)}"
                     f" {sum(r is None for r, _ in results)} {sum(r > 1 for r in ratios)}"
                     f" {max(ratios):.2f} {sum(e for _, e in results)}"
                 )

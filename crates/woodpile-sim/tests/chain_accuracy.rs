@@ -413,3 +413,67 @@ fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
         "auto is off by {error:.1e} at tolerance 1e-5"
     );
 }
+
+/// A scene from a survey of random scenes (two sharply ramped couplings, one of them cubic, and
+/// a heavy linear resonator; fixed walls; 207 sites). Its runs at 0.136, 0.068 and 0.034 sit on
+/// a plateau, 6e-4, 4.5e-4 and 3.4e-4 off, so the last two agree well enough for Richardson's
+/// estimate (1.8e-5) to pass tolerance 1e-4. `auto` must see that the changes between its runs
+/// are not shrinking as an order-3 method's do, and keep halving.
+#[test]
+fn auto_does_not_accept_a_pair_on_an_error_plateau() {
+    use woodpile_sim::energy::Region;
+    use woodpile_sim::run::{simulate, Scenario};
+    use woodpile_sim::testing::{fixed_dt, tolerance};
+    let ramp = |k2, t0, tau| Coupling::Ramp {
+        k1: 0.0,
+        k2,
+        t0,
+        tau,
+    };
+    let resonators = vec![
+        Resonator {
+            site: 112,
+            eps: 2.197850221683016,
+            coupling: ramp(2.3897265767851934, 37.13215431508864, 0.2300273676325668),
+            p: 1,
+        },
+        Resonator {
+            site: 115,
+            eps: 1.7022321072623756,
+            coupling: ramp(2.6810316232832903, 45.63277177607065, 1.0667503192452776),
+            p: 3,
+        },
+        Resonator {
+            site: 130,
+            eps: 93.09645542646219,
+            coupling: Coupling::Constant(0.8957921281524939),
+            p: 1,
+        },
+    ];
+    let model = Model::new(207, Boundary::Fixed, resonators).unwrap();
+    let scene = Scenario {
+        model,
+        impulse_site: 85,
+        impulse_velocity: 1.2181064632981897,
+        t_end: 177.7013121837715,
+        region: Region::new(111, 131, 207).unwrap(),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(1e-4),
+        sample_every: 1.0,
+    };
+    let out = simulate(&scene, &mut ()).unwrap();
+    let reference = simulate(
+        &Scenario {
+            method: MethodChoice::Named(Method::Rk4Contact),
+            accuracy: fixed_dt(0.002),
+            ..scene.clone()
+        },
+        &mut (),
+    )
+    .unwrap();
+    let error = out.fractions.largest_difference(&reference.fractions);
+    assert!(
+        error <= 1e-4,
+        "auto is off by {error:.1e} at tolerance 1e-4"
+    );
+}

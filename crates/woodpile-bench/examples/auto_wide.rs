@@ -1,0 +1,141 @@
+//! `method = "auto"` on random scenes far from the paper's: chains of 81 to 239 sites, fixed or
+//! free ends, one to three resonators (p = 1, 3, 5 or 7; eps from 0.03 to 100, kappa from 0.3
+//! to 5, a fifth of them switched on by a tanh ramp), impact velocities from 0.2 to 3, end
+//! times from 60 to 200. Each against `rk4-contact` at dt = 0.001 (0.00025 with a nonlinear
+//! resonator). Prints one line per scene, MISS where the error exceeds the tolerance, then the
+//! count and the force evaluations.
+//!
+//! ```text
+//! cargo run --release -p woodpile-bench --example auto_wide [-- SCENES [TOLERANCE]]
+//! ```
+#![allow(clippy::print_stdout, clippy::unwrap_used)]
+
+use woodpile_sim::energy::Region;
+use woodpile_sim::integrate::{Method, MethodChoice};
+use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::testing::{fixed_dt, tolerance};
+
+/// Knuth's MMIX linear congruential generator: the same scenes on every machine.
+struct Lcg(u64);
+
+impl Lcg {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + self.uniform() * (hi.ln() - lo.ln())).exp()
+    }
+}
+
+fn random_scene(rng: &mut Lcg, tol: f64) -> Scenario {
+    let half = 40 + (rng.uniform() * 80.0) as usize;
+    let n_sites = 2 * half + 1;
+    let boundary = if rng.uniform() < 0.5 {
+        Boundary::Fixed
+    } else {
+        Boundary::Free
+    };
+    let mut resonators: Vec<Resonator> = (0..1 + (rng.uniform() * 3.0) as usize)
+        .map(|_| {
+            let site = half + (rng.uniform() * 30.0) as usize;
+            let p = [1, 1, 1, 3, 5, 7][(rng.uniform() * 6.0) as usize % 6];
+            let kappa = rng.log_uniform(0.3, 5.0);
+            let coupling = if rng.uniform() < 0.2 {
+                Coupling::Ramp {
+                    k1: 0.0,
+                    k2: kappa,
+                    t0: rng.uniform() * 60.0,
+                    tau: rng.log_uniform(0.1, 5.0),
+                }
+            } else {
+                Coupling::Constant(kappa)
+            };
+            Resonator {
+                site,
+                eps: rng.log_uniform(0.03, 100.0),
+                coupling,
+                p,
+            }
+        })
+        .collect();
+    resonators.sort_by_key(|r| r.site);
+    resonators.dedup_by_key(|r| r.site);
+    let lo = resonators[0].site as i64 - 1;
+    let hi = resonators[resonators.len() - 1].site as i64 + 1;
+    let impulse_site = half - 10 - (rng.uniform() * 25.0) as usize;
+    let impulse_velocity = rng.log_uniform(0.2, 3.0);
+    let t_end = 60.0 + rng.uniform() * 140.0;
+    Scenario {
+        model: Model::new(n_sites, boundary, resonators).unwrap(),
+        impulse_site,
+        impulse_velocity,
+        t_end,
+        region: Region::new(lo, hi, n_sites).unwrap(),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(tol),
+        sample_every: 1.0,
+    }
+}
+
+/// One line for `scene` and its force evaluations (None: it missed).
+fn check(k: usize, scene: &Scenario, tol: f64) -> (String, bool, u64) {
+    let nonlinear = scene.model.resonators().iter().any(|r| r.p > 1);
+    let reference = Scenario {
+        method: MethodChoice::Named(Method::Rk4Contact),
+        accuracy: fixed_dt(if nonlinear { 0.00025 } else { 0.001 }),
+        ..scene.clone()
+    };
+    let reference = simulate(&reference, &mut ()).unwrap().fractions;
+    let out = simulate(scene, &mut ()).unwrap();
+    let error = out.fractions.largest_difference(&reference);
+    let resonators: Vec<String> = scene
+        .model
+        .resonators()
+        .iter()
+        .map(|r| format!("(eps {:.3}, p {}, {:?})", r.eps, r.p, r.coupling))
+        .collect();
+    let line = format!(
+        "{k:3} {} error {error:.1e} estimate {:.1e} dt {:.4} evals {} {:?} ends, {}",
+        if error > tol { "MISS" } else { "ok  " },
+        out.error_estimate.unwrap_or(0.0),
+        out.plan.dt().unwrap_or(0.0),
+        out.total_rhs_evals,
+        scene.model.boundary(),
+        resonators.join(" ")
+    );
+    (line, error > tol, out.total_rhs_evals)
+}
+
+fn main() {
+    let n: usize = std::env::args().nth(1).map_or(60, |s| s.parse().unwrap());
+    let tol: f64 = std::env::args().nth(2).map_or(1e-6, |s| s.parse().unwrap());
+    let mut rng = Lcg(777);
+    let scenes: Vec<Scenario> = (0..n).map(|_| random_scene(&mut rng, tol)).collect();
+    let mut results: Vec<(usize, (String, bool, u64))> = std::thread::scope(|s| {
+        let workers: Vec<_> = (0..2)
+            .map(|w| {
+                let scenes = &scenes;
+                s.spawn(move || {
+                    (w..scenes.len())
+                        .step_by(2)
+                        .map(|k| (k, check(k, &scenes[k], tol)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        workers.into_iter().flat_map(|h| h.join().unwrap()).collect()
+    });
+    results.sort_by_key(|(k, _)| *k);
+    for (_, (line, _, _)) in &results {
+        println!("{line}");
+    }
+    let missed = results.iter().filter(|(_, (_, m, _))| *m).count();
+    let evals: u64 = results.iter().map(|(_, (_, _, e))| e).sum();
+    println!("tol={tol:.0e}: {n} scenes, {missed} missed, {evals} evals");
+}
