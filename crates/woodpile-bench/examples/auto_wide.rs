@@ -129,7 +129,10 @@ fn main() {
                 })
             })
             .collect();
-        workers.into_iter().flat_map(|h| h.join().unwrap()).collect()
+        workers
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect()
     });
     results.sort_by_key(|(k, _)| *k);
     for (_, (line, _, _)) in &results {

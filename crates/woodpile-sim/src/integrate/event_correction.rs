@@ -136,12 +136,12 @@ impl<const S: usize> ContactEvents<S> {
             }
             start += BLOCK;
         }
+        // The last bonds, fewer than a block: the scalar test.
         changed.extend((start..n_bonds).filter(|&i| {
-            let d = left_q[i] - right_q[i];
-            let (low, high) = stage_slices
-                .iter()
-                .fold((d, d), |(l, h), f| (l.min(f[i]), h.max(f[i])));
-            high > 0.0 && low <= 0.0
+            changes_contact::<S>(
+                std::array::from_fn(|s| stage_slices[s][i]),
+                left_q[i] - right_q[i],
+            )
         }));
         for &i in changed.iter() {
             correct(lo + i + 1, Some(lo + i), Some(lo + i + 1));
@@ -254,5 +254,35 @@ mod tests {
         assert!(changes_contact([0.1, 0.1, 0.1, 0.2], -0.3));
         assert!(changes_contact([0.0, 0.0, 0.1], 0.0));
         assert!(!changes_contact([0.1, 0.2, 0.1], 0.1));
+    }
+
+    #[test]
+    fn the_block_test_agrees_with_the_scalar_one() {
+        // Every pattern of touching (positive), just-open (zero) and open (negative) values
+        // over three stage forces and the end overlap, four bonds to a block.
+        let values: [f64; 3] = [-0.5, 0.0, 0.7];
+        let mut bonds: Vec<([f64; 3], f64)> = Vec::new();
+        // All 81 patterns, the first three again to fill the last block.
+        for code in (0..84).map(|c| c % 81) {
+            let pick = |k: u32| values[(code / 3usize.pow(k)) % 3];
+            bonds.push((
+                [pick(0).max(0.0), pick(1).max(0.0), pick(2).max(0.0)],
+                pick(3),
+            ));
+        }
+        for block in bonds.chunks_exact(4) {
+            let right = [0.0f64; 4];
+            let left: [f64; 4] = std::array::from_fn(|i| block[i].1);
+            let stage: [[f64; 4]; 3] =
+                std::array::from_fn(|s| std::array::from_fn(|i| block[i].0[s]));
+            let mask = block_changes(&left, &right, [&stage[0], &stage[1], &stage[2]]);
+            for (i, (forces, d_end)) in block.iter().enumerate() {
+                assert_eq!(
+                    mask >> i & 1 == 1,
+                    changes_contact(*forces, *d_end),
+                    "{forces:?} {d_end}"
+                );
+            }
+        }
     }
 }
