@@ -12,9 +12,11 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use std::time::Instant;
-use woodpile_sim::integrate::{Method, MethodChoice};
+use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::run::simulate;
-use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, tolerance, PaperDefect};
+use woodpile_sim::testing::{
+    paper_scene, reference_dt, reference_fractions, sampled_sweep_scenes, tolerance, PaperDefect,
+};
 
 fn hand_picked() -> Vec<(String, Vec<PaperDefect>)> {
     let pd = |site, eps, p| PaperDefect {
@@ -59,21 +61,13 @@ struct Verdict {
 
 /// One scene at every tolerance.
 fn survey_scene(name: &str, d: &[PaperDefect], tols: &[f64]) -> Vec<Verdict> {
-    let ref_dt = if d.iter().any(|x| x.p > 1) {
-        0.00025
-    } else {
-        0.001
-    };
-    let reference = simulate(
-        &paper_scene(d, MethodChoice::Named(Method::Rk4Contact), fixed_dt(ref_dt)),
-        &mut (),
-    )
-    .unwrap()
-    .fractions;
+    let scene = |tol| paper_scene(d, MethodChoice::Auto, tolerance(tol));
+    let first = scene(tols[0]);
+    let reference = reference_fractions(&first, reference_dt(&first.model)).unwrap();
     tols.iter()
         .map(|&tol| {
             let t0 = Instant::now();
-            let o = simulate(&paper_scene(d, MethodChoice::Auto, tolerance(tol)), &mut ()).unwrap();
+            let o = simulate(&scene(tol), &mut ()).unwrap();
             let ms = t0.elapsed().as_secs_f64() * 1e3;
             let err = o.fractions.largest_difference(&reference);
             let line = format!(

@@ -11,27 +11,10 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_sim::energy::Region;
-use woodpile_sim::integrate::{Method, MethodChoice};
+use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::run::{simulate, Scenario};
-use woodpile_sim::testing::{fixed_dt, tolerance};
-
-/// Knuth's MMIX linear congruential generator: the same scenes on every machine.
-struct Lcg(u64);
-
-impl Lcg {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        (lo.ln() + self.uniform() * (hi.ln() - lo.ln())).exp()
-    }
-}
+use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance, Lcg};
 
 fn random_scene(rng: &mut Lcg, tol: f64) -> Scenario {
     let half = 40 + (rng.uniform() * 80.0) as usize;
@@ -83,15 +66,9 @@ fn random_scene(rng: &mut Lcg, tol: f64) -> Scenario {
     }
 }
 
-/// One line for `scene` and its force evaluations (None: it missed).
+/// One line for `scene`, whether it missed, and its force evaluations.
 fn check(k: usize, scene: &Scenario, tol: f64) -> (String, bool, u64) {
-    let nonlinear = scene.model.resonators().iter().any(|r| r.p > 1);
-    let reference = Scenario {
-        method: MethodChoice::Named(Method::Rk4Contact),
-        accuracy: fixed_dt(if nonlinear { 0.00025 } else { 0.001 }),
-        ..scene.clone()
-    };
-    let reference = simulate(&reference, &mut ()).unwrap().fractions;
+    let reference = reference_fractions(scene, reference_dt(&scene.model)).unwrap();
     let out = simulate(scene, &mut ()).unwrap();
     let error = out.fractions.largest_difference(&reference);
     let resonators: Vec<String> = scene

@@ -4,10 +4,11 @@
 //! omega^2 = kappa (1/m + 1/eps); a head-on Hertz collision of two equal free beads exchanges
 //! their velocities and conserves energy and momentum.
 
-use crate::energy::Region;
-use crate::integrate::{Accuracy, MethodChoice};
+use crate::energy::{Fractions, Region};
+use crate::error::SimError;
+use crate::integrate::{Accuracy, Method, MethodChoice};
 use crate::model::{Boundary, Coupling, Model, Resonator};
-use crate::run::Scenario;
+use crate::run::{simulate, Scenario};
 
 /// Half-width N of the paper's chains (sites -N..N).
 pub const PAPER_N: usize = 100;
@@ -132,31 +133,65 @@ pub fn fitted_order(dts: &[f64], errors: &[f64]) -> f64 {
     sxy / sxx
 }
 
+/// A 64-bit linear congruential generator (Knuth's MMIX constants) for drawing survey scenes:
+/// the same draws on every machine, without a dependency.
+#[derive(Debug, Clone)]
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Log-uniform in [lo, hi).
+    pub fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + self.uniform() * (hi.ln() - lo.ln())).exp()
+    }
+
+    /// A point of the grid lo, lo + step, ..., hi.
+    pub fn grid(&mut self, lo: f64, hi: f64, step: f64) -> f64 {
+        let n = ((hi - lo) / step).round();
+        (self.uniform() * (n + 1.0)).floor().min(n) * step + lo
+    }
+
+    /// One element of `from`.
+    pub fn pick<T: Copy>(&mut self, from: &[T]) -> T {
+        from[((self.uniform() * from.len() as f64) as usize).min(from.len() - 1)]
+    }
+}
+
+/// The step of the reference runs that accuracy checks compare with (`rk4-contact`): 0.001,
+/// within about 1e-10 of RK4 at 0.001 and Yoshida-6 at 5e-4 on the linear scenes, and 0.00025
+/// when a resonator is nonlinear (stiffer at its large stretches).
+pub fn reference_dt(model: &Model) -> f64 {
+    if model.resonators().iter().any(|r| r.p > 1) {
+        0.00025
+    } else {
+        0.001
+    }
+}
+
+/// `scenario`'s fractions by `rk4-contact` at the fixed step `dt`: the reference an accuracy
+/// check measures a run of the same scene against.
+pub fn reference_fractions(scenario: &Scenario, dt: f64) -> Result<Fractions, SimError> {
+    let reference = Scenario {
+        method: MethodChoice::Named(Method::Rk4Contact),
+        accuracy: fixed_dt(dt),
+        ..scenario.clone()
+    };
+    Ok(simulate(&reference, &mut ())?.fractions)
+}
+
 /// `per_kind` scenes of each of the paper's sweep kinds (F4, F5, F6, F7 coarse, F7 fine), their
 /// parameters drawn from the sweeps' own grids by a fixed-seed generator: scenes the
 /// calibration did not choose, for surveying a method's or `auto`'s accuracy. Each comes with a
 /// label naming its sweep and parameters.
 pub fn sampled_sweep_scenes(per_kind: usize) -> Vec<(String, Vec<PaperDefect>)> {
-    /// A 64-bit linear congruential generator (Knuth's MMIX constants): reproducible on every
-    /// machine without a dependency.
-    struct Lcg(u64);
-    impl Lcg {
-        fn uniform(&mut self) -> f64 {
-            self.0 = self
-                .0
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (self.0 >> 11) as f64 / (1u64 << 53) as f64
-        }
-        /// A point of the grid lo, lo + step, ..., hi.
-        fn grid(&mut self, lo: f64, hi: f64, step: f64) -> f64 {
-            let n = ((hi - lo) / step).round();
-            (self.uniform() * (n + 1.0)).floor().min(n) * step + lo
-        }
-        fn pick<T: Copy>(&mut self, from: &[T]) -> T {
-            from[((self.uniform() * from.len() as f64) as usize).min(from.len() - 1)]
-        }
-    }
     let linear = |site, eps| PaperDefect::linear(site, eps, 1.0);
     let mut rng = Lcg(20_261_123);
     let mut scenes = Vec::with_capacity(5 * per_kind);

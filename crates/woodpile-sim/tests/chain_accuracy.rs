@@ -353,7 +353,9 @@ fn auto_on_a_stiff_nonlinear_resonator_agrees_with_yoshida6() {
 fn auto_halves_past_a_first_step_that_blows_up() {
     use woodpile_sim::integrate::{MethodChoice, AUTO_METHOD};
     use woodpile_sim::run::{auto_first_step, simulate};
-    use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
+    use woodpile_sim::testing::{
+        fixed_dt, paper_scene, reference_fractions, tolerance, PaperDefect,
+    };
     let defects = [PaperDefect::linear(0, 10.0, 1.0)];
     let auto = paper_scene(&defects, MethodChoice::Auto, tolerance(1e-2));
     let first = auto_first_step(
@@ -368,16 +370,8 @@ fn auto_halves_past_a_first_step_that_blows_up() {
     assert!(blown.is_err(), "the first step should blow up: {blown:?}");
     let out = simulate(&auto, &mut ()).expect("auto converges by halving");
     assert!(out.plan.dt().unwrap() <= 0.5 * first);
-    let exact = simulate(
-        &paper_scene(
-            &defects,
-            MethodChoice::Named(Method::Rk4Contact),
-            fixed_dt(0.01),
-        ),
-        &mut (),
-    )
-    .unwrap();
-    assert!(out.fractions.largest_difference(&exact.fractions) <= 1e-2);
+    let exact = reference_fractions(&auto, 0.01).unwrap();
+    assert!(out.fractions.largest_difference(&exact) <= 1e-2);
 }
 
 /// A strongly nonlinear resonator (p = 19, eps = 0.09) is stiffest at its largest stretch. Before
@@ -388,26 +382,15 @@ fn auto_halves_past_a_first_step_that_blows_up() {
 fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
     use woodpile_sim::integrate::MethodChoice;
     use woodpile_sim::run::simulate;
-    use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
+    use woodpile_sim::testing::{paper_scene, reference_fractions, tolerance, PaperDefect};
     let defect = PaperDefect {
         p: 19,
         ..PaperDefect::linear(0, 0.09, 1.0)
     };
-    let out = simulate(
-        &paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-5)),
-        &mut (),
-    )
-    .expect("auto converges");
-    let exact = simulate(
-        &paper_scene(
-            &[defect],
-            MethodChoice::Named(Method::Rk4Contact),
-            fixed_dt(5e-4),
-        ),
-        &mut (),
-    )
-    .unwrap();
-    let error = out.fractions.largest_difference(&exact.fractions);
+    let scene = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-5));
+    let out = simulate(&scene, &mut ()).expect("auto converges");
+    let exact = reference_fractions(&scene, 5e-4).unwrap();
+    let error = out.fractions.largest_difference(&exact);
     assert!(
         error <= 1e-5,
         "auto is off by {error:.1e} at tolerance 1e-5"
@@ -423,7 +406,7 @@ fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
 fn auto_does_not_accept_a_pair_on_an_error_plateau() {
     use woodpile_sim::energy::Region;
     use woodpile_sim::run::{simulate, Scenario};
-    use woodpile_sim::testing::{fixed_dt, tolerance};
+    use woodpile_sim::testing::{reference_fractions, tolerance};
     let ramp = |k2, t0, tau| Coupling::Ramp {
         k1: 0.0,
         k2,
@@ -462,16 +445,8 @@ fn auto_does_not_accept_a_pair_on_an_error_plateau() {
         sample_every: 1.0,
     };
     let out = simulate(&scene, &mut ()).unwrap();
-    let reference = simulate(
-        &Scenario {
-            method: MethodChoice::Named(Method::Rk4Contact),
-            accuracy: fixed_dt(0.002),
-            ..scene.clone()
-        },
-        &mut (),
-    )
-    .unwrap();
-    let error = out.fractions.largest_difference(&reference.fractions);
+    let reference = reference_fractions(&scene, 0.002).unwrap();
+    let error = out.fractions.largest_difference(&reference);
     assert!(
         error <= 1e-4,
         "auto is off by {error:.1e} at tolerance 1e-4"

@@ -5,31 +5,19 @@
 //! `cargo run --release -p woodpile-bench --example auto_accuracy -- 1e-6 --survey 8`.
 #![allow(clippy::unwrap_used)]
 
-use woodpile_sim::integrate::{Method, MethodChoice};
+use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::run::simulate;
-use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, tolerance};
+use woodpile_sim::testing::{
+    paper_scene, reference_dt, reference_fractions, sampled_sweep_scenes, tolerance,
+};
 
 #[test]
 fn auto_meets_its_tolerance_on_sampled_sweep_scenes() {
     let tol = 1e-6;
     for (label, defects) in sampled_sweep_scenes(1) {
-        let nonlinear = defects.iter().any(|d| d.p > 1);
-        let reference_dt = if nonlinear { 0.00025 } else { 0.001 };
-        let reference = simulate(
-            &paper_scene(
-                &defects,
-                MethodChoice::Named(Method::Rk4Contact),
-                fixed_dt(reference_dt),
-            ),
-            &mut (),
-        )
-        .unwrap()
-        .fractions;
-        let out = simulate(
-            &paper_scene(&defects, MethodChoice::Auto, tolerance(tol)),
-            &mut (),
-        )
-        .unwrap();
+        let scene = paper_scene(&defects, MethodChoice::Auto, tolerance(tol));
+        let reference = reference_fractions(&scene, reference_dt(&scene.model)).unwrap();
+        let out = simulate(&scene, &mut ()).unwrap();
         let error = out.fractions.largest_difference(&reference);
         assert!(
             error <= tol,
