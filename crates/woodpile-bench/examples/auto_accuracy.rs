@@ -12,6 +12,7 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use std::time::Instant;
+use woodpile_bench::on_two_cores;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::run::simulate;
 use woodpile_sim::testing::{
@@ -107,28 +108,8 @@ fn main() {
         Some(n) => sampled_sweep_scenes(n),
         None => hand_picked(),
     };
-    // Two workers: the scenes are independent and the machine has two cores.
-    let results: Vec<Vec<Verdict>> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..2)
-            .map(|w| {
-                let (scenes, tols) = (&scenes, &tols);
-                s.spawn(move || {
-                    scenes
-                        .iter()
-                        .enumerate()
-                        .filter(|(i, _)| i % 2 == w)
-                        .map(|(i, (name, d))| (i, survey_scene(name, d, tols)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        let mut all: Vec<_> = workers
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect();
-        all.sort_by_key(|(i, _)| *i);
-        all.into_iter().map(|(_, r)| r).collect()
-    });
+    let results: Vec<Vec<Verdict>> =
+        on_two_cores(&scenes, |(name, d)| survey_scene(name, d, &tols));
     for (k, tol) in tols.iter().enumerate() {
         let (mut misses, mut worst, mut evals, mut ms) = (0, 0.0f64, 0u64, 0.0);
         for r in &results {

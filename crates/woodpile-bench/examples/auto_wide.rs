@@ -10,6 +10,7 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
+use woodpile_bench::on_two_cores;
 use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
@@ -93,29 +94,14 @@ fn main() {
     let n: usize = std::env::args().nth(1).map_or(60, |s| s.parse().unwrap());
     let tol: f64 = std::env::args().nth(2).map_or(1e-6, |s| s.parse().unwrap());
     let mut rng = Lcg(777);
-    let scenes: Vec<Scenario> = (0..n).map(|_| random_scene(&mut rng, tol)).collect();
-    let mut results: Vec<(usize, (String, bool, u64))> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..2)
-            .map(|w| {
-                let scenes = &scenes;
-                s.spawn(move || {
-                    (w..scenes.len())
-                        .step_by(2)
-                        .map(|k| (k, check(k, &scenes[k], tol)))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect()
-    });
-    results.sort_by_key(|(k, _)| *k);
-    for (_, (line, _, _)) in &results {
+    let indexed: Vec<(usize, Scenario)> =
+        (0..n).map(|k| (k, random_scene(&mut rng, tol))).collect();
+    let results: Vec<(String, bool, u64)> =
+        on_two_cores(&indexed, |(k, scene)| check(*k, scene, tol));
+    for (line, _, _) in &results {
         println!("{line}");
     }
-    let missed = results.iter().filter(|(_, (_, m, _))| *m).count();
-    let evals: u64 = results.iter().map(|(_, (_, _, e))| e).sum();
+    let missed = results.iter().filter(|(_, m, _)| *m).count();
+    let evals: u64 = results.iter().map(|(_, _, e)| e).sum();
     println!("tol={tol:.0e}: {n} scenes, {missed} missed, {evals} evals");
 }

@@ -8,6 +8,7 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
+use woodpile_bench::on_two_cores;
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::run::simulate;
 use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, PaperDefect};
@@ -48,25 +49,9 @@ fn main() {
     let per_kind = std::env::args().nth(1).map_or(10, |s| s.parse().unwrap());
     let scenes = sampled_sweep_scenes(per_kind);
     println!("scene,label,method,dt,R,T,E_tr,evals");
-    let rows: Vec<String> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..2)
-            .map(|w| {
-                let scenes = &scenes;
-                s.spawn(move || {
-                    scenes
-                        .iter()
-                        .enumerate()
-                        .filter(|(i, _)| i % 2 == w)
-                        .flat_map(|(i, (label, d))| scene_rows(i, label, d))
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .flat_map(|h| h.join().unwrap())
-            .collect()
-    });
+    let indexed: Vec<(usize, &(String, Vec<PaperDefect>))> = scenes.iter().enumerate().collect();
+    let rows: Vec<String> =
+        on_two_cores(&indexed, |(i, (label, d))| scene_rows(*i, label, d)).concat();
     for row in rows {
         println!("{row}");
     }
