@@ -50,10 +50,13 @@ def first_step(method, label, tol):
     return min((tol / coef) ** (1 / order), 0.5 / omega, 0.9 * stability / omega, 0.25)
 
 
-def replay(ladder, reference, method, label, tol, rungs, min_ratio=0.0):
+def replay(ladder, reference, method, label, tol, rungs, min_ratio=0.0, advance=None, shift=0):
+    """`advance`: rungs between successive fine runs (default `rungs`, auto's halving);
+    `shift`: rungs to start above the snapped first step (a larger first step)."""
+    advance = advance or rungs
     dts = [r[0] for r in ladder]
     h = first_step(method, label, tol)
-    i = min(range(len(dts)), key=lambda k: abs(math.log(dts[k] / h)))
+    i = min(range(len(dts)), key=lambda k: abs(math.log(dts[k] / h))) - shift
     used = set()
 
     def fractions(k):
@@ -79,7 +82,7 @@ def replay(ladder, reference, method, label, tol, rungs, min_ratio=0.0):
             if estimate <= 0.5 * tol and shrinks:
                 error = max(abs(a - b) for a, b in zip(fine, reference))
                 return error / tol, sum(ladder[k][2] for k in used)
-        i += rungs
+        i += advance
     return None, sum(ladder[k][2] for k in used)
 
 
@@ -99,6 +102,23 @@ def main():
                     f" {sum(r is None for r, _ in results)} {sum(r > 1 for r in ratios)}"
                     f" {max(ratios):.2f} {sum(e for _, e in results)}"
                 )
+    # Other ladder shapes for auto's method, with its asymptotic check (shrink by 2^(q-1)):
+    # as auto (companion ~1.92x, halving), a first step 1.38x larger, and fine runs 1.38x
+    # apart each paired with the run ~1.92x coarser.
+    method = "rk4c"
+    shrink = 2 ** (MODEL[method][1] - 1)
+    print("ladder shape (rk4c) tolerance scenes not_converged missed worst_err/tol evals")
+    for shape, advance, shift in (("auto", 4, 0), ("first_step_x1.38", 4, 2), ("advance_x1.38", 2, 0)):
+        for tol in (1e-5, 1e-6, 1e-7, 1e-8):
+            results = [
+                replay(runs[(s, method)], refs[s], method, labels[s], tol, 4, shrink, advance, shift)
+                for s in labels
+            ]
+            ratios = [r for r, _ in results if r is not None]
+            print(
+                f"{shape} {tol:.0e} {len(results)} {sum(r is None for r, _ in results)}"
+                f" {sum(r > 1 for r in ratios)} {max(ratios):.2f} {sum(e for _, e in results)}"
+            )
 
 
 if __name__ == "__main__":
