@@ -50,6 +50,11 @@ def first_step(method, label, tol):
     return min((tol / coef) ** (1 / order), 0.5 / omega, 0.9 * stability / omega, 0.25)
 
 
+def largest_difference(a, b):
+    """The largest difference in R, T or E_tr (`Fractions::largest_difference`)."""
+    return max(abs(x - y) for x, y in zip(a, b))
+
+
 def replay(ladder, reference, method, label, tol, rungs, min_ratio=0.0, advance=None, shift=0):
     """`advance`: rungs between successive fine runs (default `rungs`, auto's halving);
     `shift`: rungs to start above the snapped first step (a larger first step)."""
@@ -71,19 +76,32 @@ def replay(ladder, reference, method, label, tol, rungs, min_ratio=0.0, advance=
         fine, coarse = fractions(i), fractions(i - rungs)
         if fine is not None and coarse is not None:
             r = dts[i - rungs] / dts[i]
-            change = max(abs(a - b) for a, b in zip(coarse, fine))
+            change = largest_difference(coarse, fine)
             estimate = change / (r**order - 1)
-            # With a coarser run already made by the ladder, the changes must shrink by at
-            # least `min_ratio` per rung pair (a plateau of equal errors otherwise passes).
+            # As `auto`'s asymptotic check: with a coarser run already made by the ladder, the
+            # changes must shrink by at least `min_ratio` per rung pair (a plateau of equal
+            # errors otherwise passes), unless the last change is itself within half the
+            # tolerance.
             coarser = fractions(i - 2 * rungs) if (i - 2 * rungs) in used else None
-            shrinks = coarser is None or max(
-                abs(a - b) for a, b in zip(coarser, coarse)
-            ) >= min_ratio * change
+            shrinks = (
+                coarser is None
+                or change <= 0.5 * tol
+                or largest_difference(coarser, coarse) >= min_ratio * change
+            )
             if estimate <= 0.5 * tol and shrinks:
-                error = max(abs(a - b) for a, b in zip(fine, reference))
+                error = largest_difference(fine, reference)
                 return error / tol, sum(ladder[k][2] for k in used)
         i += advance
     return None, sum(ladder[k][2] for k in used)
+
+
+def summary(results):
+    """Scenes, not converged, missed, worst error / tolerance, evaluations."""
+    ratios = [r for r, _ in results if r is not None]
+    return (
+        f"{len(results)} {sum(r is None for r, _ in results)} {sum(r > 1 for r in ratios)}"
+        f" {max(ratios):.2f} {sum(e for _, e in results)}"
+    )
 
 
 def main():
@@ -96,12 +114,7 @@ def main():
                     replay(runs[(s, method)], refs[s], method, labels[s], tol, rungs, min_ratio)
                     for s in labels
                 ]
-                ratios = [r for r, _ in results if r is not None]
-                print(
-                    f"{method} {rungs} {0.85 ** -rungs:.2f} {min_ratio} {tol:.0e} {len(results)}"
-                    f" {sum(r is None for r, _ in results)} {sum(r > 1 for r in ratios)}"
-                    f" {max(ratios):.2f} {sum(e for _, e in results)}"
-                )
+                print(f"{method} {rungs} {0.85 ** -rungs:.2f} {min_ratio} {tol:.0e} {summary(results)}")
     # Other ladder shapes for auto's method, with its asymptotic check (shrink by 2^(q-1)):
     # as auto (companion ~1.92x, halving), a first step 1.38x larger, and fine runs 1.38x
     # apart each paired with the run ~1.92x coarser.
@@ -114,11 +127,7 @@ def main():
                 replay(runs[(s, method)], refs[s], method, labels[s], tol, 4, shrink, advance, shift)
                 for s in labels
             ]
-            ratios = [r for r, _ in results if r is not None]
-            print(
-                f"{shape} {tol:.0e} {len(results)} {sum(r is None for r, _ in results)}"
-                f" {sum(r > 1 for r in ratios)} {max(ratios):.2f} {sum(e for _, e in results)}"
-            )
+            print(f"{shape} {tol:.0e} {summary(results)}")
 
 
 if __name__ == "__main__":
