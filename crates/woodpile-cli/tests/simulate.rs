@@ -207,3 +207,53 @@ fn blow_up_exits_3_without_numbers() {
         "{stderr}"
     );
 }
+
+/// Inputs that are not files, or far too large, are refused before they are read.
+#[test]
+fn devices_and_oversized_files_are_refused_unread() {
+    let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .args(["simulate", "/dev/zero"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("/dev/zero") && stderr.contains("not a regular file"),
+        "{stderr}"
+    );
+
+    let mut big = String::from("[chain]\nn = 100\n");
+    while big.len() <= 2 << 20 {
+        big.push_str("[[defect]]\nsite = 0\neps = 1.0\n");
+    }
+    let (out, path) = simulate(&big);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains(&*path.to_string_lossy()) && stderr.contains("bytes"),
+        "{stderr}"
+    );
+}
+
+/// Runs that could never finish are refused at once with the key and the estimate, and a
+/// standing impulse is named for what it is.
+#[test]
+fn endless_runs_and_standing_impulses_exit_2_naming_the_key() {
+    for (scene, key) in [
+        ("[run]\nt_end = 1e12\n", "run.t_end"),
+        ("[run]\nmethod = \"rk4\"\ndt = 1e-300\n", "run.dt"),
+        ("[run]\ntolerance = 1e-30\n", "run.tolerance"),
+        ("[run]\nsample_every = 1e-12\n", "run.sample_every"),
+        ("[[defect]]\nsite = 0\neps = 1e-300\n", "defect[0]"),
+        ("[impulse]\nvelocity = 0.0\n", "impulse.velocity"),
+    ] {
+        let (out, _) = simulate(scene);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{scene}: {stderr}");
+        assert!(
+            stderr.contains(&format!("key `{key}`")),
+            "{scene}: {stderr}"
+        );
+        assert!(out.stdout.is_empty());
+    }
+}

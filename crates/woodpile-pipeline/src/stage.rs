@@ -103,7 +103,7 @@ pub struct Stage {
 impl Stage {
     /// Reads and parses the stage file at `file`.
     pub fn load(file: &Path) -> Result<Stage> {
-        let text = std::fs::read_to_string(file).map_err(|e| PipelineError::Syntax {
+        let text = woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: format!("cannot read: {e}"),
         })?;

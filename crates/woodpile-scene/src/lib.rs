@@ -44,13 +44,43 @@ pub enum SceneError {
     },
 }
 
+/// Largest scene or stage file accepted: a hundred times the largest the paper needs, and small
+/// enough that parsing it never takes long or much memory.
+pub const MAX_FILE_BYTES: u64 = 1 << 20;
+
 /// Reads and validates the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+    let text = read_input(path).map_err(|reason| SceneError::Read {
         file: path.to_path_buf(),
-        reason: e.to_string(),
+        reason,
     })?;
     parse(&text, path)
+}
+
+/// Reads an input file (scene or stage) as text: only a regular file of at most
+/// [`MAX_FILE_BYTES`], so that `/dev/zero`, a FIFO or a runaway generated file is refused
+/// at once instead of read until memory runs out. The error is the reason, without the path.
+pub fn read_input(path: &Path) -> Result<String, String> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err("not a regular file".into());
+    }
+    let too_big =
+        |n: u64| format!("{n} bytes, more than the {MAX_FILE_BYTES} an input file may have");
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(too_big(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut text = String::new();
+    // The file may grow between the check and the read: never read more than the limit.
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_string(&mut text)
+        .map_err(|e| e.to_string())?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_big(text.len() as u64));
+    }
+    Ok(text)
 }
 
 /// Parses and validates scene TOML `text`; `path` only names the source in errors.

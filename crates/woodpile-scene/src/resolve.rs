@@ -3,11 +3,13 @@
 //! Paper numbering: sites n = -N..N with N = `chain.n` (or `chain.sites = [first, last]`); the
 //! simulator's index is n - first.
 
+use woodpile_sim::budget::{OverBudget, StepSetBy, MAX_STEPS};
 use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::run::Scenario;
 use woodpile_sim::units::Scales;
+use woodpile_sim::SimError;
 
 use crate::raw;
 
@@ -17,6 +19,9 @@ const DEFAULT_IMPULSE_SITE: i64 = -25;
 const DEFAULT_T_END: f64 = 150.0;
 const DEFAULT_TOLERANCE: f64 = 1e-8;
 const DEFAULT_SAMPLE_EVERY: f64 = 1.0;
+/// Smallest tolerance accepted: the fractions are sums of hundreds of energies, each known to
+/// about 1e-16 relative, so a finer target could never be verified.
+const MIN_TOLERANCE: f64 = 1e-13;
 /// Longest chain accepted: far beyond any paper scene, small enough to never exhaust memory.
 const MAX_N: i64 = 5_000_000;
 
@@ -162,6 +167,15 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         None => None,
     };
 
+    if file.defect.len() > n_sites {
+        return Err(invalid(
+            "defect",
+            format!(
+                "{} defects on a chain of {n_sites} sites: at most one resonator per site",
+                file.defect.len()
+            ),
+        ));
+    }
     let mut resonators = Vec::with_capacity(file.defect.len());
     let mut masses = vec![1.0; n_sites];
     let mut derived = Vec::new();
@@ -250,6 +264,12 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
                 "is physical.velocity in a [physical] scene",
             ));
         }
+        (Some(v), None) if v == 0.0 => {
+            return Err(invalid(
+                "impulse.velocity",
+                "is 0: no wave enters the chain, so there is no energy to split and the fractions are undefined",
+            ));
+        }
         (Some(v), None) => finite("impulse.velocity", v)?,
         (None, _) => 1.0,
     };
@@ -276,6 +296,12 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         })?),
     };
     let tolerance = positive("run.tolerance", run.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
+    if tolerance < MIN_TOLERANCE {
+        return Err(invalid(
+            "run.tolerance",
+            format!("{tolerance:e} is below {MIN_TOLERANCE:e}: fractions summed over a chain in double precision cannot be verified that closely"),
+        ));
+    }
     let dt = run.dt.map(|dt| positive("run.dt", dt)).transpose()?;
     if let Some(dt) = dt {
         match method {
@@ -345,6 +371,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         },
         sample_every,
     };
+    within_budget(&scenario, run.sample_every.is_some())?;
     let physical = scales.map(|scales| Physical {
         scales,
         defects: derived,
@@ -356,6 +383,30 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         region_paper,
         physical,
     })
+}
+
+/// Refuses a scene whose run could never finish within the simulator's budgets, naming the key
+/// that makes it so (`t_end` when even the largest step of any method would be too many).
+fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Result<(), Invalid> {
+    let error = match woodpile_sim::budget::check(scenario) {
+        Ok(()) => return Ok(()),
+        Err(SimError::OverBudget(over)) => over,
+        Err(other) => return Err(invalid("run", other.to_string())),
+    };
+    let longest_step = 0.25;
+    let key = match &error {
+        OverBudget::Samples { .. } if sample_every_given => "run.sample_every".to_string(),
+        OverBudget::Samples { .. } => "run.t_end".to_string(),
+        OverBudget::Steps { .. } if scenario.t_end / longest_step > MAX_STEPS as f64 => {
+            "run.t_end".to_string()
+        }
+        OverBudget::Steps { set_by, .. } => match set_by {
+            StepSetBy::Dt => "run.dt".to_string(),
+            StepSetBy::Tolerance => "run.tolerance".to_string(),
+            StepSetBy::Resonator(i) => format!("defect[{i}]"),
+        },
+    };
+    Err(invalid(key, error.to_string()))
 }
 
 /// Rejects the first of `keys` that is present: those keys do not belong in this kind of scene.
@@ -497,6 +548,65 @@ mod tests {
             invalid_key(&format!("{physical}[impulse]\nvelocity = 2.0\n")),
             "impulse.velocity"
         );
+    }
+
+    /// Runs that could never finish are refused before they start, naming the key that makes
+    /// them too long; the reason carries the estimate.
+    #[test]
+    fn endless_runs_are_refused_up_front_naming_the_key() {
+        let cases = [
+            ("[run]\nt_end = 1e12\n", "run.t_end"),
+            ("[run]\nt_end = 1e8\nsample_every = 1e3\n", "run.t_end"),
+            ("[run]\nmethod = \"rk4\"\ndt = 1e-300\n", "run.dt"),
+            ("[run]\ntolerance = 1e-12\nt_end = 1e5\n", "run.tolerance"),
+            ("[run]\nsample_every = 1e-12\n", "run.sample_every"),
+            ("[[defect]]\nsite = 0\neps = 1e-300\n", "defect[0]"),
+            (
+                "[[defect]]\nsite = 0\neps = 1.0\n[[defect]]\nsite = 3\neps = 1e-300\n",
+                "defect[1]",
+            ),
+            (
+                "[[defect]]\nsite = 0\neps = 1e-300\n[run]\nmethod = \"dop853\"\n",
+                "defect[0]",
+            ),
+        ];
+        for (text, key) in cases {
+            assert_eq!(invalid_key(text), key, "{text}");
+        }
+        match parse(
+            "[run]\nmethod = \"rk4\"\ndt = 1e-300\n",
+            Path::new("s.toml"),
+        ) {
+            Err(SceneError::Invalid { reason, .. }) => {
+                assert!(reason.contains("1.500e302 steps"), "{reason}")
+            }
+            other => panic!("{other:?}"),
+        }
+        // The budget is generous: the paper's tightest scenes pass.
+        assert!(parse("[run]\ntolerance = 1e-10\n", Path::new("s.toml")).is_ok());
+    }
+
+    #[test]
+    fn tolerances_below_what_doubles_can_verify_are_refused() {
+        assert_eq!(invalid_key("[run]\ntolerance = 1e-30\n"), "run.tolerance");
+    }
+
+    #[test]
+    fn a_standing_impulse_has_no_fractions() {
+        assert_eq!(
+            invalid_key("[impulse]\nvelocity = 0.0\n"),
+            "impulse.velocity"
+        );
+        assert!(parse("[impulse]\nvelocity = -1.0\n", Path::new("s.toml")).is_ok());
+    }
+
+    #[test]
+    fn defects_are_capped_at_the_chains_sites() {
+        let mut text = String::from("[chain]\nn = 2\n");
+        for _ in 0..6 {
+            text.push_str("[[defect]]\nsite = 0\neps = 1.0\n");
+        }
+        assert_eq!(invalid_key(&text), "defect");
     }
 
     #[test]

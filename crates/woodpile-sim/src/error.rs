@@ -125,4 +125,7 @@ pub enum SimError {
     /// A run setting (t_end, dt, tolerance, sample interval) is invalid.
     #[error("invalid run setting: {0}")]
     BadRun(String),
+    /// The run would exceed its step or sample budget: refused before it starts.
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
 }

@@ -77,6 +77,7 @@ pub fn simulate<O: Observer + ?Sized>(
     observer: &mut O,
 ) -> Result<Outcome, SimError> {
     let plan = Plan::choose(&scenario.model, scenario.method, scenario.accuracy)?;
+    crate::budget::check(scenario)?;
     match scenario.method {
         MethodChoice::Named(_) => run_plan(scenario, &plan, observer),
         MethodChoice::Auto => verified(scenario, plan, observer),

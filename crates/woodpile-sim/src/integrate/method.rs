@@ -273,7 +273,6 @@ impl Plan {
     /// The fixed step predicted to reach `tol` with `method` on `model`: the calibrated error
     /// model, capped so that the fastest linear resonator is resolved and never above 0.25.
     pub fn dt_for(model: &Model, method: Method, tol: f64) -> f64 {
-        let em = error_model(method);
         let omega = model.max_linear_omega();
         let resolved = if omega > 0.0 {
             MAX_OMEGA_DT / omega
@@ -285,11 +284,14 @@ impl Plan {
         } else {
             f64::INFINITY
         };
-        (tol / em.coef)
-            .powf(1.0 / em.order)
-            .min(resolved)
-            .min(stable)
-            .min(0.25)
+        Self::tolerance_dt(method, tol).min(resolved).min(stable)
+    }
+
+    /// The fixed step the calibrated error model predicts for `tol` with `method`, before any
+    /// resonator caps it (never above 0.25). For an adaptive method, its step scale.
+    pub fn tolerance_dt(method: Method, tol: f64) -> f64 {
+        let em = error_model(method);
+        (tol / em.coef).powf(1.0 / em.order).min(0.25)
     }
 
     /// The largest step that keeps every resonator of `model` resolved (omega * dt at most
@@ -351,7 +353,7 @@ impl Plan {
             t_end,
             sample_every,
             control: self.control,
-            max_steps: 50_000_000,
+            max_steps: crate::budget::MAX_STEPS,
             energy_drift_limit: Some(self.drift_limit),
             active_window,
         };
