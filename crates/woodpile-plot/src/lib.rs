@@ -1,7 +1,7 @@
 //! Headless figures: panels of line plots and heat maps with colour bars, drawn by plotters to
 //! PNG and SVG with an embedded DejaVu Sans (registered once), so text renders identically on
-//! every machine without system font libraries. Each file is written to a temporary name and
-//! renamed into place: a figure is complete or absent.
+//! every machine without system font libraries. A figure comes out as bytes: whoever stores it
+//! decides where, and how to make the write atomic.
 //!
 //! This crate knows nothing about simulations or parquet: it draws the numbers it is given.
 #![warn(missing_docs)]
@@ -9,7 +9,6 @@
 mod colour;
 mod draw;
 
-use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use plotters::prelude::*;
@@ -19,10 +18,10 @@ pub use draw::cell_edges;
 
 /// Drawing failed.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: {reason}")]
+#[error("drawing the {format}: {reason}")]
 pub struct PlotError {
-    /// The figure file.
-    pub path: PathBuf,
+    /// `png` or `svg`.
+    pub format: &'static str,
     /// What went wrong.
     pub reason: String,
 }
@@ -116,61 +115,43 @@ impl Figure {
         )
     }
 
-    /// Writes `png` and `svg`, each atomically.
-    pub fn render(&self, png: &Path, svg: &Path) -> Result<(), PlotError> {
-        fn err(path: &Path) -> impl Fn(String) -> PlotError + '_ {
-            move |reason| PlotError {
-                path: path.to_path_buf(),
-                reason,
-            }
+    /// The figure as a PNG file's bytes. The caller writes them (atomically, under the name
+    /// it chooses): this crate draws, it does not manage files.
+    pub fn png(&self) -> Result<Vec<u8>, PlotError> {
+        register_font().map_err(fail("png"))?;
+        let (width, height) = self.size();
+        let mut rgb = vec![0u8; width as usize * height as usize * 3];
+        {
+            let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
+            draw::figure(&root, self).map_err(fail("png"))?;
+            root.present().map_err(|e| fail("png")(e.to_string()))?;
         }
-        register_font().map_err(err(png))?;
-        for path in [png, svg] {
-            if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-                std::fs::create_dir_all(dir).map_err(|e| err(path)(e.to_string()))?;
-            }
-        }
-        let size = self.size();
-        let tmp_png = temp_path(png);
-        let drawn = (|| {
-            let root = BitMapBackend::new(&tmp_png, size).into_drawing_area();
-            draw::figure(&root, self)?;
-            root.present().map_err(|e| e.to_string())
-        })();
-        finish(drawn, &tmp_png, png).map_err(err(png))?;
+        let mut bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut bytes, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder
+            .write_header()
+            .and_then(|mut writer| writer.write_image_data(&rgb))
+            .map_err(|e| fail("png")(e.to_string()))?;
+        Ok(bytes)
+    }
+
+    /// The figure as SVG text.
+    pub fn svg(&self) -> Result<String, PlotError> {
+        register_font().map_err(fail("svg"))?;
         let mut text = String::new();
         {
-            let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
-            draw::figure(&root, self).map_err(err(svg))?;
-            root.present().map_err(|e| err(svg)(e.to_string()))?;
+            let root = SVGBackend::with_string(&mut text, self.size()).into_drawing_area();
+            draw::figure(&root, self).map_err(fail("svg"))?;
+            root.present().map_err(|e| fail("svg")(e.to_string()))?;
         }
-        let tmp_svg = temp_path(svg);
-        let written = std::fs::write(&tmp_svg, text).map_err(|e| e.to_string());
-        finish(written, &tmp_svg, svg).map_err(err(svg))
+        Ok(text)
     }
 }
 
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    // The extension stays last: the PNG encoder picks the format from it.
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()))
-}
-
-fn finish(result: Result<(), String>, tmp: &Path, path: &Path) -> Result<(), String> {
-    match result.and_then(|()| std::fs::rename(tmp, path).map_err(|e| e.to_string())) {
-        Ok(()) => Ok(()),
-        Err(e) => {
-            let _ = std::fs::remove_file(tmp);
-            Err(e)
-        }
-    }
+fn fail(format: &'static str) -> impl Fn(String) -> PlotError {
+    move |reason| PlotError { format, reason }
 }
 
 #[cfg(test)]
@@ -179,7 +160,6 @@ mod tests {
 
     #[test]
     fn renders_png_and_svg_with_text() {
-        let dir = tempfile::tempdir().unwrap();
         let figure = Figure {
             title: "test".into(),
             columns: 2,
@@ -210,17 +190,10 @@ mod tests {
                 }),
             ],
         };
-        let (png, svg) = (dir.path().join("f.png"), dir.path().join("f.svg"));
-        figure.render(&png, &svg).unwrap();
-        let bytes = std::fs::read(&png).unwrap();
+        let bytes = figure.png().unwrap();
         assert_eq!(&bytes[1..4], b"PNG");
-        let text = std::fs::read_to_string(&svg).unwrap();
+        let text = figure.svg().unwrap();
         assert!(text.contains("<svg") && text.contains("E_tr") && text.contains("test"));
         assert!(text.contains("bound"), "the overlay has a legend entry");
-        assert_eq!(
-            std::fs::read_dir(dir.path()).unwrap().count(),
-            2,
-            "no temporaries left"
-        );
     }
 }
