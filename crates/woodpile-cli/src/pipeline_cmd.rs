@@ -305,19 +305,25 @@ pub(crate) fn diff_command(args: &DiffArgs) -> Result<bool, Failure> {
 }
 
 fn parse_tolerance(spec: &str) -> Result<(String, Tolerance), String> {
-    let (column, values) = spec.split_once('=').ok_or("expected COLUMN=ABS[,REL]")?;
-    let mut parts = values.split(',');
-    let number = |s: Option<&str>| -> Result<f64, String> {
-        s.unwrap_or("0")
-            .trim()
+    const FORM: &str = "expected COLUMN=ABS or COLUMN=ABS,REL";
+    let (column, values) = spec.split_once('=').ok_or(FORM)?;
+    if column.trim().is_empty() {
+        return Err(format!("no column name; {FORM}"));
+    }
+    let parts: Vec<&str> = values.split(',').collect();
+    if parts.len() > 2 {
+        return Err(format!("{} numbers; {FORM}", parts.len()));
+    }
+    let number = |s: &str| -> Result<f64, String> {
+        s.trim()
             .parse::<f64>()
             .ok()
             .filter(|x| *x >= 0.0)
-            .ok_or_else(|| "tolerances are numbers >= 0".to_string())
+            .ok_or_else(|| format!("`{s}` is not a tolerance (a number >= 0 or inf)"))
     };
-    let abs = number(parts.next())?;
-    let rel = number(parts.next())?;
-    Ok((column.to_string(), Tolerance { abs, rel }))
+    let abs = number(parts[0])?;
+    let rel = parts.get(1).map_or(Ok(0.0), |r| number(r))?;
+    Ok((column.trim().to_string(), Tolerance { abs, rel }))
 }
 
 fn print_report(report: &DiffReport) {

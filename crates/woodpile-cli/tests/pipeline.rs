@@ -175,3 +175,74 @@ fn shards_from_flags_and_slurm_variables_merge_to_the_local_result() {
     let submit = std::fs::read_to_string(d.join("slurm/sweep.submit.sh")).unwrap();
     assert!(submit.contains("--dependency=afterok"));
 }
+
+#[test]
+fn malformed_or_unknown_tolerance_columns_exit_2() {
+    let dir = project();
+    let d = dir.path();
+    assert!(woodpile(d, &["run"]).status.success());
+    for tol in ["R=1,2,3", "nope=1", "=1", "E_tr=x", "E_tr=-1"] {
+        let out = woodpile(d, &["diff", "results", "results", "--tol", tol]);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "--tol {tol}: {}",
+            text(&out.stderr)
+        );
+        assert!(
+            text(&out.stderr).contains("error:"),
+            "{}",
+            text(&out.stderr)
+        );
+    }
+    let ok = woodpile(
+        d,
+        &["diff", "results", "results", "--tol", "E_tr=1e-9,1e-6"],
+    );
+    assert_eq!(ok.status.code(), Some(0), "{}", text(&ok.stderr));
+}
+
+/// Two `woodpile run` on one results tree at once: the second waits for the first (or finds
+/// its work done); both succeed, and the tree is what one run makes, with no temporaries.
+#[test]
+fn two_runs_on_one_results_tree_do_not_duplicate_or_damage_work() {
+    let dir = project();
+    let d = dir.path();
+    let spawn = || {
+        Command::new(env!("CARGO_BIN_EXE_woodpile"))
+            .current_dir(d)
+            .arg("run")
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (first, second) = (spawn(), spawn());
+    let (first, second) = (
+        first.wait_with_output().unwrap(),
+        second.wait_with_output().unwrap(),
+    );
+    assert!(first.status.success(), "{}", text(&first.stderr));
+    assert!(second.status.success(), "{}", text(&second.stderr));
+    assert_eq!(woodpile(d, &["status", "--check"]).status.code(), Some(0));
+    assert!(woodpile(d, &["run", "--results", "alone"]).status.success());
+    let same = woodpile(d, &["diff", "results", "alone"]);
+    assert_eq!(same.status.code(), Some(0), "{}", text(&same.stdout));
+    let leftovers: Vec<_> = walk(&d.join("results"))
+        .into_iter()
+        .filter(|p| p.to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            out.extend(walk(&path));
+        } else {
+            out.push(path);
+        }
+    }
+    out
+}

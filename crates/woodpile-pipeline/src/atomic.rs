@@ -2,12 +2,12 @@
 //!
 //! Every write goes to a hidden temporary file in the destination's directory (same file
 //! system, so the rename is atomic), is flushed and synced, then renamed over the destination.
-//! A process killed mid-write leaves only a `.{name}.{pid}.tmp` file, which readers never look
-//! at and [`sweep_stale_temps`] removes once its writer is gone.
+//! A process killed mid-write leaves only a `.{name}~{host}~{pid}~{token}.tmp` file, which
+//! readers never look at and [`sweep_stale_temps`] removes once its writer is gone.
 
 use std::fs;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::error::{PipelineError, Result};
 
@@ -21,42 +21,84 @@ pub fn write_with(
     path: &Path,
     fill: impl FnOnce(&mut fs::File) -> std::io::Result<()>,
 ) -> Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     fs::create_dir_all(dir).map_err(|e| PipelineError::io(dir, e))?;
-    let tmp = temp_path(path);
     let result = (|| {
-        let mut file = fs::File::create(&tmp)?;
-        fill(&mut file)?;
-        file.flush()?;
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&tmp, path)
+        // Dropped on any error before `persist`: the temporary is removed with it.
+        let mut tmp = temp_file(path, dir)?;
+        fill(tmp.as_file_mut())?;
+        tmp.as_file_mut().flush()?;
+        tmp.as_file().sync_all()?;
+        tmp.persist(path).map(|_| ()).map_err(|e| e.error)
     })();
-    result.map_err(|e| {
-        // Best effort: a failed write must not leave its temporary behind.
-        let _ = fs::remove_file(&tmp);
-        PipelineError::io(path, e)
-    })
+    result.map_err(|e| PipelineError::io(path, e))
 }
 
-/// `dir/.name.PID.tmp` for `dir/name`.
-fn temp_path(path: &Path) -> PathBuf {
+/// A new temporary beside `path` in `dir`, named `.{name}~{host}~{pid}~{random}.tmp`: unique
+/// across threads, processes and machines sharing a file system, and saying who wrote it.
+/// Two writers of the same file (two threads simulating one point, two cluster nodes whose
+/// processes have the same PID) thus never write into each other's temporary; each renames
+/// its own complete file, and the last rename leaves a complete file.
+fn temp_file(path: &Path, dir: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+    tempfile::Builder::new()
+        .prefix(&format!(".{name}~{}~{}~", host(), std::process::id()))
+        .suffix(".tmp")
+        .rand_bytes(12)
+        .tempfile_in(dir)
 }
 
-/// The writer's process id, if `name` is one of [`temp_path`]'s temporaries.
-fn temp_owner(name: &str) -> Option<u32> {
+/// This machine's name, as it appears in temporary names (no separators in it).
+fn host() -> &'static str {
+    static HOST: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    HOST.get_or_init(|| {
+        let name = fs::read_to_string("/proc/sys/kernel/hostname")
+            .or_else(|_| fs::read_to_string("/etc/hostname"))
+            .unwrap_or_default();
+        let name: String = name
+            .trim()
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        if name.is_empty() {
+            "localhost".into()
+        } else {
+            name
+        }
+    })
+}
+
+/// The writer (host, process id) of one of [`temp_file`]'s temporaries; the `.{name}.{pid}.tmp`
+/// of earlier versions counts as this host's.
+fn temp_owner(name: &str) -> Option<(&str, u32)> {
     let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
-    rest.rsplit_once('.')?.1.parse().ok()
+    let mut parts = rest.rsplitn(4, '~');
+    match (parts.next(), parts.next(), parts.next(), parts.next()) {
+        (Some(_token), Some(pid), Some(host), Some(_name)) => Some((host, pid.parse().ok()?)),
+        _ => Some((host(), rest.rsplit_once('.')?.1.parse().ok()?)),
+    }
 }
 
-/// Removes temporaries in `dir` (not recursive) whose writing process no longer runs: the
-/// leftovers of a killed run. Temporaries of live processes (another shard writing into the
-/// same directory) are left alone. Returns how many were removed.
+/// How old another machine's temporary must be before a sweep removes it: its writer cannot be
+/// asked whether it still runs, and no writer spends a day on one file.
+const FOREIGN_TEMP_AGE: std::time::Duration = std::time::Duration::from_secs(24 * 3600);
+
+/// Removes temporaries in `dir` (not recursive) whose writer is gone: on this machine, a
+/// process that no longer runs; on another machine sharing the directory, a file untouched
+/// for a day. Temporaries of live writers (another shard writing into the same directory) are
+/// left alone. Returns how many were removed.
 pub fn sweep_stale_temps(dir: &Path) -> usize {
     let Ok(entries) = fs::read_dir(dir) else {
         return 0;
@@ -64,10 +106,21 @@ pub fn sweep_stale_temps(dir: &Path) -> usize {
     let mut removed = 0;
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
-        if let Some(pid) = temp_owner(&name) {
-            if !process_alive(pid) && fs::remove_file(entry.path()).is_ok() {
-                removed += 1;
-            }
+        let Some((writer_host, pid)) = temp_owner(&name) else {
+            continue;
+        };
+        let gone = if writer_host == host() {
+            !process_alive(pid)
+        } else {
+            entry
+                .metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age > FOREIGN_TEMP_AGE)
+        };
+        if gone && fs::remove_file(entry.path()).is_ok() {
+            removed += 1;
         }
     }
     removed
@@ -104,22 +157,50 @@ mod tests {
     fn stale_temporaries_of_dead_writers_are_swept_live_ones_kept() {
         let dir = tempfile::tempdir().unwrap();
         // pid 0 is never a user process; our own pid is alive.
-        let dead = dir.path().join(".out.bin.0.tmp");
-        let live = dir
-            .path()
-            .join(format!(".out.bin.{}.tmp", std::process::id()));
+        let dead = dir.path().join(format!(".out.bin~{}~0~1-ab.tmp", host()));
+        let live_file = temp_file(&dir.path().join("out.bin"), dir.path()).unwrap();
+        let live = live_file.path().to_path_buf();
+        // Another machine's fresh temporary: its writer may be running there.
+        let foreign = dir.path().join(".out.bin~elsewhere~0~1-ab.tmp");
         let other = dir.path().join("keep.tmp");
-        for p in [&dead, &live, &other] {
+        for p in [&dead, &live, &foreign, &other] {
             fs::write(p, b"x").unwrap();
         }
         assert_eq!(sweep_stale_temps(dir.path()), 1);
-        assert!(!dead.exists() && live.exists() && other.exists());
+        assert!(!dead.exists() && live.exists() && foreign.exists() && other.exists());
     }
 
     #[test]
-    fn temp_owner_parses_only_our_names() {
-        assert_eq!(temp_owner(".a.parquet.123.tmp"), Some(123));
+    fn temporaries_are_unique_and_name_their_writer() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.parquet");
+        let (a, b) = (
+            temp_file(&path, dir.path()).unwrap(),
+            temp_file(&path, dir.path()).unwrap(),
+        );
+        assert_ne!(a.path(), b.path());
+        let name = a.path().file_name().unwrap().to_str().unwrap();
+        assert_eq!(temp_owner(name), Some((host(), std::process::id())));
         assert_eq!(temp_owner("a.parquet"), None);
         assert_eq!(temp_owner(".a.tmp"), None);
+        assert_eq!(temp_owner(".a~h~x~t.tmp"), None);
+        assert_eq!(temp_owner(".a.parquet.123.tmp"), Some((host(), 123)));
+    }
+
+    #[test]
+    fn concurrent_writers_of_one_file_never_collide() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("point.bin");
+        std::thread::scope(|scope| {
+            for _ in 0..8 {
+                scope.spawn(|| {
+                    for _ in 0..50 {
+                        write(&path, b"the same bytes").unwrap();
+                    }
+                });
+            }
+        });
+        assert_eq!(fs::read(&path).unwrap(), b"the same bytes");
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 }

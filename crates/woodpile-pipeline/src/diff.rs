@@ -1,16 +1,18 @@
 //! `woodpile diff A B`: two result files, or two result trees, compared column by column.
 //!
 //! A value pair passes when |a - b| <= abs + rel * max(|a|, |b|) (both nulls, or both NaN,
-//! are equal; one null is a difference). Strings must match exactly. Missing files, missing
-//! columns and row-count mismatches are structural problems and always fail.
+//! are equal; one null is a difference). Strings must match exactly. Missing files, columns or
+//! manifests, damaged tables, changed column types and row-count mismatches are structural
+//! problems and always fail. A tolerance for a column no compared table has is an error: it is
+//! a typo that would otherwise silently compare that column at the default tolerance.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use polars::prelude::DataFrame;
 
 use crate::error::{PipelineError, Result};
-use crate::table::{f64_column, read, str_column};
+use crate::table::{f64_column, read_checked, str_column, Integrity, DAMAGED};
 
 /// Absolute and relative tolerance of one column.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -60,8 +62,11 @@ pub struct DiffReport {
     pub values: u64,
     /// Values beyond tolerance.
     pub beyond: u64,
-    /// Structural problems (missing files or columns, different row counts).
+    /// Structural problems (missing files, columns or manifests, damaged tables, different
+    /// column types or row counts).
     pub problems: Vec<String>,
+    /// Every column name seen in the compared tables.
+    pub columns: BTreeSet<String>,
     /// The largest differences, worst first (at most [`WORST`]), within tolerance or not.
     pub worst: Vec<Difference>,
 }
@@ -110,6 +115,16 @@ pub fn diff(a: &Path, b: &Path, options: &DiffOptions) -> Result<DiffReport> {
             "expected two files or two directories that exist",
         ));
     }
+    if let Some(unknown) = options
+        .columns
+        .keys()
+        .find(|c| !report.columns.contains(*c))
+    {
+        return Err(PipelineError::io(
+            a,
+            format!("a tolerance is given for column `{unknown}`, which no compared table has"),
+        ));
+    }
     report.worst.sort_by(|x, y| y.excess.total_cmp(&x.excess));
     report.worst.truncate(WORST);
     Ok(report)
@@ -147,8 +162,27 @@ fn compare_files(
     options: &DiffOptions,
     report: &mut DiffReport,
 ) -> Result<()> {
-    let (fa, fb) = (read(a)?, read(b)?);
+    let (ca, cb) = (read_checked(a)?, read_checked(b)?);
+    for (checked, path) in [(&ca, a), (&cb, b)] {
+        if checked.manifest.is_none() {
+            report.problems.push(format!(
+                "{name}: no `woodpile` manifest in {}",
+                path.display()
+            ));
+        } else if checked.integrity == Integrity::Damaged {
+            report
+                .problems
+                .push(format!("{name}: {} {DAMAGED}", path.display()));
+        }
+    }
+    let (fa, fb) = (ca.frame, cb.frame);
     report.files += 1;
+    for column in fa.columns() {
+        report.columns.insert(column.name().to_string());
+    }
+    for column in fb.columns() {
+        report.columns.insert(column.name().to_string());
+    }
     let names = |f: &DataFrame| {
         f.get_column_names()
             .iter()
@@ -175,6 +209,19 @@ fn compare_files(
         return Ok(());
     }
     for column in ca.iter().filter(|c| cb.contains(c)) {
+        let dtype = |f: &DataFrame| f.column(column).map(|c| c.dtype().clone()).ok();
+        let (ta, tb) = (dtype(&fa), dtype(&fb));
+        if ta != tb {
+            let show =
+                |t: Option<polars::prelude::DataType>| t.map_or("?".into(), |t| t.to_string());
+            report.problems.push(format!(
+                "{name}: column `{column}` is {} in {} but {} in {}",
+                show(ta),
+                a.display(),
+                show(tb),
+                b.display()
+            ));
+        }
         let tol = options
             .columns
             .get(column)

@@ -59,8 +59,11 @@ impl Axis {
     }
 }
 
-/// Most points a single sweep may have: beyond this, shard the sweep (or fix a typo in `step`).
-pub const MAX_POINTS: usize = 50_000_000;
+/// Most points a single sweep may have: a hundred times the paper's largest grid (10^4). A
+/// run plans every point (about 1.4 KB each) and keeps its series, so beyond this a grid
+/// needs gigabytes before its first simulation: split it into several sweeps (or fix a typo
+/// in `step`). [`crate::sweep`] also bounds the memory of the series themselves.
+pub const MAX_POINTS: usize = 1_000_000;
 
 /// Column names an axis may not take (the sweep's own output columns).
 pub const RESERVED: &[&str] = &[
@@ -109,7 +112,10 @@ pub(crate) fn parse_axes(mut fields: Fields<'_>) -> Result<Vec<Axis>, PipelineEr
         .iter()
         .try_fold(1usize, |n, a| n.checked_mul(a.values.len()));
     if !matches!(total, Some(n) if n <= MAX_POINTS) {
-        return Err(fields.error_here(format!("more than {MAX_POINTS} points")));
+        return Err(fields.error_here(format!(
+            "{} points, more than the {MAX_POINTS} a sweep may have (about 1.4 KB each to plan, plus the series); split the grid",
+            total.map_or("over 2^64".to_string(), |n| n.to_string())
+        )));
     }
     fields.finish()?;
     Ok(axes)

@@ -12,6 +12,7 @@
 //! - [`approximate`]: the product approximation of two-defect trapping (paper Fig. 9).
 //! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
+//! - [`lock`]: one writer of a results tree at a time.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
 //! - [`table`], [`manifest`], [`atomic`], [`canonical`]: parquet IO, self-description, atomic
 //!   writes, blake3 keys of canonical JSON.
@@ -29,6 +30,7 @@ mod fields;
 pub mod fit;
 pub mod grid;
 pub mod lm;
+pub mod lock;
 pub mod manifest;
 pub mod optimize;
 pub mod pipeline;

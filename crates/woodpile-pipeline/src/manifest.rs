@@ -26,6 +26,11 @@ pub struct Manifest {
     pub inputs: BTreeMap<String, String>,
     /// Kind-specific facts about the result (points, failures, method, tolerance, ...).
     pub summary: Value,
+    /// The table's seal, set when it is written: blake3 of its data pages, its decoded content
+    /// and this manifest ([`crate::table::write`]). `status` and every reader of the table as
+    /// an input check it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub checksum: Option<String>,
 }
 
 impl Manifest {

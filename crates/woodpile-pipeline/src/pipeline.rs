@@ -49,6 +49,7 @@ impl Pipeline {
         for stage in &stages {
             check_kinds(stage, &by_name)?;
         }
+        check_markdown_distinct(&stages)?;
         let mut stages: Vec<Option<Stage>> = stages.into_iter().map(Some).collect();
         let stages: Vec<Stage> = order.into_iter().filter_map(|i| stages[i].take()).collect();
         let index: HashMap<String, usize> = stages
@@ -183,6 +184,23 @@ fn check_names(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
 }
 
 /// Every input is of a kind the stage can read.
+/// Two reports may not write the same Markdown file: each would overwrite the other's.
+fn check_markdown_distinct(stages: &[Stage]) -> Result<()> {
+    let mut owner: BTreeMap<&str, &str> = BTreeMap::new();
+    for stage in stages {
+        if let Spec::Report(report) = &stage.spec {
+            if let Some(other) = owner.insert(report.markdown.as_str(), stage.name.as_str()) {
+                return Err(definition_error(
+                    stage,
+                    "markdown",
+                    format!("`{}` is written by stage `{other}` too", report.markdown),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
     let kind_of = |name: &str| &by_name[name].spec;
     let error = |key: &str, reason: String| Err(definition_error(stage, key, reason));

@@ -358,9 +358,9 @@ impl Render {
             },
         };
         let [png, svg] = Render::files(figures, stage);
-        figure
-            .render(&png, &svg)
-            .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
+        let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
+        crate::atomic::write(&png, &figure.png().map_err(drawing)?)?;
+        crate::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
         // The stage's table: exactly the plotted columns.
         if let Some(p) = panel_name {
             used.insert(0, p);

@@ -166,6 +166,7 @@ struct Scanned {
 impl Report {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Report> {
         let markdown: String = fields.required("markdown")?;
+        check_markdown_path(&markdown).map_err(|reason| fields.error("markdown", reason))?;
         let title: String = fields.required("title")?;
         let preamble: String = fields.optional("preamble")?.unwrap_or_default();
         let Some(toml::Value::Array(entries)) = fields.take("quote") else {
@@ -203,6 +204,31 @@ impl Report {
             }
         }
         out
+    }
+
+    /// Refuses to replace a file at `path` that this stage did not write (its previous output's
+    /// manifest names the Markdown it wrote): a report never overwrites a hand-written file.
+    fn check_owned(&self, stage: &str, path: &Path, results: &Path) -> Result<()> {
+        if !path.exists() {
+            return Ok(());
+        }
+        let previous = table::read_manifest(&output_path(results, stage))
+            .ok()
+            .flatten();
+        let written_here =
+            previous.is_some_and(|m| m.summary["markdown"] == self.markdown.as_str());
+        if written_here {
+            Ok(())
+        } else {
+            Err(PipelineError::stage(
+                stage,
+                format!(
+                    "`markdown = \"{}\"` would overwrite {}, which this stage did not write; move that file or choose another name",
+                    self.markdown,
+                    path.display()
+                ),
+            ))
+        }
     }
 
     /// The Markdown file for outputs under `results`.
@@ -244,7 +270,9 @@ impl Report {
             evaluated.push((ours, conventions));
         }
         let text = markdown(self, &evaluated);
-        crate::atomic::write(&self.markdown_path(results), text.as_bytes())?;
+        let path = self.markdown_path(results);
+        self.check_owned(stage, &path, results)?;
+        crate::atomic::write(&path, text.as_bytes())?;
         let reproduced = evaluated
             .iter()
             .zip(&self.quotes)
@@ -270,6 +298,27 @@ impl Report {
             }),
         })
     }
+}
+
+/// A report's Markdown must stay inside the tree that holds `results/` (a relative path of
+/// plain names, no `..`) and be Markdown: any other extension could overwrite another stage's
+/// table or figure.
+fn check_markdown_path(markdown: &str) -> std::result::Result<(), String> {
+    let path = Path::new(markdown);
+    let plain = path
+        .components()
+        .all(|c| matches!(c, std::path::Component::Normal(_)));
+    if markdown.is_empty() || !plain {
+        return Err(format!(
+            "`{markdown}` must be a relative path inside the project (no `..`, not absolute)"
+        ));
+    }
+    if path.extension().is_none_or(|e| e != "md") {
+        return Err(format!(
+            "`{markdown}` must end in `.md`: a report writes Markdown, and another name could replace a stage's table or figure"
+        ));
+    }
+    Ok(())
 }
 
 fn parse_quote(mut f: Fields<'_>) -> Result<Quote> {

@@ -8,6 +8,7 @@ use crate::atomic;
 use crate::canonical::code_version;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
+use crate::lock::lock_results;
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
 use crate::points::PointStore;
@@ -46,10 +47,25 @@ pub struct Step {
     pub points: Option<(usize, usize)>,
 }
 
-/// Runs (or plans) the pipeline; returns what each selected stage did.
+/// Runs (or plans) the pipeline; returns what each selected stage did. A run holds the
+/// results tree's lock ([`crate::lock`]) throughout: a second run on the same tree waits.
 pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Result<Vec<Step>> {
     let results = &options.results;
     let store = PointStore::new(points_dir(results));
+    let _lock = match options.dry_run {
+        true => None,
+        false => Some(lock_results(results, events)?),
+    };
+    if !options.dry_run {
+        let removed = store.sweep_stale_temps()
+            + atomic::sweep_stale_temps(results)
+            + atomic::sweep_stale_temps(&options.figures);
+        if removed > 0 {
+            events.warn(&format!(
+                "removed {removed} temporary file(s) left by an interrupted run"
+            ));
+        }
+    }
     let mut steps = Vec::new();
     for stage in pipeline.selection(&options.targets)? {
         let forced =
@@ -67,6 +83,15 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
                 continue;
             }
             (State::Fresh, true) => "forced".to_string(),
+            (State::Damaged(reason), _) => {
+                if !options.dry_run {
+                    events.warn(&format!(
+                        "stage `{}`: {reason}; computing it again",
+                        stage.name
+                    ));
+                }
+                format!("damaged: {reason}")
+            }
             (other, _) => format!("{}: {}", other.label(), other.why()),
         };
         let points = match &stage.spec {
@@ -97,12 +122,6 @@ fn execute(
     events: &dyn Events,
 ) -> Result<String> {
     let results = &options.results;
-    let removed = store.sweep_stale_temps() + atomic::sweep_stale_temps(results);
-    if removed > 0 {
-        events.warn(&format!(
-            "removed {removed} temporary file(s) left by an interrupted run"
-        ));
-    }
     let output = match &stage.spec {
         Spec::Sweep(sweep) => sweep.run(&stage.name, store, events)?,
         Spec::SpaceTime(field) => field.run(&stage.name)?,
@@ -173,5 +192,6 @@ pub(crate) fn manifest_for(
             .map(|i| (i.clone(), pipeline.key(i).to_string()))
             .collect::<BTreeMap<_, _>>(),
         summary,
+        checksum: None,
     }
 }

@@ -152,7 +152,11 @@ pub fn run_shard(
     let key = pipeline.key(name).to_string();
     let part = part_path(results, name, &key, shard);
     let indices = shard.points(sweep.count());
-    if matches!(table::read_manifest(&part), Ok(Some(m)) if m.key == key) {
+    // Done only if the part is for this definition and intact: a damaged part is recomputed.
+    let done = table::read_checked(&part).is_ok_and(|c| {
+        c.integrity == table::Integrity::Intact && c.manifest.is_some_and(|m| m.key == key)
+    });
+    if done {
         return Ok(ShardRun {
             part,
             points: indices.len(),
@@ -181,6 +185,7 @@ pub fn run_shard(
 /// Joins the complete set of parts of sweep `name` (for its current definition) into
 /// `results/<name>.parquet`. Returns the number of parts merged.
 pub fn merge(pipeline: &Pipeline, name: &str, results: &Path) -> Result<usize> {
+    let _lock = crate::lock::lock_results(results, &crate::events::Silent)?;
     let (stage, sweep) = sweep_of(pipeline, name)?;
     let key = pipeline.key(name).to_string();
     let dir = parts_dir(results, name);

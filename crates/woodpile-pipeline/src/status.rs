@@ -7,7 +7,7 @@ use crate::canonical::{changed_paths, code_version};
 use crate::pipeline::Pipeline;
 use crate::render::Render;
 use crate::stage::{Spec, Stage};
-use crate::table;
+use crate::table::{self, Integrity};
 
 /// Freshness of one stage output.
 #[derive(Debug, Clone, PartialEq)]
@@ -18,6 +18,9 @@ pub enum State {
     Stale(Vec<String>),
     /// No output yet.
     Missing,
+    /// The output exists but its content does not match its manifest's checksum (or it has
+    /// none to check): it must be computed again, whatever its key says.
+    Damaged(String),
 }
 
 impl State {
@@ -27,6 +30,7 @@ impl State {
             State::Fresh => "fresh",
             State::Stale(_) => "stale",
             State::Missing => "missing",
+            State::Damaged(_) => "damaged",
         }
     }
 
@@ -36,6 +40,7 @@ impl State {
             State::Fresh => String::new(),
             State::Missing => "no output yet".into(),
             State::Stale(reasons) => reasons.join("; "),
+            State::Damaged(reason) => reason.clone(),
         }
     }
 }
@@ -47,11 +52,27 @@ pub fn output_path(results: &Path, name: &str) -> PathBuf {
 
 /// The state of `stage` given the outputs under `results` (and, for render stages, the figure
 /// files under `figures`).
+///
+/// The whole table is read and checked against its manifest's checksum, so a damaged output is
+/// never reported fresh (the results are a few MB: this costs well under a second).
 pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage) -> State {
-    let stored = match table::read_manifest(&output_path(results, &stage.name)) {
-        Ok(None) => return State::Missing,
-        Ok(Some(m)) => m,
-        Err(e) => return State::Stale(vec![format!("output unreadable ({e})")]),
+    let path = output_path(results, &stage.name);
+    if !path.exists() {
+        return State::Missing;
+    }
+    let checked = match table::read_checked(&path) {
+        Ok(checked) => checked,
+        Err(e) => return State::Damaged(format!("output unreadable ({e})")),
+    };
+    let stored = match (checked.manifest, checked.integrity) {
+        (None, _) => return State::Damaged("output has no `woodpile` manifest".into()),
+        (Some(_), Integrity::Damaged) => {
+            return State::Damaged(format!("output {}", table::DAMAGED))
+        }
+        (Some(_), Integrity::Unchecked) => {
+            return State::Damaged("output has no checksum to check its content against".into())
+        }
+        (Some(m), Integrity::Intact) => m,
     };
     let key = pipeline.key(&stage.name);
     if stored.key == key.as_str() {

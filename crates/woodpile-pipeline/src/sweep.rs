@@ -24,6 +24,7 @@
 //! for any number of threads. A point whose simulation fails gets one row with null fractions
 //! and the reason in `failure`: a failure is reported, never written as a number.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use polars::prelude::DataFrame;
@@ -81,7 +82,20 @@ impl Sweep {
         // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
         // the grid exercise the extremes of every axis.
         sweep.scene_at(0)?;
-        sweep.scene_at(sweep.count() - 1)?;
+        let last = sweep.scene_at(sweep.count() - 1)?;
+        let bytes = sweep.count() as f64 * point_bytes(&last);
+        if bytes > MAX_SWEEP_BYTES {
+            return Err(fields.error(
+                "axes",
+                format!(
+                "{} points of {} samples would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
+                sweep.count(),
+                samples(&last),
+                bytes / 1e9,
+                MAX_SWEEP_BYTES / 1e9
+            ),
+            ));
+        }
         Ok(sweep)
     }
 
@@ -159,11 +173,14 @@ impl Sweep {
 
     /// How many of the points are already in `store`.
     pub fn cached(&self, store: &PointStore) -> Result<usize> {
-        let points = self.points()?;
-        Ok(points
-            .par_iter()
-            .filter(|(k, _)| store.path(k).exists())
-            .count())
+        // One scene at a time per thread: a dry run of a large grid holds no list of scenes.
+        (0..self.count())
+            .into_par_iter()
+            .map(|i| {
+                let key = point_key(&self.scene_at(i)?, self.series);
+                Ok(usize::from(store.path(&key).exists()))
+            })
+            .sum()
     }
 
     /// Simulates what `store` lacks and assembles the whole output.
@@ -193,8 +210,10 @@ impl Sweep {
         let points = self.points_at(indices)?;
         let mut results: Vec<Option<PointResult>> =
             points.par_iter().map(|(k, _)| store.load(k)).collect();
+        // A scene listed twice (an axis value repeated) is simulated once: its first point.
+        let mut first_of: HashMap<&Key, usize> = HashMap::new();
         let todo: Vec<usize> = (0..points.len())
-            .filter(|&i| results[i].is_none())
+            .filter(|&i| results[i].is_none() && *first_of.entry(&points[i].0).or_insert(i) == i)
             .collect();
         events.simulating(stage, todo.len(), points.len() - todo.len());
         let computed: Vec<(usize, PointResult)> = todo
@@ -209,6 +228,11 @@ impl Sweep {
             .collect::<Result<_>>()?;
         for (i, result) in computed {
             results[i] = Some(result);
+        }
+        for i in 0..points.len() {
+            if results[i].is_none() {
+                results[i] = results[first_of[&points[i].0]].clone();
+            }
         }
         let results: Vec<PointResult> = results.into_iter().flatten().collect();
         let stats = SweepStats::of(&results);
@@ -293,6 +317,22 @@ impl Sweep {
             "max_energy_drift": stats.max_energy_drift,
         }))
     }
+}
+
+/// Most memory a sweep's run may need for its points (planned scenes and their series).
+const MAX_SWEEP_BYTES: f64 = 4e9;
+
+/// Samples a point of `scene` records.
+fn samples(scene: &Scene) -> u64 {
+    let s = &scene.scenario;
+    woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1
+}
+
+/// What one point of a sweep like `scene` holds in memory during a run: its planned scene
+/// (measured at about 1.4 KB on the paper's chain) and its series (five numbers a sample,
+/// in the point and again in the output table).
+fn point_bytes(scene: &Scene) -> f64 {
+    1400.0 + (samples(scene) * 5 * 8 * 2) as f64
 }
 
 /// Facts about a set of simulated points that combine exactly across shards (counts, sums of

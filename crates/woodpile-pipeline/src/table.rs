@@ -46,26 +46,183 @@ impl Columns {
     }
 }
 
-/// Writes `frame` to `path` atomically, with `manifest` in the metadata.
+/// Writes `frame` to `path` atomically, with `manifest` in the metadata, sealed: the manifest's
+/// `checksum` covers the file's data pages, the decoded content and the manifest itself
+/// ([`seal`]), so that a byte changed anywhere that matters is caught on reading.
 pub fn write(path: &Path, mut frame: DataFrame, manifest: &Manifest) -> Result<()> {
-    let metadata =
-        KeyValueMetadata::from_static(vec![(METADATA_KEY.to_string(), manifest.to_json_text())]);
-    atomic::write_with(path, |file| {
-        ParquetWriter::new(file)
-            .with_compression(ParquetCompression::Zstd(None))
-            .with_key_value_metadata(Some(metadata))
-            .finish(&mut frame)
-            .map(|_| ())
-            .map_err(std::io::Error::other)
+    // The manifest's text with a placeholder seal: the seal is computed over this exact text,
+    // then written in the placeholder's place, so checking it needs no re-serialisation.
+    let placeholder = Manifest {
+        checksum: Some(UNSEALED.into()),
+        ..manifest.clone()
+    }
+    .to_json_text();
+    // The data pages come before the footer that holds the manifest, so they are the same
+    // bytes with either text: encode once to learn them, then again with the seal.
+    let unsealed = encode(&mut frame, placeholder.clone())?;
+    let pages = data_pages(&unsealed)
+        .ok_or_else(|| PipelineError::io(path, "parquet writer produced no footer"))?;
+    let seal = seal(pages, &checksum(&frame)?, &placeholder);
+    let bytes = encode(&mut frame, placeholder.replace(UNSEALED, &seal))?;
+    if data_pages(&bytes) != Some(pages) {
+        return Err(PipelineError::io(
+            path,
+            "parquet writer is not deterministic: cannot seal",
+        ));
+    }
+    atomic::write(path, &bytes)
+}
+
+/// The seal's placeholder while it is computed: 64 characters, as the seal itself.
+const UNSEALED: &str = "unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-u";
+
+fn encode(frame: &mut DataFrame, manifest_text: String) -> Result<Vec<u8>> {
+    let metadata = KeyValueMetadata::from_static(vec![(METADATA_KEY.to_string(), manifest_text)]);
+    let mut bytes = Vec::new();
+    ParquetWriter::new(&mut bytes)
+        .with_compression(ParquetCompression::Zstd(None))
+        .with_key_value_metadata(Some(metadata))
+        .finish(frame)
+        .map_err(|e| PipelineError::stage("table", e.to_string()))?;
+    Ok(bytes)
+}
+
+/// A parquet file's bytes before its footer (magic, column chunks, page headers, pages), or
+/// `None` when the trailer is not a parquet one.
+fn data_pages(bytes: &[u8]) -> Option<&[u8]> {
+    let n = bytes.len();
+    if n < 12 || &bytes[n - 4..] != b"PAR1" {
+        return None;
+    }
+    let footer = u32::from_le_bytes(bytes[n - 8..n - 4].try_into().ok()?) as usize;
+    let start = n.checked_sub(8)?.checked_sub(footer)?;
+    (start >= 4).then(|| &bytes[..start])
+}
+
+/// The checksum a manifest records: blake3 over the data pages' bytes, the decoded content's
+/// [`checksum`] and the manifest's exact text with the seal replaced by [`UNSEALED`]. A changed
+/// page, a footer change that alters what is decoded, and an edited manifest all break it.
+fn seal(pages: &[u8], content: &str, placeholder_text: &str) -> String {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(&(pages.len() as u64).to_le_bytes());
+    hasher.update(pages);
+    hasher.update(content.as_bytes());
+    hasher.update(placeholder_text.as_bytes());
+    hasher.finalize().to_hex().to_string()
+}
+
+/// Whether a table's content still matches the checksum its manifest recorded.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Integrity {
+    /// It does.
+    Intact,
+    /// It does not: the file was damaged after it was written.
+    Damaged,
+    /// There is no manifest, or the manifest records no checksum: nothing to check against.
+    Unchecked,
+}
+
+/// A table as read, with its manifest and whether its content matches the manifest.
+#[derive(Debug)]
+pub struct Checked {
+    /// The table.
+    pub frame: DataFrame,
+    /// Its manifest, if it has one.
+    pub manifest: Option<Manifest>,
+    /// Content against the manifest's checksum.
+    pub integrity: Integrity,
+}
+
+/// Reads the whole table at `path` and checks its content against its manifest's checksum.
+pub fn read_checked(path: &Path) -> Result<Checked> {
+    let bytes = std::fs::read(path).map_err(|e| PipelineError::io(path, e))?;
+    // polars' decoder panics on some damaged files (a page header out of range) instead of
+    // returning an error: a damaged file is an error here, never a crash.
+    let decoded = std::panic::catch_unwind(|| {
+        let mut reader = ParquetReader::new(std::io::Cursor::new(&bytes));
+        let metadata = reader.get_metadata()?.clone();
+        reader.finish().map(|frame| (metadata, frame))
+    });
+    let (metadata, frame) = match decoded {
+        Ok(result) => result.map_err(|e| PipelineError::io(path, e))?,
+        Err(_) => return Err(PipelineError::io(path, "the parquet decoder failed on it")),
+    };
+    let text = manifest_text(&metadata);
+    let manifest = text
+        .as_deref()
+        .map(|t| parse_manifest(path, t))
+        .transpose()?;
+    let integrity = match (&manifest, &text, data_pages(&bytes)) {
+        (Some(m), Some(text), Some(pages)) => match &m.checksum {
+            None => Integrity::Unchecked,
+            Some(recorded) => {
+                let placeholder = text.replacen(recorded.as_str(), UNSEALED, 1);
+                match *recorded == seal(pages, &checksum(&frame)?, &placeholder) {
+                    true => Integrity::Intact,
+                    false => Integrity::Damaged,
+                }
+            }
+        },
+        (Some(_), _, _) => Integrity::Damaged,
+        (None, _, _) => Integrity::Unchecked,
+    };
+    Ok(Checked {
+        frame,
+        manifest,
+        integrity,
     })
 }
 
-/// Reads the whole table at `path`.
+/// Reads the whole table at `path` (a stage's input): an error if its content no longer
+/// matches the checksum in its manifest, so a damaged table never flows downstream.
 pub fn read(path: &Path) -> Result<DataFrame> {
-    let file = File::open(path).map_err(|e| PipelineError::io(path, e))?;
-    ParquetReader::new(file)
-        .finish()
-        .map_err(|e| PipelineError::io(path, e))
+    let checked = read_checked(path)?;
+    if checked.integrity == Integrity::Damaged {
+        return Err(PipelineError::io(path, DAMAGED));
+    }
+    Ok(checked.frame)
+}
+
+/// What a table that fails its checksum is told.
+pub const DAMAGED: &str = "damaged: its bytes no longer match the checksum in its manifest";
+
+/// The blake3 checksum (hex) of a table's content: every column's name, type and values in
+/// order, nulls marked. It is computed from the decoded values, so it catches a damaged data
+/// page whatever the parquet encoding, and it does not depend on how the file was compressed.
+pub fn checksum(frame: &DataFrame) -> Result<String> {
+    let mut hasher = blake3::Hasher::new();
+    let mut put = |bytes: &[u8]| {
+        hasher.update(&(bytes.len() as u64).to_le_bytes());
+        hasher.update(bytes);
+    };
+    put(&(frame.height() as u64).to_le_bytes());
+    for column in frame.columns() {
+        let name = column.name().as_str();
+        let bad = |e: PolarsError| PipelineError::stage("table", format!("column `{name}`: {e}"));
+        put(name.as_bytes());
+        let dtype = column.dtype();
+        put(dtype.to_string().as_bytes());
+        if dtype.is_float() {
+            let values = column.cast(&DataType::Float64).map_err(bad)?;
+            for v in values.f64().map_err(bad)?.iter() {
+                put(&v.map_or([0xff; 8], |x| x.to_bits().to_le_bytes()));
+                put(&[u8::from(v.is_some())]);
+            }
+        } else if dtype.is_integer() || dtype.is_bool() {
+            let values = column.cast(&DataType::Int64).map_err(bad)?;
+            for v in values.i64().map_err(bad)?.iter() {
+                put(&v.unwrap_or(0).to_le_bytes());
+                put(&[u8::from(v.is_some())]);
+            }
+        } else {
+            let values = column.cast(&DataType::String).map_err(bad)?;
+            for v in values.str().map_err(bad)?.iter() {
+                put(v.unwrap_or("").as_bytes());
+                put(&[u8::from(v.is_some())]);
+            }
+        }
+    }
+    Ok(hasher.finalize().to_hex().to_string())
 }
 
 /// Reads only the manifest in `path`'s footer: `Ok(None)` when the file does not exist.
@@ -79,15 +236,23 @@ pub fn read_manifest(path: &Path) -> Result<Option<Manifest>> {
     let metadata = reader
         .get_metadata()
         .map_err(|e| PipelineError::io(path, e))?;
-    let text = metadata
+    let text = manifest_text(metadata)
+        .ok_or_else(|| PipelineError::io(path, "no `woodpile` manifest in the metadata"))?;
+    parse_manifest(path, &text).map(Some)
+}
+
+/// The manifest's text in a parquet footer, `None` when it has none.
+fn manifest_text(metadata: &FileMetadataRef) -> Option<String> {
+    metadata
         .key_value_metadata()
         .iter()
         .flatten()
         .find(|kv| kv.key == METADATA_KEY)
         .and_then(|kv| kv.value.clone())
-        .ok_or_else(|| PipelineError::io(path, "no `woodpile` manifest in the metadata"))?;
-    Manifest::from_json_text(&text)
-        .map(Some)
+}
+
+fn parse_manifest(path: &Path, text: &str) -> Result<Manifest> {
+    Manifest::from_json_text(text)
         .map_err(|e| PipelineError::io(path, format!("unreadable manifest: {e}")))
 }
 
@@ -128,4 +293,42 @@ pub fn str_column(frame: &DataFrame, name: &str) -> Result<Vec<Option<String>>> 
         .map(|v| v.map(str::to_string))
         .collect();
     Ok(values)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn manifest() -> Manifest {
+        Manifest {
+            stage: "s".into(),
+            kind: "sweep".into(),
+            key: "k".into(),
+            code_version: "v".into(),
+            params: serde_json::json!({"a": 1e-6, "b": [1, 2.5], "c": "x"}),
+            inputs: Default::default(),
+            summary: serde_json::json!({"points": 3}),
+            checksum: None,
+        }
+    }
+
+    #[test]
+    fn a_written_table_reads_back_intact() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.parquet");
+        let mut columns = Columns::new();
+        columns
+            .f64("x", vec![Some(1.0), None, Some(f64::NAN)])
+            .i64("n", vec![Some(1), Some(2), None])
+            .str("s", vec![Some("a".into()), None, Some("c".into())]);
+        let frame = columns.into_frame().unwrap();
+        let before = checksum(&frame).unwrap();
+        write(&path, frame, &manifest()).unwrap();
+        let checked = read_checked(&path).unwrap();
+        assert_eq!(checksum(&checked.frame).unwrap(), before, "content");
+        let mut m = checked.manifest.clone().unwrap();
+        m.checksum = None;
+        assert_eq!(m.to_json_text(), manifest().to_json_text(), "manifest");
+        assert_eq!(checked.integrity, Integrity::Intact);
+    }
 }

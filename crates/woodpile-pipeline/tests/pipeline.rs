@@ -958,3 +958,243 @@ fn work_precision_measures_error_against_the_reference() {
     assert!(p.results.join("figures").join("chart.png").exists());
     assert_eq!(p.state("chart"), State::Fresh);
 }
+
+/// A scene listed many times in one sweep (an axis value repeated) is simulated once, and two
+/// threads writing its point never collide.
+#[test]
+fn a_point_repeated_in_one_sweep_is_simulated_once() {
+    let repeated = format!("[{}]", vec!["1.5"; 40].join(", "));
+    let sweep = SWEEP
+        .replace("L = [0, 1]\n", "")
+        .replace("{ from = 0.5, to = 1.5, step = 0.5 }", &repeated)
+        .replace("through = \"$L\"\n", "");
+    let p = Project::new(&[("sweep", &sweep)]);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    let events = pool.install(|| p.run(&[]));
+    assert_eq!(events.points.load(Ordering::SeqCst), 1);
+    let frame = table::read(&p.output("sweep")).unwrap();
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    let per_point = frame.height() / 40;
+    for (i, value) in e_tr.iter().enumerate() {
+        assert_eq!(*value, e_tr[i % per_point], "row {i}");
+    }
+}
+
+/// Replaces `path`'s first `column` value, keeping the manifest (and so its checksum) as it
+/// was: a damaged data page that still decodes.
+fn corrupt_keeping_manifest(path: &Path, column: &str) {
+    use polars::prelude::*;
+    let manifest = table::read_manifest(path).unwrap().unwrap();
+    let mut frame = table::read(path).unwrap();
+    let mut values = table::f64_column(&frame, column).unwrap();
+    values[0] = values[0].map(|v| v + 0.25);
+    frame
+        .with_column(Column::new(column.into(), values))
+        .unwrap();
+    let metadata =
+        KeyValueMetadata::from_static(vec![("woodpile".to_string(), manifest.to_json_text())]);
+    let file = std::fs::File::create(path).unwrap();
+    ParquetWriter::new(file)
+        .with_key_value_metadata(Some(metadata))
+        .finish(&mut frame)
+        .unwrap();
+}
+
+#[test]
+fn a_damaged_table_is_never_fresh_and_is_recomputed_before_it_is_read() {
+    let p = Project::new(&[("sweep", SWEEP), ("best", BEST)]);
+    p.run(&[]);
+    let (sweep, best) = (
+        std::fs::read(p.output("sweep")).unwrap(),
+        std::fs::read(p.output("best")).unwrap(),
+    );
+    corrupt_keeping_manifest(&p.output("sweep"), "E_tr");
+    assert!(
+        matches!(p.state("sweep"), State::Damaged(ref why) if why.contains("checksum")),
+        "{:?}",
+        p.state("sweep")
+    );
+    assert!(table::read(&p.output("sweep"))
+        .unwrap_err()
+        .to_string()
+        .contains("checksum"));
+    // Forcing the downstream stage recomputes the damaged input first, with a warning.
+    let events = p.run_with(&["best"], true);
+    assert!(events
+        .warnings
+        .lock()
+        .unwrap()
+        .iter()
+        .any(|w| w.contains("`sweep`") && w.contains("again")));
+    assert_eq!(std::fs::read(p.output("sweep")).unwrap(), sweep);
+    assert_eq!(std::fs::read(p.output("best")).unwrap(), best);
+
+    // One flipped bit in any page (data, header or statistics) or in the manifest is never
+    // fresh either; every such byte is tried.
+    let footer = u32::from_le_bytes(sweep[sweep.len() - 8..sweep.len() - 4].try_into().unwrap());
+    let pages = sweep.len() - 8 - footer as usize;
+    let manifest_text = table::read_manifest(&p.output("sweep"))
+        .unwrap()
+        .unwrap()
+        .to_json_text();
+    let manifest_at = sweep
+        .windows(manifest_text.len())
+        .position(|w| w == manifest_text.as_bytes())
+        .unwrap();
+    let offsets = (0..pages).chain(manifest_at..manifest_at + manifest_text.len());
+    for offset in offsets {
+        let mut bytes = sweep.clone();
+        bytes[offset] ^= 0x04;
+        std::fs::write(p.output("sweep"), &bytes).unwrap();
+        assert!(
+            !matches!(p.state("sweep"), State::Fresh),
+            "a flip at byte {offset} of {} went unnoticed",
+            sweep.len()
+        );
+    }
+}
+
+#[test]
+fn a_report_writes_only_markdown_inside_the_tree_and_never_over_a_file_it_did_not_write() {
+    let report = REPORT.replace("PAPER", "0.1");
+    for (markdown, expected) in [
+        ("../../x.md", "inside the project"),
+        ("/tmp/x.md", "inside the project"),
+        ("results/sweep.parquet", "must end in `.md`"),
+        ("figures/f.png", "must end in `.md`"),
+    ] {
+        let e = load_error(&[
+            ("sweep", SWEEP),
+            ("at_end", REDUCE),
+            (
+                "report",
+                &report.replace("\"REPORT.md\"", &format!("\"{markdown}\"")),
+            ),
+        ]);
+        assert!(
+            e.contains("report.toml") && e.contains("`markdown`") && e.contains(expected),
+            "{markdown}: {e}"
+        );
+    }
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("report", &report),
+        ("report2", &report),
+    ]);
+    assert!(
+        e.contains("report2.toml") && e.contains("written by stage `report`"),
+        "{e}"
+    );
+
+    // A hand-written file of that name is not overwritten; the report's own file is.
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("report", &report)]);
+    let markdown = p.results.parent().unwrap().join("REPORT.md");
+    std::fs::write(&markdown, "mine").unwrap();
+    let options = RunOptions {
+        targets: vec![],
+        force: false,
+        dry_run: false,
+        results: p.results.clone(),
+        figures: p.results.join("figures"),
+    };
+    let e = run(&p.load(), &options, &Counter::default()).unwrap_err();
+    assert!(e.to_string().contains("did not write"), "{e}");
+    assert_eq!(std::fs::read_to_string(&markdown).unwrap(), "mine");
+    std::fs::remove_file(&markdown).unwrap();
+    p.run(&[]);
+    p.run_with(&["report"], true);
+    assert!(std::fs::read_to_string(&markdown)
+        .unwrap()
+        .starts_with("# Tiny report"));
+}
+
+#[test]
+fn diff_reports_changed_types_and_missing_manifests_and_refuses_unknown_columns() {
+    use polars::prelude::*;
+    let a = Project::new(&[("sweep", SWEEP)]);
+    let b = Project::new(&[("sweep", SWEEP)]);
+    a.run(&[]);
+    b.run(&[]);
+    // `steps` (integers) rewritten as floats, without a manifest.
+    let mut frame = table::read(&b.output("sweep")).unwrap();
+    let steps = frame
+        .column("steps")
+        .unwrap()
+        .cast(&DataType::Float64)
+        .unwrap();
+    frame.with_column(steps).unwrap();
+    let file = std::fs::File::create(b.output("sweep")).unwrap();
+    ParquetWriter::new(file).finish(&mut frame).unwrap();
+    let report = diff(&a.results, &b.results, &DiffOptions::default()).unwrap();
+    assert!(!report.agrees());
+    assert!(
+        report
+            .problems
+            .iter()
+            .any(|p| p.contains("`steps`") && p.contains("f64")),
+        "{:?}",
+        report.problems
+    );
+    assert!(
+        report
+            .problems
+            .iter()
+            .any(|p| p.contains("no `woodpile` manifest")),
+        "{:?}",
+        report.problems
+    );
+    let mut options = DiffOptions::default();
+    options.columns.insert("nope".into(), Tolerance::default());
+    let e = diff(&a.results, &a.results, &options).unwrap_err();
+    assert!(e.to_string().contains("`nope`"), "{e}");
+}
+
+#[test]
+fn every_run_sweeps_leftover_temporaries_even_when_all_is_fresh() {
+    let p = Project::new(&[("sweep", SWEEP)]);
+    p.run(&[]);
+    // Another machine's temporary, two days old; and one of a process on this machine that
+    // has ended (pid 0 is never a user process) cannot be named without the host, so the
+    // foreign one stands for both rules here (the atomic module tests the other).
+    let figures = p.results.join("figures");
+    std::fs::create_dir_all(&figures).unwrap();
+    let stale = figures.join(".f.png~elsewhere~12~abc.tmp");
+    let file = std::fs::File::create(&stale).unwrap();
+    let two_days = std::time::Duration::from_secs(2 * 24 * 3600);
+    file.set_modified(std::time::SystemTime::now() - two_days)
+        .unwrap();
+    drop(file);
+    let events = p.run(&[]);
+    assert!(!stale.exists());
+    assert!(
+        events.started.lock().unwrap().is_empty(),
+        "nothing was stale"
+    );
+    assert!(events
+        .warnings
+        .lock()
+        .unwrap()
+        .iter()
+        .any(|w| w.contains("temporary")));
+}
+
+#[test]
+fn grids_too_large_to_plan_are_refused_at_load_with_their_size() {
+    let huge = SWEEP.replace(
+        "L = [0, 1]",
+        "L = { from = 0, to = 9999, step = 1 }\nx = { from = 0, to = 999, step = 1 }",
+    );
+    let e = load_error(&[("sweep", &huge)]);
+    assert!(
+        e.contains("sweep.toml") && e.contains("30000000 points"),
+        "{e}"
+    );
+    let fine = SWEEP.replace("sample_every = 2.0", "sample_every = 0.0001");
+    let fine = fine.replace("to = 1.5, step = 0.5", "to = 1000.5, step = 0.5");
+    let e = load_error(&[("sweep", &fine)]);
+    assert!(e.contains("sweep.toml") && e.contains("GB"), "{e}");
+}
