@@ -115,6 +115,7 @@ impl Approximate {
             .f64("error", error)
             .i64("on_diagonal", diagonal);
         Ok(Output {
+            failures: Vec::new(),
             frame: columns.into_frame()?,
             summary,
         })

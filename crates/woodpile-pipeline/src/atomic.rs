@@ -29,6 +29,13 @@ pub fn write_with(
     let result = (|| {
         // Dropped on any error before `persist`: the temporary is removed with it.
         let mut tmp = temp_file(path, dir)?;
+        // tempfile creates its files private (0600); a result is as readable as any file.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            tmp.as_file()
+                .set_permissions(fs::Permissions::from_mode(0o644))?;
+        }
         fill(tmp.as_file_mut())?;
         tmp.as_file_mut().flush()?;
         tmp.as_file().sync_all()?;
@@ -146,6 +153,12 @@ mod tests {
         write(&path, b"first").unwrap();
         write(&path, b"second").unwrap();
         assert_eq!(fs::read(&path).unwrap(), b"second");
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let mode = fs::metadata(&path).unwrap().permissions().mode();
+            assert_eq!(mode & 0o777, 0o644, "results are readable by others");
+        }
         let names: Vec<_> = fs::read_dir(path.parent().unwrap())
             .unwrap()
             .map(|e| e.unwrap().file_name())

@@ -41,6 +41,13 @@ pub enum PipelineError {
         /// What went wrong.
         reason: String,
     },
+    /// The run finished what it could, but stages failed (or failed in part, or were skipped
+    /// because an input failed): each named with its reason.
+    #[error("{} failure(s): {}", failures.len(), failures.join("; "))]
+    Failed {
+        /// One line per failure.
+        failures: Vec<String>,
+    },
     /// A stage ran but cannot produce its output (bad data from upstream, impossible
     /// reduction, ...).
     #[error("stage `{stage}`: {reason}")]

@@ -16,7 +16,9 @@
 //!
 //! One output row per model: A, B, C with standard errors, the relative error
 //! ‖y − f‖/‖y‖, and, when given, the paper's coefficients and *their* relative error on our
-//! data, so the two fits can be judged on the same numbers.
+//! data, so the two fits can be judged on the same numbers. A model that cannot be fitted keeps
+//! its row with null coefficients and the reason in `failure`; the stage still writes its
+//! table, and the run ends non-zero naming it.
 
 use polars::prelude::DataFrame;
 use serde_json::json;
@@ -124,6 +126,7 @@ impl FitStage {
             .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
         let xs = column(&self.x)?;
         let mut out = Rows::default();
+        let mut failures = Vec::new();
         for m in &self.models {
             let ys = column(&m.y)?;
             let (x, y): (Vec<f64>, Vec<f64>) = keep
@@ -132,8 +135,15 @@ impl FitStage {
                 .filter(|(a, b)| a.is_finite() && b.is_finite())
                 .filter(|(a, _)| m.x_range.is_none_or(|[lo, hi]| (lo..=hi).contains(a)))
                 .unzip();
-            let result = fit(m.form, &x, &y, m.start)
-                .map_err(|e| fail(format!("model `{}`: {e}", m.name)))?;
+            let result = match fit(m.form, &x, &y, m.start) {
+                Ok(result) => result,
+                Err(reason) => {
+                    // A fit that fails is a row with its reason, as a failed scene is.
+                    failures.push(format!("model `{}`: {reason}", m.name));
+                    out.push_failure(m, x.len(), reason);
+                    continue;
+                }
+            };
             let paper_error = m.paper.map(|p| {
                 let ssr: f64 = x
                     .iter()
@@ -154,7 +164,8 @@ impl FitStage {
         let rows = out.name.len();
         Ok(Output {
             frame: out.into_columns().into_frame()?,
-            summary: json!({"models": rows, "rows_used": keep.len()}),
+            summary: json!({"models": rows, "rows_used": keep.len(), "failed": failures.len()}),
+            failures,
         })
     }
 }
@@ -173,6 +184,7 @@ struct Rows {
     iterations: Vec<Option<i64>>,
     paper: [Vec<Option<f64>>; 3],
     paper_relative_error: Vec<Option<f64>>,
+    failure: Vec<Option<String>>,
 }
 
 impl Rows {
@@ -198,6 +210,26 @@ impl Rows {
         self.n.push(Some(n as i64));
         self.iterations.push(Some(f.iterations as i64));
         self.paper_relative_error.push(paper_error);
+        self.failure.push(None);
+    }
+
+    /// A model that could not be fitted: its name and inputs, null coefficients, the reason.
+    fn push_failure(&mut self, m: &Model, n: usize, reason: String) {
+        self.name.push(Some(m.name.clone()));
+        self.form.push(Some(m.form.name().to_string()));
+        self.y.push(Some(m.y.clone()));
+        for k in 0..3 {
+            self.params[k].push(None);
+            self.errors[k].push(None);
+            self.paper[k].push(m.paper.map(|p| p[k]));
+        }
+        self.relative_error.push(None);
+        self.x_min.push(None);
+        self.x_max.push(None);
+        self.n.push(Some(n as i64));
+        self.iterations.push(None);
+        self.paper_relative_error.push(None);
+        self.failure.push(Some(reason));
     }
 
     fn into_columns(self) -> Columns {
@@ -215,6 +247,7 @@ impl Rows {
         c.i64("n", self.n).i64("iterations", self.iterations);
         c.f64("paper_A", pa).f64("paper_B", pb).f64("paper_C", pc);
         c.f64("paper_relative_error", self.paper_relative_error);
+        c.str("failure", self.failure);
         c
     }
 }

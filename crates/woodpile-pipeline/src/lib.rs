@@ -59,4 +59,8 @@ pub struct Output {
     pub frame: polars::prelude::DataFrame,
     /// Kind-specific facts for the manifest.
     pub summary: serde_json::Value,
+    /// What failed inside the stage without stopping it (a fit that did not converge, a
+    /// quote that could not be read): recorded in the table, and the run ends non-zero
+    /// naming them.
+    pub failures: Vec<String>,
 }

@@ -76,9 +76,64 @@ pub struct Fit {
 /// Most iterations before giving up.
 const MAX_ITERATIONS: usize = 500;
 
-/// Fits `form` to (x, y) from `start`; `Err` when it cannot (too few points, singular
-/// normal equations, no convergence).
+/// Fits `form` to (x, y) from `start`; if that does not converge, again from the best start a
+/// profile over B finds (for each B on a grid, A and C are a linear least-squares problem).
+/// `Err` when neither converges (too few points, singular normal equations, no convergence).
+///
+/// Why the fallback: a nearly flat power law (T(eps) on all of (0, 60]) has A, B and C so
+/// correlated that a start far from the optimum can wander for hundreds of iterations; the
+/// profile lands near the optimum in B, the one nonlinear parameter. Fits that converge from
+/// the given start are untouched.
 pub fn fit(form: Form, x: &[f64], y: &[f64], start: [f64; 3]) -> Result<Fit, String> {
+    let first = levenberg_marquardt(form, x, y, start);
+    match first {
+        Ok(fit) => Ok(fit),
+        Err(reason) => match profile_start(form, x, y) {
+            Some(profiled) => levenberg_marquardt(form, x, y, profiled)
+                .map_err(|again| format!("{reason} (and from a start profiled over B: {again})")),
+            None => Err(reason),
+        },
+    }
+}
+
+/// The (A, B, C) with the smallest residual over a grid of B, A and C solved exactly for each.
+fn profile_start(form: Form, x: &[f64], y: &[f64]) -> Option<[f64; 3]> {
+    let grid: Vec<f64> = match form {
+        Form::Power => (0..=240)
+            .map(|k| -3.0 + 6.0 * k as f64 / 240.0)
+            .filter(|b: &f64| b.abs() > 1e-6)
+            .collect(),
+        Form::Tanh => (0..=240)
+            .map(|k| 10f64.powf(-3.0 + 5.0 * k as f64 / 240.0))
+            .collect(),
+    };
+    let n = x.len() as f64;
+    grid.into_iter()
+        .filter_map(|b| {
+            let g: Vec<f64> = x.iter().map(|&xi| form.eval([1.0, b, 0.0], xi)).collect();
+            let (sg, sgg) = (g.iter().sum::<f64>(), g.iter().map(|v| v * v).sum::<f64>());
+            let (sy, sgy) = (
+                y.iter().sum::<f64>(),
+                g.iter().zip(y).map(|(a, b)| a * b).sum::<f64>(),
+            );
+            let det = n * sgg - sg * sg;
+            if !(det.abs() > 1e-300) {
+                return None;
+            }
+            let a = (n * sgy - sg * sy) / det;
+            let c = (sy - a * sg) / n;
+            let ssr: f64 = g
+                .iter()
+                .zip(y)
+                .map(|(gi, yi)| (a * gi + c - yi).powi(2))
+                .sum();
+            ssr.is_finite().then_some(([a, b, c], ssr))
+        })
+        .min_by(|p, q| p.1.total_cmp(&q.1))
+        .map(|(p, _)| p)
+}
+
+fn levenberg_marquardt(form: Form, x: &[f64], y: &[f64], start: [f64; 3]) -> Result<Fit, String> {
     let n = x.len();
     if n != y.len() || n < 4 {
         return Err(format!("need at least 4 points with x and y, have {n}"));
@@ -132,7 +187,15 @@ pub fn fit(form: Form, x: &[f64], y: &[f64], start: [f64; 3]) -> Result<Fit, Str
         }
     }
     if !converged {
-        return Err(format!("no convergence in {MAX_ITERATIONS} iterations"));
+        let drift = if form == Form::Power && p[1].abs() < 1e-2 && p[0].abs() > 10.0 {
+            "; the fit drifts to B → 0, |A| → ∞, the limit a + b ln x: no power law fits these data"
+        } else {
+            ""
+        };
+        return Err(format!(
+            "no convergence in {MAX_ITERATIONS} iterations (last A, B, C = {:.4e}, {:.4e}, {:.4e}){drift}",
+            p[0], p[1], p[2]
+        ));
     }
     let (jtj, _) = normal_equations(form, p, x, y);
     let inverse = invert(jtj)

@@ -166,6 +166,7 @@ impl Optimize {
         columns.f64("grid_table_value", vec![target[best_row], None]);
         columns.i64("simulations", vec![Some(1), Some(evaluations as i64)]);
         Ok(Output {
+            failures: Vec::new(),
             frame: columns.into_frame()?,
             summary: json!({"grid": grid_value, "refined": best_value, "gain": best_value - grid_value, "simulations": evaluations}),
         })

@@ -286,7 +286,21 @@ fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
             }
             Ok(())
         }
-        Spec::Fit(_) | Spec::Render(_) => {
+        Spec::Render(_) => match stage
+            .inputs
+            .iter()
+            .position(|i| matches!(kind_of(i), Spec::Render(_)))
+        {
+            Some(k) => error(
+                &format!("inputs[{k}]"),
+                format!("`{}` is a render stage: read a data table", stage.inputs[k]),
+            ),
+            None if stage.inputs.is_empty() => {
+                error("inputs", "a render stage reads one or more tables".into())
+            }
+            None => Ok(()),
+        },
+        Spec::Fit(_) => {
             let [input] = stage.inputs.as_slice() else {
                 return error(
                     "inputs",

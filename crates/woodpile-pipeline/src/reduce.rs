@@ -125,6 +125,7 @@ impl Reduce {
             .str("failure", rows.iter().map(|p| p.failure.clone()).collect());
         let failed: usize = rows.iter().map(|p| p.failed).sum();
         Ok(Output {
+            failures: Vec::new(),
             frame: columns.into_frame()?,
             summary: json!({"rows": rows.len(), "failed_points": failed, "at": self.at}),
         })

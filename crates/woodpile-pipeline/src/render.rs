@@ -1,50 +1,93 @@
-//! `kind = "render"`: draw one input table as a figure (PNG and SVG under `figures/`), and keep
+//! `kind = "render"`: draw input tables as one figure (PNG and SVG under `figures/`), and keep
 //! exactly the plotted numbers as the stage's parquet table.
+//!
+//! A figure is a title over panels laid out `columns` per row. The simple form draws one
+//! input, with the plot keys at the top level:
 //!
 //! ```toml
 //! kind = "render"
 //! inputs = ["f4_fractions"]
-//! title = "Fig. 4: energy fractions against the mass ratio"
+//! title = "Fig. 4: energy fractions at t = {f4_fractions.params.at}"
 //! columns = 2                     # panels per row
 //! [lines]                         # or [heatmap]
 //! x = "eps"
 //! y = ["R", "T", "E_tr"]          # one curve each
 //! panels = "L"                    # optional: one panel per value of this column
 //! x_label = "ε"
-//! y_label = "energy fraction at t = 150"
+//! y_label = "energy fraction"
 //! ```
 //!
-//! An optional `where = { column = value }` draws only the matching rows, and
-//! `panel_label = "column"` titles each panel by that string column instead of `panel = value`. In `[lines]`,
-//! `series = "column"` draws one curve of the single `y` per value of that column, named by
-//! the string column `series_label` when given (work-precision charts: one curve per method).
-//! `[heatmap]` takes `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`,
-//! optionally `panels`, `mark_max = true` (circle and label the largest z), and
-//! `overlay = [{ x = "column", label = "text" }, ...]`: a line over each panel through
-//! (that column's value, y) for every row of the map, e.g. a stability bound against ε.
+//! The composite form lays out panels from several inputs, as the paper's multi-panel
+//! figures do: `[[panel]]` tables, each with `input = "stage"` and the same keys as the simple
+//! form (`where`, `panel_label`, `[panel.lines]` or `[panel.heatmap]`), plus an optional
+//! fixed `title`.
+//!
+//! Keys of a panel (simple form: top level):
+//! - `where = { column = value }` draws only the matching rows; `panel_label = "column"` titles
+//!   each panel by that string column instead of `panel = value`.
+//! - `x_range = [lo, hi]`, `y_range = [lo, hi]`: the visible ranges (a zoom).
+//! - `mark = [{ x = 0.0, label = "defect" }, { y = 40.0, label = "switch-on" }]`: dashed lines
+//!   at fixed positions, with a legend entry per label.
+//! - `[lines]`: `x`, `y` (columns), `x_label`, `y_label`, optional `panels`; `series = "column"`
+//!   draws one curve of the single `y` per value of that column, named by the string column
+//!   `series_label` when given.
+//! - `[heatmap]`: `x`, `y`, `z` (a rectangular grid), `x_label`, `y_label`, `z_label`, optional
+//!   `panels`, `mark_max = true` (circle and label the largest z), `colours = "sequential"`
+//!   (viridis, the default) or `"diverging"` (blue-white-red, white at zero: signed values), or
+//!   `categories = ["meets", "misses", "unstable"]` (z = 0, 1, 2 ... as named colours in a
+//!   legend), `z_range = [lo, hi]`, and `overlay = [{ x = "column", label = "text" }, ...]`: a
+//!   line over each panel through (that column's value, y) for every row of the map.
+//!
+//! `same_colour_scale = true` gives every heat map of the figure one colour scale, the union of
+//! their ranges, so that panels compare by colour (the paper's Fig. 9).
+//!
+//! Titles (the figure's and fixed panel titles) may quote an input's manifest:
+//! `{stage.params.at}` or `{stage.summary.tolerance}` is replaced by that value, so a title
+//! follows the parameters it states.
 
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use polars::prelude::DataFrame;
-use serde_json::json;
-use woodpile_plot::{cell_edges, Figure, HeatPanel, LinePanel, Panel, Series};
+use serde_json::{json, Value};
+use woodpile_plot::{
+    cell_edges, Colours, Figure, HeatPanel, LinePanel, Mark, MarkAt, Panel, Series, View,
+};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::manifest::Manifest;
 use crate::table::{f64_column, matching_rows, str_column, Columns};
 use crate::Output;
 
 /// A parsed render stage.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Render {
-    /// Figure title.
+    /// Figure title, possibly quoting input manifests (`{stage.params.at}`).
     pub title: String,
-    /// String column whose value titles each panel (instead of `column = value`).
-    pub panel_label: Option<String>,
     /// Panels per row.
     pub columns: usize,
+    /// What to draw, in order.
+    pub panels: Vec<PanelSpec>,
+    /// One colour scale for every heat map of the figure.
+    pub same_colour_scale: bool,
+}
+
+/// One input table drawn as one or more panels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PanelSpec {
+    /// The stage whose table is drawn.
+    pub input: String,
+    /// A fixed title (may quote manifests); otherwise `panels = value` or `panel_label`.
+    pub title: Option<String>,
+    /// String column whose value titles each panel (instead of `column = value`).
+    pub panel_label: Option<String>,
     /// Row filter: draw only rows where these columns equal these values.
     pub filter: Vec<(String, f64)>,
+    /// Dashed lines at fixed positions.
+    pub marks: Vec<Mark>,
+    /// Visible ranges.
+    pub view: View,
     /// What to draw.
     pub plot: Plot,
 }
@@ -89,90 +132,69 @@ pub enum Plot {
         mark_max: bool,
         /// Lines over the map: (x column, legend label).
         overlays: Vec<(String, String)>,
+        /// How values become colours.
+        colours: Colours,
+        /// The value range the colours span.
+        z_range: Option<(f64, f64)>,
     },
 }
 
 impl Render {
-    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Render> {
+    /// Parses the render keys; `inputs` are the stage's inputs, which every panel and every
+    /// quoted manifest must name.
+    pub(crate) fn parse(fields: &mut Fields<'_>, inputs: &[String]) -> Result<Render> {
         let title: String = fields.required("title")?;
         let columns = fields.optional::<i64>("columns")?.unwrap_or(1);
         if !(1..=8).contains(&columns) {
             return Err(fields.error("columns", "expected 1 to 8 panels per row"));
         }
-        let filter = fields.equality_filter("where")?;
-        let panel_label = fields.optional::<String>("panel_label")?;
-        let lines = fields.optional::<toml::Table>("lines")?;
-        let heat = fields.optional::<toml::Table>("heatmap")?;
-        let plot = match (lines, heat) {
-            (Some(t), None) => {
-                let mut f = fields.nested("lines", t);
-                let plot = Plot::Lines {
-                    x: f.required("x")?,
-                    y: f.required("y")?,
-                    panels: f.optional("panels")?,
-                    series: f.optional("series")?,
-                    series_label: f.optional("series_label")?,
-                    x_label: f.required("x_label")?,
-                    y_label: f.required("y_label")?,
-                };
-                if let Plot::Lines {
-                    y,
-                    series,
-                    series_label,
-                    ..
-                } = &plot
-                {
-                    if series.is_some() && y.len() != 1 {
-                        return Err(f.error("y", "with `series`, give exactly one y column"));
+        let same_colour_scale = flag(fields, "same_colour_scale")?;
+        check_quotes(&title, inputs).map_err(|reason| fields.error("title", reason))?;
+        let panels = match fields.take("panel") {
+            Some(toml::Value::Array(items)) => {
+                let mut panels = Vec::with_capacity(items.len());
+                for (i, item) in items.into_iter().enumerate() {
+                    let key = format!("panel[{i}]");
+                    let toml::Value::Table(table) = item else {
+                        return Err(fields.error(&key, "expected a table"));
+                    };
+                    let mut f = fields.nested(&key, table);
+                    let input: String = f.required("input")?;
+                    if !inputs.contains(&input) {
+                        return Err(f.error(
+                            "input",
+                            format!("`{input}` is not one of the stage's inputs {inputs:?}"),
+                        ));
                     }
-                    if series.is_none() && series_label.is_some() {
-                        return Err(f.error("series_label", "needs `series`"));
+                    let title = f.optional::<String>("title")?;
+                    if let Some(t) = &title {
+                        check_quotes(t, inputs).map_err(|reason| f.error("title", reason))?;
                     }
+                    let panel = parse_panel(&mut f, input, title)?;
+                    f.finish()?;
+                    panels.push(panel);
                 }
-                f.finish()?;
-                plot
+                if panels.is_empty() {
+                    return Err(fields.error("panel", "expected one or more [[panel]] tables"));
+                }
+                panels
             }
-            (None, Some(t)) => {
-                let mut f = fields.nested("heatmap", t);
-                let mark_max = match f.take("mark_max") {
-                    None => false,
-                    Some(toml::Value::Boolean(b)) => b,
-                    Some(_) => return Err(f.error("mark_max", "expected true or false")),
+            Some(_) => return Err(fields.error("panel", "expected [[panel]] tables")),
+            None => {
+                let [input] = inputs else {
+                    return Err(fields.error(
+                        "inputs",
+                        "a render stage of several inputs draws them as [[panel]] tables, each naming its input",
+                    ));
                 };
-                let overlays = parse_overlays(&mut f)?;
-                let plot = Plot::Heatmap {
-                    overlays,
-                    x: f.required("x")?,
-                    y: f.required("y")?,
-                    z: f.required("z")?,
-                    panels: f.optional("panels")?,
-                    x_label: f.required("x_label")?,
-                    y_label: f.required("y_label")?,
-                    z_label: f.required("z_label")?,
-                    mark_max,
-                };
-                f.finish()?;
-                plot
-            }
-            _ => {
-                let others = fields.keys();
-                let reason = if others.is_empty() {
-                    "give exactly one of [lines] or [heatmap]".to_string()
-                } else {
-                    format!(
-                        "give exactly one of [lines] or [heatmap] (unknown keys: {})",
-                        others.join(", ")
-                    )
-                };
-                return Err(fields.error("lines", reason));
+                vec![parse_panel(fields, input.clone(), None)?]
             }
         };
         Ok(Render {
             title,
-            panel_label,
             columns: columns as usize,
-            filter,
-            plot,
+            panels,
+            same_colour_scale,
         })
     }
 
@@ -184,23 +206,358 @@ impl Render {
         ]
     }
 
-    /// Draws `input` and returns the plotted numbers.
-    pub(crate) fn run(&self, stage: &str, input: &DataFrame, figures: &Path) -> Result<Output> {
+    /// Draws the panels from `inputs` (stage name to its table and manifest) and returns the
+    /// plotted numbers, one row per drawn point or cell.
+    pub(crate) fn run(
+        &self,
+        stage: &str,
+        inputs: &HashMap<String, (DataFrame, Manifest)>,
+        figures: &Path,
+    ) -> Result<Output> {
         let fail = |e: PipelineError| PipelineError::stage(stage, e.to_string());
-        let all = |name: &str| f64_column(input, name).map_err(fail);
-        let keep = matching_rows(input, &self.filter)
-            .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
+        let quote = |text: &str| quoted(text, inputs).map_err(|r| PipelineError::stage(stage, r));
+        let mut panels = Vec::new();
+        for spec in &self.panels {
+            let (frame, _) = &inputs[&spec.input];
+            let title = spec.title.as_deref().map(quote).transpose()?;
+            panels.extend(spec.draw(frame, title).map_err(fail)?);
+        }
+        if self.same_colour_scale {
+            share_colour_scale(&mut panels);
+        }
+        let figure = Figure {
+            title: quote(&self.title)?,
+            columns: self.columns,
+            panel_size: match panels.first() {
+                Some(Panel::Heat(_)) => (620, 500),
+                _ => (560, 400),
+            },
+            panels,
+        };
+        let [png, svg] = Render::files(figures, stage);
+        let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
+        crate::atomic::write(&png, &figure.png().map_err(drawing)?)?;
+        crate::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
+        Ok(Output {
+            failures: Vec::new(),
+            frame: plotted(&figure.panels).into_frame()?,
+            summary: json!({
+                "figures": [format!("{stage}.png"), format!("{stage}.svg")],
+                "panels": figure.panels.len(),
+                "title": figure.title,
+            }),
+        })
+    }
+}
+
+fn flag(fields: &mut Fields<'_>, key: &str) -> Result<bool> {
+    match fields.take(key) {
+        None => Ok(false),
+        Some(toml::Value::Boolean(b)) => Ok(b),
+        Some(_) => Err(fields.error(key, "expected true or false")),
+    }
+}
+
+fn range_key(f: &mut Fields<'_>, key: &str) -> Result<Option<(f64, f64)>> {
+    match f.optional::<Vec<f64>>(key)?.as_deref() {
+        None => Ok(None),
+        Some(&[lo, hi]) if lo < hi && lo.is_finite() && hi.is_finite() => Ok(Some((lo, hi))),
+        Some(_) => Err(f.error(key, "expected [lo, hi] with lo < hi")),
+    }
+}
+
+/// The keys of one panel (at the top level in the simple form).
+fn parse_panel(f: &mut Fields<'_>, input: String, title: Option<String>) -> Result<PanelSpec> {
+    let filter = f.equality_filter("where")?;
+    let panel_label = f.optional::<String>("panel_label")?;
+    let view = View {
+        x: range_key(f, "x_range")?,
+        y: range_key(f, "y_range")?,
+    };
+    let marks = parse_marks(f)?;
+    let lines = f.optional::<toml::Table>("lines")?;
+    let heat = f.optional::<toml::Table>("heatmap")?;
+    let plot = match (lines, heat) {
+        (Some(t), None) => {
+            let mut f = f.nested("lines", t);
+            let plot = Plot::Lines {
+                x: f.required("x")?,
+                y: f.required("y")?,
+                panels: f.optional("panels")?,
+                series: f.optional("series")?,
+                series_label: f.optional("series_label")?,
+                x_label: f.required("x_label")?,
+                y_label: f.required("y_label")?,
+            };
+            if let Plot::Lines {
+                y,
+                series,
+                series_label,
+                ..
+            } = &plot
+            {
+                if series.is_some() && y.len() != 1 {
+                    return Err(f.error("y", "with `series`, give exactly one y column"));
+                }
+                if series.is_none() && series_label.is_some() {
+                    return Err(f.error("series_label", "needs `series`"));
+                }
+            }
+            f.finish()?;
+            plot
+        }
+        (None, Some(t)) => {
+            let mut f = f.nested("heatmap", t);
+            let mark_max = flag(&mut f, "mark_max")?;
+            let overlays = parse_overlays(&mut f)?;
+            let categories = f.optional::<Vec<String>>("categories")?;
+            let colours = match (f.optional::<String>("colours")?.as_deref(), categories) {
+                (None | Some("sequential"), None) => Colours::Sequential,
+                (Some("diverging"), None) => Colours::Diverging,
+                (None, Some(names)) if !names.is_empty() => Colours::Categories(names),
+                (None, Some(_)) => return Err(f.error("categories", "name at least one")),
+                (Some(_), Some(_)) => {
+                    return Err(f.error("colours", "give `colours` or `categories`, not both"))
+                }
+                (Some(other), None) => {
+                    return Err(f.error(
+                        "colours",
+                        format!("expected \"sequential\" or \"diverging\", got \"{other}\""),
+                    ))
+                }
+            };
+            let plot = Plot::Heatmap {
+                overlays,
+                colours,
+                z_range: range_key(&mut f, "z_range")?,
+                x: f.required("x")?,
+                y: f.required("y")?,
+                z: f.required("z")?,
+                panels: f.optional("panels")?,
+                x_label: f.required("x_label")?,
+                y_label: f.required("y_label")?,
+                z_label: f.required("z_label")?,
+                mark_max,
+            };
+            f.finish()?;
+            plot
+        }
+        _ => {
+            let others = f.keys();
+            let reason = if others.is_empty() {
+                "give exactly one of [lines] or [heatmap]".to_string()
+            } else {
+                format!(
+                    "give exactly one of [lines] or [heatmap] (unknown keys: {})",
+                    others.join(", ")
+                )
+            };
+            return Err(f.error("lines", reason));
+        }
+    };
+    Ok(PanelSpec {
+        input,
+        title,
+        panel_label,
+        filter,
+        marks,
+        view,
+        plot,
+    })
+}
+
+/// `mark = [{ x = value, label = "text" } | { y = value, label = "text" }, ...]`.
+fn parse_marks(f: &mut Fields<'_>) -> Result<Vec<Mark>> {
+    let Some(value) = f.take("mark") else {
+        return Ok(Vec::new());
+    };
+    let toml::Value::Array(items) = value else {
+        return Err(f.error("mark", "expected an array of { x or y, label } tables"));
+    };
+    items
+        .into_iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let key = format!("mark[{i}]");
+            let toml::Value::Table(table) = item else {
+                return Err(f.error(&key, "expected a table { x = 0.0, label = \"text\" }"));
+            };
+            let mut m = f.nested(&key, table);
+            let at = match (m.optional::<f64>("x")?, m.optional::<f64>("y")?) {
+                (Some(x), None) => MarkAt::X(x),
+                (None, Some(y)) => MarkAt::Y(y),
+                _ => return Err(m.error("x", "give exactly one of x or y")),
+            };
+            let mark = Mark {
+                at,
+                label: m.required("label")?,
+            };
+            m.finish()?;
+            Ok(mark)
+        })
+        .collect()
+}
+
+/// `overlay = [{ x = "column", label = "text" }, ...]` of a `[heatmap]`.
+fn parse_overlays(f: &mut Fields<'_>) -> Result<Vec<(String, String)>> {
+    let Some(value) = f.take("overlay") else {
+        return Ok(Vec::new());
+    };
+    let toml::Value::Array(items) = value else {
+        return Err(f.error("overlay", "expected an array of { x, label } tables"));
+    };
+    items
+        .into_iter()
+        .enumerate()
+        .map(|(i, item)| {
+            let key = format!("overlay[{i}]");
+            let toml::Value::Table(table) = item else {
+                return Err(f.error(
+                    &key,
+                    "expected a table { x = \"column\", label = \"text\" }",
+                ));
+            };
+            let mut o = f.nested(&key, table);
+            let overlay = (o.required("x")?, o.required("label")?);
+            o.finish()?;
+            Ok(overlay)
+        })
+        .collect()
+}
+
+/// The `{stage.path}` quotes of `text`, each naming one of `inputs`.
+fn check_quotes(text: &str, inputs: &[String]) -> std::result::Result<(), String> {
+    for quote in quotes(text) {
+        let stage = quote.split('.').next().unwrap_or_default();
+        if !inputs.iter().any(|i| i == stage) {
+            return Err(format!(
+                "`{{{quote}}}` quotes `{stage}`, which is not one of the inputs {inputs:?}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn quotes(text: &str) -> impl Iterator<Item = &str> {
+    text.split('{')
+        .skip(1)
+        .filter_map(|part| part.split_once('}').map(|(q, _)| q))
+}
+
+/// `text` with every `{stage.path}` replaced by that value of the stage's manifest.
+fn quoted(
+    text: &str,
+    inputs: &HashMap<String, (DataFrame, Manifest)>,
+) -> std::result::Result<String, String> {
+    let mut out = text.to_string();
+    for quote in quotes(text) {
+        let (stage, path) = quote.split_once('.').unwrap_or((quote, ""));
+        let manifest = inputs
+            .get(stage)
+            .map(|(_, m)| serde_json::to_value(m).unwrap_or(Value::Null))
+            .ok_or_else(|| format!("`{{{quote}}}`: no input `{stage}`"))?;
+        let value = path
+            .split('.')
+            .filter(|k| !k.is_empty())
+            .try_fold(&manifest, |v, k| v.get(k))
+            .ok_or_else(|| format!("`{{{quote}}}`: the manifest of `{stage}` has no `{path}`"))?;
+        let shown = match value {
+            Value::Number(n) => n
+                .as_f64()
+                .map_or(n.to_string(), |x| woodpile_plot::tick(&x)),
+            Value::String(s) => s.clone(),
+            other => other.to_string(),
+        };
+        out = out.replace(&format!("{{{quote}}}"), &shown);
+    }
+    Ok(out)
+}
+
+/// Gives every heat map the union of their colour ranges.
+fn share_colour_scale(panels: &mut [Panel]) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for panel in panels.iter() {
+        if let Panel::Heat(h) = panel {
+            let (l, u) = h.z_range.unwrap_or_else(|| {
+                h.z.iter()
+                    .flatten()
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), &v| {
+                        (l.min(v), u.max(v))
+                    })
+            });
+            (lo, hi) = (lo.min(l), hi.max(u));
+        }
+    }
+    if lo < hi {
+        for panel in panels.iter_mut() {
+            if let Panel::Heat(h) = panel {
+                h.z_range = Some((lo, hi));
+            }
+        }
+    }
+}
+
+/// The plotted numbers of `panels`: one row per curve point or heat-map cell, with the
+/// panel's index, the curve's (or the colour bar's) label, and x, y, z.
+fn plotted(panels: &[Panel]) -> Columns {
+    let (mut panel, mut label) = (Vec::new(), Vec::new());
+    let (mut xs, mut ys, mut zs) = (Vec::new(), Vec::new(), Vec::new());
+    let mut push = |p: usize, l: &str, x: f64, y: f64, z: Option<f64>| {
+        panel.push(Some(p as i64));
+        label.push(Some(l.to_string()));
+        xs.push(Some(x));
+        ys.push(Some(y));
+        zs.push(z);
+    };
+    for (p, drawn) in panels.iter().enumerate() {
+        match drawn {
+            Panel::Lines(l) => {
+                for s in &l.series {
+                    for &(x, y) in &s.points {
+                        push(p, &s.label, x, y, None);
+                    }
+                }
+            }
+            Panel::Heat(h) => {
+                for (j, &y) in h.ys.iter().enumerate() {
+                    for (i, &x) in h.xs.iter().enumerate() {
+                        push(p, &h.z_label, x, y, h.z[j * h.xs.len() + i]);
+                    }
+                }
+                for s in &h.overlays {
+                    for &(x, y) in &s.points {
+                        push(p, &s.label, x, y, None);
+                    }
+                }
+            }
+        }
+    }
+    let mut columns = Columns::new();
+    columns
+        .i64("panel", panel)
+        .str("series", label)
+        .f64("x", xs)
+        .f64("y", ys)
+        .f64("z", zs);
+    columns
+}
+
+impl PanelSpec {
+    /// The panels this spec draws from `input`: one, or one per value of `panels`.
+    fn draw(&self, input: &DataFrame, title: Option<String>) -> Result<Vec<Panel>> {
+        let keep = matching_rows(input, &self.filter)?;
         let column = |name: &str| -> Result<Vec<Option<f64>>> {
-            let values = all(name)?;
+            let values = f64_column(input, name)?;
             Ok(keep.iter().map(|&r| values[r]).collect())
         };
         // An optional string column (curve or panel names), on the kept rows.
         let text_column = |name: Option<&String>| -> Result<Option<Vec<Option<String>>>> {
             let Some(name) = name else { return Ok(None) };
-            let values = str_column(input, name).map_err(fail)?;
+            let values = str_column(input, name)?;
             Ok(Some(keep.iter().map(|&r| values[r].clone()).collect()))
         };
-        let (panel_name, mut used): (Option<&String>, Vec<&String>) = match &self.plot {
+        let (panel_name, used): (Option<&String>, Vec<&String>) = match &self.plot {
             Plot::Lines {
                 x,
                 y,
@@ -247,6 +604,9 @@ impl Render {
         };
         let panel_labels = text_column(self.panel_label.as_ref())?;
         let title_of = |key: f64| {
+            if let Some(t) = &title {
+                return t.clone();
+            }
             let labelled = panel_labels.as_ref().and_then(|labels| {
                 (0..height)
                     .find(|&r| panel_values[r] == Some(key))
@@ -254,11 +614,11 @@ impl Render {
             });
             labelled.unwrap_or_else(|| {
                 panel_name
-                    .map(|p| format!("{p} = {key}"))
+                    .map(|p| format!("{p} = {}", woodpile_plot::tick(&key)))
                     .unwrap_or_default()
             })
         };
-        let panels: Vec<Panel> = keys
+        let panels = keys
             .iter()
             .map(|&key| match &self.plot {
                 Plot::Lines {
@@ -287,6 +647,8 @@ impl Render {
                                 .collect(),
                         })
                         .collect(),
+                    marks: self.marks.clone(),
+                    view: self.view,
                 }),
                 Plot::Lines {
                     x_label,
@@ -295,9 +657,8 @@ impl Render {
                     ..
                 } => {
                     // data = [x, y, series]; curves in order of first appearance.
-                    let rows = rows_of(key);
                     let mut curves: Vec<(f64, Vec<usize>)> = Vec::new();
-                    for r in rows {
+                    for r in rows_of(key) {
                         let Some(id) = data[2][r] else { continue };
                         match curves.iter_mut().find(|(v, _)| *v == id) {
                             Some((_, members)) => members.push(r),
@@ -314,7 +675,9 @@ impl Render {
                                 label: labels
                                     .as_ref()
                                     .and_then(|l| l[members[0]].clone())
-                                    .unwrap_or_else(|| format!("{series} = {id}")),
+                                    .unwrap_or_else(|| {
+                                        format!("{series} = {}", woodpile_plot::tick(&id))
+                                    }),
                                 points: members
                                     .iter()
                                     .map(|&r| {
@@ -326,149 +689,94 @@ impl Render {
                                     .collect(),
                             })
                             .collect(),
+                        marks: self.marks.clone(),
+                        view: self.view,
                     })
                 }
-                Plot::Heatmap {
-                    x_label,
-                    y_label,
-                    z_label,
-                    mark_max,
-                    overlays,
-                    ..
-                } => {
-                    let rows = rows_of(key);
-                    let labels: Vec<&str> = overlays.iter().map(|(_, l)| l.as_str()).collect();
-                    heat_panel(
-                        &data,
-                        &rows,
-                        (title_of(key), [x_label, y_label, z_label]),
-                        *mark_max,
-                        &labels,
-                    )
+                Plot::Heatmap { .. } => self.heat_panel(&data, &rows_of(key), title_of(key)),
+            })
+            .collect();
+        Ok(panels)
+    }
+
+    /// One heat-map panel from `data` = [x, y, z, overlay columns...] on `rows`.
+    fn heat_panel(&self, data: &[Vec<Option<f64>>], rows: &[usize], title: String) -> Panel {
+        let Plot::Heatmap {
+            x_label,
+            y_label,
+            z_label,
+            mark_max,
+            overlays,
+            colours,
+            z_range,
+            ..
+        } = &self.plot
+        else {
+            unreachable!("heat_panel is called for heat maps only")
+        };
+        let unique = |k: usize| {
+            let mut v: Vec<f64> = rows.iter().filter_map(|&r| data[k][r]).collect();
+            v.sort_by(f64::total_cmp);
+            v.dedup();
+            v
+        };
+        let (xs, ys) = (unique(0), unique(1));
+        let mut z = vec![None; xs.len() * ys.len()];
+        let mut best: Option<(f64, f64, f64)> = None;
+        for &r in rows {
+            let (Some(x), Some(y)) = (data[0][r], data[1][r]) else {
+                continue;
+            };
+            let i = xs.partition_point(|&v| v < x);
+            let j = ys.partition_point(|&v| v < y);
+            z[j * xs.len() + i] = data[2][r];
+            if let Some(v) = data[2][r].filter(|v| v.is_finite()) {
+                if best.is_none_or(|(_, _, b)| v > b) {
+                    best = Some((x, y, v));
+                }
+            }
+        }
+        // Each overlay: its x on every row of the map, as a step line over the row's cell.
+        let y_edges = cell_edges(&ys);
+        let overlays = overlays
+            .iter()
+            .enumerate()
+            .map(|(k, (_, label))| {
+                let column = &data[3 + k];
+                let points = ys
+                    .iter()
+                    .enumerate()
+                    .filter_map(|(j, &y)| {
+                        let x = rows
+                            .iter()
+                            .find(|&&r| data[1][r] == Some(y))
+                            .and_then(|&r| column[r])?;
+                        Some([(x, y_edges[j]), (x, y_edges[j + 1])])
+                    })
+                    .flatten()
+                    .collect();
+                Series {
+                    label: label.clone(),
+                    points,
                 }
             })
             .collect();
-        let figure = Figure {
-            title: self.title.clone(),
-            panels,
-            columns: self.columns,
-            panel_size: match self.plot {
-                Plot::Lines { .. } => (560, 400),
-                Plot::Heatmap { .. } => (620, 500),
-            },
-        };
-        let [png, svg] = Render::files(figures, stage);
-        let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
-        crate::atomic::write(&png, &figure.png().map_err(drawing)?)?;
-        crate::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
-        // The stage's table: exactly the plotted columns.
-        if let Some(p) = panel_name {
-            used.insert(0, p);
-        }
-        let mut columns = Columns::new();
-        for name in used {
-            columns.f64(name, column(name)?);
-        }
-        Ok(Output {
-            frame: columns.into_frame()?,
-            summary: json!({"figures": [format!("{stage}.png"), format!("{stage}.svg")], "panels": keys.len()}),
+        Panel::Heat(HeatPanel {
+            title,
+            x_label: x_label.clone(),
+            y_label: y_label.clone(),
+            z_label: z_label.clone(),
+            overlays,
+            xs,
+            ys,
+            z,
+            marker: best
+                .filter(|_| *mark_max)
+                .map(|(x, y, v)| (x, y, format!("max {v:.4}"))),
+            colours: colours.clone(),
+            z_range: *z_range,
+            marks: self.marks.clone(),
+            view: self.view,
         })
     }
-}
-
-/// `overlay = [{ x = "column", label = "text" }, ...]` of a `[heatmap]`.
-fn parse_overlays(f: &mut Fields<'_>) -> Result<Vec<(String, String)>> {
-    let Some(value) = f.take("overlay") else {
-        return Ok(Vec::new());
-    };
-    let toml::Value::Array(items) = value else {
-        return Err(f.error("overlay", "expected an array of { x, label } tables"));
-    };
-    items
-        .into_iter()
-        .enumerate()
-        .map(|(i, item)| {
-            let key = format!("overlay[{i}]");
-            let toml::Value::Table(table) = item else {
-                return Err(f.error(
-                    &key,
-                    "expected a table { x = \"column\", label = \"text\" }",
-                ));
-            };
-            let mut o = f.nested(&key, table);
-            let overlay = (o.required("x")?, o.required("label")?);
-            o.finish()?;
-            Ok(overlay)
-        })
-        .collect()
-}
-
-/// One heat-map panel from `data` = [x, y, z, overlay columns...] on `rows`.
-fn heat_panel(
-    data: &[Vec<Option<f64>>],
-    rows: &[usize],
-    (title, [x_label, y_label, z_label]): (String, [&String; 3]),
-    mark_max: bool,
-    overlay_labels: &[&str],
-) -> Panel {
-    let unique = |k: usize| {
-        let mut v: Vec<f64> = rows.iter().filter_map(|&r| data[k][r]).collect();
-        v.sort_by(f64::total_cmp);
-        v.dedup();
-        v
-    };
-    let (xs, ys) = (unique(0), unique(1));
-    let mut z = vec![None; xs.len() * ys.len()];
-    let mut best: Option<(f64, f64, f64)> = None;
-    for &r in rows {
-        let (Some(x), Some(y)) = (data[0][r], data[1][r]) else {
-            continue;
-        };
-        let i = xs.partition_point(|&v| v < x);
-        let j = ys.partition_point(|&v| v < y);
-        z[j * xs.len() + i] = data[2][r];
-        if let Some(v) = data[2][r].filter(|v| v.is_finite()) {
-            if best.is_none_or(|(_, _, b)| v > b) {
-                best = Some((x, y, v));
-            }
-        }
-    }
-    // Each overlay: its x on every row of the map, as a step line over the row's cell.
-    let y_edges = cell_edges(&ys);
-    let overlays = overlay_labels
-        .iter()
-        .enumerate()
-        .map(|(k, label)| {
-            let column = &data[3 + k];
-            let points = ys
-                .iter()
-                .enumerate()
-                .filter_map(|(j, &y)| {
-                    let x = rows
-                        .iter()
-                        .find(|&&r| data[1][r] == Some(y))
-                        .and_then(|&r| column[r])?;
-                    Some([(x, y_edges[j]), (x, y_edges[j + 1])])
-                })
-                .flatten()
-                .collect();
-            Series {
-                label: (*label).to_string(),
-                points,
-            }
-        })
-        .collect();
-    Panel::Heat(HeatPanel {
-        title,
-        x_label: x_label.clone(),
-        y_label: y_label.clone(),
-        z_label: z_label.clone(),
-        overlays,
-        xs,
-        ys,
-        z,
-        marker: best
-            .filter(|_| mark_max)
-            .map(|(x, y, v)| (x, y, format!("max {v:.4}"))),
-    })
 }

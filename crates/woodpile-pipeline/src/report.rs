@@ -148,6 +148,19 @@ struct Measured {
     value: f64,
     location: String,
     scan: Option<Scanned>,
+    /// Why the number could not be read (a failed fit upstream, say): shown in its place.
+    failure: Option<String>,
+}
+
+impl Measured {
+    fn failed(reason: String) -> Measured {
+        Measured {
+            value: f64::NAN,
+            location: String::new(),
+            scan: None,
+            failure: Some(reason),
+        }
+    }
 }
 
 /// Where along a scan the value meets the paper's number.
@@ -246,21 +259,24 @@ impl Report {
         };
         let mut rows = Rows::default();
         let mut evaluated = Vec::with_capacity(self.quotes.len());
+        let mut failures = Vec::new();
         for (i, q) in self.quotes.iter().enumerate() {
-            let fail = |what: &str, e: PipelineError| {
-                PipelineError::stage(
-                    stage,
-                    format!("quote[{i}] ({} {}), {what}: {e}", q.figure, q.quantity),
-                )
+            // A number that cannot be read is reported in its place, and the run fails.
+            let mut read = |source: &Source, what: &str| match reader.measure(source, &q.paper) {
+                Ok(m) => m,
+                Err(e) => {
+                    let reason = e.to_string();
+                    failures.push(format!(
+                        "quote[{i}] ({} {}), {what}: {reason}",
+                        q.figure, q.quantity
+                    ));
+                    Measured::failed(reason)
+                }
             };
-            let ours = reader
-                .measure(&q.ours, &q.paper)
-                .map_err(|e| fail("ours", e))?;
+            let ours = read(&q.ours, "ours");
             let mut conventions = Vec::with_capacity(q.conventions.len());
             for (j, c) in q.conventions.iter().enumerate() {
-                let m = reader
-                    .measure(&c.source, &q.paper)
-                    .map_err(|e| fail(&format!("convention[{j}]"), e))?;
+                let m = read(&c.source, &format!("convention[{j}]"));
                 conventions.push((c.name.clone(), m));
             }
             rows.push(q, &format!("as run: {}", q.as_run), &ours);
@@ -294,8 +310,10 @@ impl Report {
                 "quotes": self.quotes.len(),
                 "reproduced_as_run": reproduced,
                 "reproduced_by_some_convention": by_some,
+                "failed": failures.len(),
                 "markdown": self.markdown,
             }),
+            failures,
         })
     }
 }
@@ -469,6 +487,7 @@ impl Reader<'_> {
                     value,
                     location: String::new(),
                     scan: None,
+                    failure: None,
                 });
             }
             Read::Column(c) => c.clone(),
@@ -511,10 +530,15 @@ impl Reader<'_> {
                 },
             }
         };
+        // A row that failed upstream (a fit that did not converge) says why in `failure`.
+        let failures = str_column(frame, "failure").ok();
         let value_at = |r: usize| -> std::result::Result<f64, String> {
-            values[r]
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| format!("column `{column}` is null or not finite in the row read"))
+            values[r].filter(|v| v.is_finite()).ok_or_else(|| {
+                match failures.as_ref().and_then(|f| f[r].clone()) {
+                    Some(reason) => format!("the row read failed upstream: {reason}"),
+                    None => format!("column `{column}` is null or not finite in the row read"),
+                }
+            })
         };
         let Some(scan_column) = &source.scan else {
             let r = pick(&rows).map_err(fail)?;
@@ -522,6 +546,7 @@ impl Reader<'_> {
                 value: value_at(r).map_err(fail)?,
                 location: location(r),
                 scan: None,
+                failure: None,
             });
         };
         let scan_values = f64_column(frame, scan_column)?;
@@ -618,6 +643,7 @@ impl Reader<'_> {
                 closest: s,
                 slope,
             }),
+            failure: None,
         })
     }
 }
@@ -644,6 +670,9 @@ fn filtered_rows(frame: &DataFrame, filter: &[(String, Match)]) -> Result<Vec<us
 
 /// Whether `m` reproduces the paper's number (None for a statement without a range).
 fn reproduces(paper: &Paper, m: &Measured) -> Option<bool> {
+    if m.failure.is_some() {
+        return None;
+    }
     match paper {
         Paper::Value { value, agree } => Some((m.value - value).abs() <= *agree),
         Paper::Text {
@@ -651,6 +680,14 @@ fn reproduces(paper: &Paper, m: &Measured) -> Option<bool> {
             ..
         } => Some((*lo..=*hi).contains(&m.value)),
         Paper::Text { range: None, .. } => None,
+    }
+}
+
+/// A measured value as the report shows it: the number, or that it failed.
+fn shown(m: &Measured) -> String {
+    match m.failure {
+        Some(_) => "**failed**".into(),
+        None => fmt(m.value),
     }
 }
 
@@ -703,6 +740,9 @@ fn paper_text(p: &Paper) -> String {
 }
 
 fn difference(p: &Paper, m: &Measured) -> (Option<f64>, Option<f64>) {
+    if m.failure.is_some() {
+        return (None, None);
+    }
     match p {
         Paper::Value { value, .. } => (
             Some(m.value - value),
@@ -743,7 +783,7 @@ fn markdown(report: &Report, evaluated: &[(Measured, Vec<(String, Measured)>)]) 
             q.figure,
             q.quantity,
             paper_text(&q.paper),
-            fmt(ours.value),
+            shown(ours),
             diff.map_or("–".into(), fmt),
             verdict(&q.paper, ours),
             if by.is_empty() {
@@ -798,11 +838,11 @@ fn markdown(report: &Report, evaluated: &[(Measured, Vec<(String, Measured)>)]) 
                 out.push_str(&format!(
                     "| {} | {} | {} | {} | {} | {} | {} |\n",
                     name,
-                    fmt(m.value),
-                    if m.location.is_empty() {
-                        "–"
-                    } else {
-                        &m.location
+                    shown(m),
+                    match (&m.failure, m.location.is_empty()) {
+                        (Some(reason), _) => reason.replace('|', "/"),
+                        (None, true) => "–".into(),
+                        (None, false) => m.location.clone(),
                     },
                     diff.map_or("–".into(), fmt),
                     verdict(&q.paper, m),
@@ -832,6 +872,7 @@ struct Rows {
     scan_closest: Vec<Option<f64>>,
     scan_runs: Vec<Option<String>>,
     sensitivity: Vec<Option<f64>>,
+    failure: Vec<Option<String>>,
 }
 
 impl Rows {
@@ -845,9 +886,10 @@ impl Rows {
             Paper::Text { .. } => None,
         });
         self.paper_text.push(Some(paper_text(&q.paper)));
-        self.value.push(Some(m.value));
+        self.value.push(m.failure.is_none().then_some(m.value));
         self.location
             .push((!m.location.is_empty()).then(|| m.location.clone()));
+        self.failure.push(m.failure.clone());
         self.difference.push(diff);
         self.relative_difference.push(rel);
         self.reproduces.push(reproduces(&q.paper, m).map(i64::from));
@@ -873,7 +915,8 @@ impl Rows {
             .str("scan_column", self.scan_column)
             .f64("scan_closest", self.scan_closest)
             .str("scan_within_tolerance", self.scan_runs)
-            .f64("sensitivity", self.sensitivity);
+            .f64("sensitivity", self.sensitivity)
+            .str("failure", self.failure);
         c
     }
 }

@@ -49,6 +49,10 @@ pub struct Step {
 
 /// Runs (or plans) the pipeline; returns what each selected stage did. A run holds the
 /// results tree's lock ([`crate::lock`]) throughout: a second run on the same tree waits.
+///
+/// A stage that fails stops only the stages that read it: the others still run, and the run
+/// then ends with [`PipelineError::Failed`] naming every failure, including the partial ones a
+/// stage recorded in its table (a fit that did not converge).
 pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Result<Vec<Step>> {
     let results = &options.results;
     let store = PointStore::new(points_dir(results));
@@ -67,7 +71,23 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
         }
     }
     let mut steps = Vec::new();
+    // Stages that failed (or were skipped because an input failed), and every failure.
+    let mut failed: Vec<&str> = Vec::new();
+    let mut failures: Vec<String> = Vec::new();
     for stage in pipeline.selection(&options.targets)? {
+        if let Some(input) = stage.inputs.iter().find(|i| failed.contains(&i.as_str())) {
+            let why = format!("skipped: input `{input}` failed");
+            events.warn(&format!("stage `{}` {why}", stage.name));
+            failures.push(format!("stage `{}` {why}", stage.name));
+            failed.push(&stage.name);
+            steps.push(Step {
+                stage: stage.name.clone(),
+                runs: false,
+                why,
+                points: None,
+            });
+            continue;
+        }
         let forced =
             options.force && (options.targets.is_empty() || options.targets.contains(&stage.name));
         let current = state(pipeline, results, &options.figures, stage);
@@ -108,10 +128,32 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
             continue;
         }
         events.stage_started(&stage.name, &why);
-        let summary = execute(pipeline, stage, options, &store, events)?;
-        events.stage_finished(&stage.name, &summary);
+        match execute(pipeline, stage, options, &store, events) {
+            Ok((summary, partial)) => {
+                for failure in &partial {
+                    events.warn(&format!("stage `{}`: {failure}", stage.name));
+                }
+                failures.extend(
+                    partial
+                        .into_iter()
+                        .map(|f| format!("stage `{}`: {f}", stage.name)),
+                );
+                events.stage_finished(&stage.name, &summary);
+            }
+            // A stage that cannot produce its output stops only what depends on it.
+            Err(e @ PipelineError::Stage { .. }) => {
+                events.warn(&e.to_string());
+                failures.push(e.to_string());
+                failed.push(&stage.name);
+            }
+            Err(e) => return Err(e),
+        }
     }
-    Ok(steps)
+    if failures.is_empty() {
+        Ok(steps)
+    } else {
+        Err(PipelineError::Failed { failures })
+    }
 }
 
 fn execute(
@@ -120,7 +162,7 @@ fn execute(
     options: &RunOptions,
     store: &PointStore,
     events: &dyn Events,
-) -> Result<String> {
+) -> Result<(String, Vec<String>)> {
     let results = &options.results;
     let output = match &stage.spec {
         Spec::Sweep(sweep) => sweep.run(&stage.name, store, events)?,
@@ -157,8 +199,15 @@ fn execute(
             approximate.run(&stage.name, &fits, &data)?
         }
         Spec::Render(render) => {
-            let frame = table::read(&output_path(results, &stage.inputs[0]))?;
-            render.run(&stage.name, &frame, &options.figures)?
+            let inputs = stage
+                .inputs
+                .iter()
+                .map(|name| {
+                    let table = table::read_with_manifest(&output_path(results, name))?;
+                    Ok((name.clone(), table))
+                })
+                .collect::<Result<_>>()?;
+            render.run(&stage.name, &inputs, &options.figures)?
         }
         Spec::Report(report) => report.run(&stage.name, results)?,
         Spec::WorkPrecision(wp) => wp.run(&stage.name)?,
@@ -168,10 +217,11 @@ fn execute(
     let rows = output.frame.height();
     table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
     let count = |k: &str| output.summary.get(k).and_then(|v| v.as_u64());
-    Ok(match (count("points"), count("failed")) {
+    let line = match (count("points"), count("failed")) {
         (Some(points), Some(failed)) => format!("{rows} rows, {points} points, {failed} failed"),
         _ => format!("{rows} rows"),
-    })
+    };
+    Ok((line, output.failures))
 }
 
 /// The manifest of `stage`'s output as computed from the current definitions.

@@ -124,6 +124,7 @@ impl SpaceTime {
             .i64("site", site)
             .f64("velocity", velocity);
         Ok(Output {
+            failures: Vec::new(),
             frame: columns.into_frame()?,
             summary: json!({"points": self.sweep.count(), "sites": self.sites}),
         })

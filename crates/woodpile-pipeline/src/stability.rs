@@ -286,6 +286,7 @@ impl Stability {
         .f64("error", runs.iter().map(|r| r.error).collect())
         .str("failure", runs.iter().map(|r| r.failure.clone()).collect());
         Ok(Output {
+            failures: Vec::new(),
             frame: c.into_frame()?,
             summary,
         })

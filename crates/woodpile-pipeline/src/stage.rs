@@ -132,7 +132,7 @@ impl Stage {
             "optimize" => Spec::Optimize(Optimize::parse(&mut fields)?),
             "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
             "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),
-            "render" => Spec::Render(Render::parse(&mut fields)?),
+            "render" => Spec::Render(Render::parse(&mut fields, &inputs)?),
             "report" => Spec::Report(Report::parse(&mut fields)?),
             "workprecision" => Spec::WorkPrecision(WorkPrecision::parse(&mut fields)?),
             "stability" => Spec::Stability(Stability::parse(&mut fields)?),

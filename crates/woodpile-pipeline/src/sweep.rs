@@ -193,6 +193,7 @@ impl Sweep {
         let all: Vec<usize> = (0..self.count()).collect();
         let (frame, stats) = self.run_points(stage, store, events, &all)?;
         Ok(Output {
+            failures: Vec::new(),
             frame,
             summary: self.summary(&stats)?,
         })

@@ -183,6 +183,19 @@ pub fn read(path: &Path) -> Result<DataFrame> {
     Ok(checked.frame)
 }
 
+/// [`read`], with the table's manifest (for a stage that quotes its inputs' parameters).
+pub fn read_with_manifest(path: &Path) -> Result<(DataFrame, Manifest)> {
+    let checked = read_checked(path)?;
+    match (checked.integrity, checked.manifest) {
+        (Integrity::Damaged, _) => Err(PipelineError::io(path, DAMAGED)),
+        (_, None) => Err(PipelineError::io(
+            path,
+            "no `woodpile` manifest in the metadata",
+        )),
+        (_, Some(manifest)) => Ok((checked.frame, manifest)),
+    }
+}
+
 /// What a table that fails its checksum is told.
 pub const DAMAGED: &str = "damaged: its bytes no longer match the checksum in its manifest";
 

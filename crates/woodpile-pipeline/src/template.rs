@@ -111,8 +111,31 @@ fn substitute(value: &mut toml::Value, axes: &[Axis], values: &[AxisValue]) {
     }
 }
 
+/// The number of sites of the scene's chain (`chain.n` or `chain.sites`, else the default
+/// 2 * 100 + 1), saturating; a value of the wrong type counts as the largest chain a scene
+/// accepts (the scene's own validation reports it).
+fn chain_sites(table: &toml::Table) -> i64 {
+    const LARGEST: i64 = 10_000_001;
+    let chain = table.get("chain").and_then(|c| c.as_table());
+    match (
+        chain.and_then(|c| c.get("n")),
+        chain.and_then(|c| c.get("sites")),
+    ) {
+        (Some(toml::Value::Integer(n)), _) => n.saturating_mul(2).saturating_add(1).min(LARGEST),
+        (None, Some(toml::Value::Array(ends))) => match ends.as_slice() {
+            [toml::Value::Integer(a), toml::Value::Integer(b)] => {
+                b.saturating_sub(*a).saturating_add(1).min(LARGEST)
+            }
+            _ => LARGEST,
+        },
+        (None, None) => 201,
+        _ => LARGEST,
+    }
+}
+
 /// Replaces each defect entry carrying `through` by one entry per site `site..=through`.
 fn expand_blocks(table: &mut toml::Table) -> Result<(), TemplateError> {
+    let sites = chain_sites(table);
     let Some(toml::Value::Array(entries)) = table.get_mut("defect") else {
         return Ok(());
     };
@@ -145,6 +168,15 @@ fn expand_blocks(table: &mut toml::Table) -> Result<(), TemplateError> {
                 ))
             }
         };
+        // Never build more defects than the chain has sites (the scene would refuse them
+        // anyway): `through = 99999999` must not allocate a hundred million tables first.
+        let block = last.saturating_sub(site).saturating_add(1);
+        if block.saturating_add(expanded.len() as i64) > sites {
+            return Err((
+                key("through"),
+                format!("a block of {block} defects on a chain of {sites} sites"),
+            ));
+        }
         for s in site..=last {
             let mut one = defect.clone();
             one.insert("site".into(), toml::Value::Integer(s));

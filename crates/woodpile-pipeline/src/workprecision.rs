@@ -190,6 +190,7 @@ impl WorkPrecision {
             }
         }
         Ok(Output {
+            failures: Vec::new(),
             frame: rows.into_columns().into_frame()?,
             summary: json!({
                 "reference": {"method": "dop853", "tolerance": self.reference_tolerance},

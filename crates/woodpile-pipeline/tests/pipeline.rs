@@ -342,7 +342,7 @@ fn a_read_out_time_between_samples_is_a_clear_stage_error() {
         &Counter::default(),
     )
     .unwrap_err();
-    assert!(matches!(err, PipelineError::Stage { .. }));
+    assert!(matches!(err, PipelineError::Failed { ref failures } if failures.len() == 1));
     assert!(err.to_string().contains("at = 11"), "{err}");
     assert!(!p.output("at_end").exists());
 }
@@ -539,13 +539,36 @@ mark_max = true
     for name in ["figure.png", "figure.svg", "map.png", "map.svg"] {
         assert!(figures.join(name).exists(), "{name}");
     }
+    // The table holds exactly the plotted numbers: a row per curve point, per panel.
     let plotted = table::read(&p.output("figure")).unwrap();
     let names: Vec<String> = plotted
         .get_column_names()
         .iter()
         .map(|n| n.to_string())
         .collect();
-    assert_eq!(names, ["L", "eps", "R", "E_tr"]);
+    assert_eq!(names, ["panel", "series", "x", "y", "z"]);
+    let reduced = table::read(&p.output("at_end")).unwrap();
+    assert_eq!(
+        plotted.height(),
+        2 * reduced.height(),
+        "R and E_tr of every row"
+    );
+    let (x, y) = (
+        table::f64_column(&plotted, "x").unwrap(),
+        table::f64_column(&plotted, "y").unwrap(),
+    );
+    let series = table::str_column(&plotted, "series").unwrap();
+    let (eps, e_tr) = (
+        table::f64_column(&reduced, "eps").unwrap(),
+        table::f64_column(&reduced, "E_tr").unwrap(),
+    );
+    let drawn: Vec<(Option<f64>, Option<f64>)> = (0..plotted.height())
+        .filter(|&r| series[r].as_deref() == Some("E_tr"))
+        .map(|r| (x[r], y[r]))
+        .collect();
+    for pair in eps.iter().zip(&e_tr) {
+        assert!(drawn.contains(&(*pair.0, *pair.1)), "{pair:?} not drawn");
+    }
     // A deleted figure makes its stage stale, and only that stage re-runs.
     std::fs::remove_file(figures.join("map.svg")).unwrap();
     assert!(matches!(p.state("map"), State::Stale(why) if why[0].contains("map.svg")));
@@ -1197,4 +1220,161 @@ fn grids_too_large_to_plan_are_refused_at_load_with_their_size() {
     let fine = fine.replace("to = 1.5, step = 0.5", "to = 1000.5, step = 0.5");
     let e = load_error(&[("sweep", &fine)]);
     assert!(e.contains("sweep.toml") && e.contains("GB"), "{e}");
+}
+
+/// A composite figure draws panels from several inputs, with marks, a diverging map and a
+/// title that quotes an input's parameters; a quote of a stage that is not an input, or an
+/// unknown panel input, is refused at load.
+#[test]
+fn composite_figures_draw_several_inputs_and_quote_their_parameters() {
+    let composite = r#"
+kind = "render"
+inputs = ["sweep", "at_end"]
+title = "read out at t = {at_end.params.at}, tolerance {sweep.summary.tolerance}"
+columns = 2
+same_colour_scale = true
+
+[[panel]]
+input = "at_end"
+title = "fractions at L = 0"
+where = { L = 0 }
+mark = [{ x = 1.0, label = "eps = 1" }]
+[panel.lines]
+x = "eps"
+y = ["R", "T", "E_tr"]
+x_label = "eps"
+y_label = "fraction"
+
+[[panel]]
+input = "sweep"
+where = { L = 1 }
+[panel.heatmap]
+x = "t"
+y = "eps"
+z = "E_tr"
+colours = "diverging"
+x_label = "t"
+y_label = "eps"
+z_label = "E_tr"
+"#;
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("both", composite)]);
+    p.run(&[]);
+    let manifest = table::read_manifest(&p.output("both")).unwrap().unwrap();
+    assert_eq!(
+        manifest.summary["title"],
+        "read out at t = 12, tolerance 0.00000001"
+            .replace("0.00000001", &woodpile_plot::tick(&1e-8))
+            .as_str()
+    );
+    assert_eq!(manifest.summary["panels"], 2);
+    let svg = std::fs::read_to_string(p.results.join("figures/both.svg")).unwrap();
+    assert!(svg.contains("read out at t = 12") && svg.contains("eps = 1"));
+    // The read-out time is in the title: changing it re-renders with the new value.
+    p.write("at_end", &REDUCE.replace("at = 12.0", "at = 10.0"));
+    p.run(&[]);
+    let manifest = table::read_manifest(&p.output("both")).unwrap().unwrap();
+    assert!(manifest.summary["title"]
+        .as_str()
+        .unwrap()
+        .starts_with("read out at t = 10,"));
+
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        (
+            "both",
+            &composite.replace("{at_end.params.at}", "{other.params.at}"),
+        ),
+    ]);
+    assert!(
+        e.contains("both.toml") && e.contains("`title`") && e.contains("other"),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        (
+            "both",
+            &composite.replace("input = \"sweep\"", "input = \"nope\""),
+        ),
+    ]);
+    assert!(e.contains("panel[1].input") && e.contains("nope"), "{e}");
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        (
+            "both",
+            &composite.replace("[[panel]]\ninput = \"sweep\"", "[wrong]\ninput = \"sweep\""),
+        ),
+    ]);
+    assert!(e.contains("both.toml"), "{e}");
+}
+
+/// A fit that cannot converge is a row with its reason; the stages after it still run, the
+/// report shows the failure, and the run ends with an error naming it.
+#[test]
+fn a_failed_fit_is_a_row_the_run_goes_on_and_ends_naming_it() {
+    let fits = r#"
+kind = "fit"
+inputs = ["at_end"]
+x = "eps"
+[[model]]
+name = "good"
+y = "E_tr"
+form = "tanh"
+start = [0.1, 1.0, 0.0]
+[[model]]
+name = "hopeless"
+y = "E_tr"
+form = "power"
+start = [1.0, 1.0, 0.0]
+x_range = [100.0, 200.0]
+"#;
+    let report = r#"
+kind = "report"
+inputs = ["fits"]
+markdown = "REPORT.md"
+title = "Fits"
+[[quote]]
+figure = "X"
+quantity = "A of the good fit"
+paper = 0.1
+agree = 1.0
+as_run = "tanh"
+ours = { stage = "fits", column = "A", where = { model = "good" } }
+[[quote.convention]]
+name = "the hopeless fit"
+source = { stage = "fits", column = "A", where = { model = "hopeless" } }
+"#;
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("fits", fits),
+        ("report", report),
+    ]);
+    let options = RunOptions {
+        results: p.results.clone(),
+        figures: p.results.join("figures"),
+        ..Default::default()
+    };
+    let e = run(&p.load(), &options, &Counter::default()).unwrap_err();
+    let PipelineError::Failed { failures } = &e else {
+        panic!("{e}")
+    };
+    assert!(
+        failures[0].contains("`fits`") && failures[0].contains("hopeless"),
+        "{e}"
+    );
+    let table = table::read(&p.output("fits")).unwrap();
+    let failure = table::str_column(&table, "failure").unwrap();
+    let a = table::f64_column(&table, "A").unwrap();
+    assert_eq!(failure[0], None);
+    assert!(a[0].is_some());
+    assert!(failure[1].as_deref().unwrap().contains("at least 4 points"));
+    assert_eq!(a[1], None);
+    let markdown = std::fs::read_to_string(p.results.parent().unwrap().join("REPORT.md")).unwrap();
+    assert!(
+        markdown.contains("**failed**") && markdown.contains("at least 4 points"),
+        "{markdown}"
+    );
 }

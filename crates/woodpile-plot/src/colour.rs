@@ -1,5 +1,6 @@
-//! The viridis colour map (perceptually uniform, readable in grey and by colour-blind readers),
-//! interpolated from 9 anchor colours of matplotlib's table.
+//! Colour maps. Viridis for magnitudes (perceptually uniform, readable in grey and by
+//! colour-blind readers), a blue-white-red diverging map for signed values (white is zero),
+//! and distinct named colours for categories.
 
 use plotters::style::RGBColor;
 
@@ -15,17 +16,48 @@ const ANCHORS: [(u8, u8, u8); 9] = [
     (253, 231, 37),
 ];
 
+/// Matplotlib's RdBu reversed: dark blue (most negative) through white (zero) to dark red.
+const DIVERGING: [(u8, u8, u8); 7] = [
+    (5, 48, 97),
+    (67, 147, 195),
+    (209, 229, 240),
+    (247, 247, 247),
+    (253, 219, 199),
+    (214, 96, 77),
+    (103, 0, 31),
+];
+
+/// Colours for categories, in order: green, orange, red, then tab10's others. Three classes
+/// such as "meets", "misses", "unstable" read as go, caution, stop.
+pub const CATEGORIES: [RGBColor; 6] = [
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(214, 39, 40),
+    RGBColor(31, 119, 180),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+];
+
 /// The viridis colour at `t` in [0, 1] (clamped).
 pub fn viridis(t: f64) -> RGBColor {
+    interpolate(&ANCHORS, t)
+}
+
+/// The diverging colour at `t` in [0, 1] (clamped); 0.5 is white.
+pub fn diverging(t: f64) -> RGBColor {
+    interpolate(&DIVERGING, t)
+}
+
+fn interpolate(anchors: &[(u8, u8, u8)], t: f64) -> RGBColor {
     let t = if t.is_finite() {
         t.clamp(0.0, 1.0)
     } else {
         0.0
     };
-    let x = t * (ANCHORS.len() - 1) as f64;
-    let i = (x.floor() as usize).min(ANCHORS.len() - 2);
+    let x = t * (anchors.len() - 1) as f64;
+    let i = (x.floor() as usize).min(anchors.len() - 2);
     let f = x - i as f64;
-    let (a, b) = (ANCHORS[i], ANCHORS[i + 1]);
+    let (a, b) = (anchors[i], anchors[i + 1]);
     let mix = |p: u8, q: u8| (p as f64 + (q as f64 - p as f64) * f).round() as u8;
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
 }
@@ -40,5 +72,7 @@ mod tests {
         assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
         assert_eq!(viridis(7.0), viridis(1.0));
         assert_eq!(viridis(f64::NAN), viridis(0.0));
+        assert_eq!(diverging(0.5), RGBColor(247, 247, 247));
+        assert_eq!(diverging(0.0), RGBColor(5, 48, 97));
     }
 }

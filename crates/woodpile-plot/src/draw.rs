@@ -1,10 +1,11 @@
 //! The drawing itself, generic over the backend so PNG and SVG are the same picture.
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::colour::viridis;
-use crate::{Figure, HeatPanel, LinePanel, Panel};
+use crate::colour::{diverging, viridis, CATEGORIES};
+use crate::{Colours, Figure, HeatPanel, LinePanel, Mark, MarkAt, Panel};
 
 /// Height of the figure title strip in pixels.
 pub(crate) const TITLE_HEIGHT: u32 = 36;
@@ -89,10 +90,76 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// A tick label: integers without a decimal point (`10`, not `10.0`), other values with at
+/// most four significant decimals, and never `-0`.
+pub fn tick(v: &f64) -> String {
+    let v = if v.abs() < 1e-12 { 0.0 } else { *v };
+    if (v - v.round()).abs() <= 1e-9 * v.abs().max(1.0) && v.abs() < 1e15 {
+        return format!("{}", v.round() as i64);
+    }
+    let magnitude = v.abs().log10().floor();
+    if !(-4.0..6.0).contains(&magnitude) {
+        return format!("{v:.2e}");
+    }
+    let decimals = (3.0 - magnitude).clamp(0.0, 8.0) as usize;
+    let text = format!("{v:.decimals$}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
+}
+
+/// Mark colours: dark grey and black read on white and on every map colour.
+const MARK_COLOURS: [RGBColor; 2] = [RGBColor(60, 60, 60), BLACK];
+
+/// Draws `marks` across the visible ranges, one legend entry per distinct label.
+fn draw_marks<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    marks: &[Mark],
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<(), String> {
+    let mut labels: Vec<&str> = Vec::new();
+    for mark in marks {
+        let k = match labels.iter().position(|l| *l == mark.label) {
+            Some(k) => k,
+            None => {
+                labels.push(&mark.label);
+                labels.len() - 1
+            }
+        };
+        let colour = MARK_COLOURS[k % MARK_COLOURS.len()];
+        let style = ShapeStyle::from(&colour).stroke_width(2);
+        let points = match mark.at {
+            MarkAt::X(x) => vec![(x, y0), (x, y1)],
+            MarkAt::Y(y) => vec![(x0, y), (x1, y)],
+        };
+        let drawn = chart
+            .draw_series(DashedLineSeries::new(points, 8, 5, style))
+            .map_err(text)?;
+        if first_of(marks, mark) {
+            drawn
+                .label(mark.label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `mark` is the first of `marks` with its label.
+fn first_of(marks: &[Mark], mark: &Mark) -> bool {
+    marks
+        .iter()
+        .find(|m| m.label == mark.label)
+        .is_some_and(|m| std::ptr::eq(m, mark))
+}
+
 fn lines<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &LinePanel) -> Result<(), String> {
     let all = || p.series.iter().flat_map(|s| s.points.iter());
-    let (x0, x1) = range(all().map(|q| q.0));
-    let (y0, y1) = range(all().map(|q| q.1));
+    let (x0, x1) = p.view.x.unwrap_or_else(|| range(all().map(|q| q.0)));
+    let (y0, y1) = p.view.y.unwrap_or_else(|| range(all().map(|q| q.1)));
     let mut chart = ChartBuilder::on(area)
         .caption(&p.title, (FONT, 16))
         .margin(10)
@@ -104,6 +171,8 @@ fn lines<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &LinePanel) -> Re
         .configure_mesh()
         .x_desc(&p.x_label)
         .y_desc(&p.y_label)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 14))
         .light_line_style(RGBColor(235, 235, 235))
@@ -136,8 +205,9 @@ fn lines<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &LinePanel) -> Re
             }
         }
     }
+    draw_marks(&mut chart, &p.marks, (x0, x1), (y0, y1))?;
     // One curve is named by the y label; a legend would only hide data.
-    if p.series.len() > 1 {
+    if p.series.len() > 1 || !p.marks.is_empty() {
         legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     }
     Ok(())
@@ -159,36 +229,105 @@ pub fn cell_edges(centres: &[f64]) -> Vec<f64> {
     }
 }
 
-/// Overlay line colours: red and white stand out on every viridis shade.
-const OVERLAY_COLOURS: [RGBColor; 3] = [RGBColor(230, 30, 40), WHITE, RGBColor(255, 140, 0)];
+/// The colour of each value of a heat map, and the range its scale spans.
+struct Scale<'a> {
+    colours: &'a Colours,
+    lo: f64,
+    hi: f64,
+}
+
+impl Scale<'_> {
+    fn of(h: &HeatPanel) -> Scale<'_> {
+        let (lo, hi) = h.z_range.unwrap_or_else(|| {
+            let (lo, hi) =
+                h.z.iter()
+                    .flatten()
+                    .filter(|v| v.is_finite())
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), &v| {
+                        (l.min(v), u.max(v))
+                    });
+            match (&h.colours, lo.is_finite()) {
+                (_, false) => (0.0, 1.0),
+                (Colours::Diverging, true) => {
+                    let m = lo.abs().max(hi.abs()).max(f64::MIN_POSITIVE);
+                    (-m, m)
+                }
+                (_, true) if hi > lo => (lo, hi),
+                (_, true) => (lo - 0.5, lo + 0.5),
+            }
+        });
+        Scale {
+            colours: &h.colours,
+            lo,
+            hi,
+        }
+    }
+
+    fn colour(&self, v: Option<f64>) -> RGBColor {
+        let Some(v) = v.filter(|v| v.is_finite()) else {
+            return MISSING;
+        };
+        let t = (v - self.lo) / (self.hi - self.lo);
+        match self.colours {
+            Colours::Sequential => viridis(t),
+            Colours::Diverging => diverging(t),
+            Colours::Categories(_) => {
+                let k = v.round();
+                if k >= 0.0 && (k as usize) < CATEGORIES.len() {
+                    CATEGORIES[k as usize]
+                } else {
+                    MISSING
+                }
+            }
+        }
+    }
+}
+
+/// The heat map's cells as an RGB raster of `(w, h)` pixels covering the visible ranges: one
+/// image instead of a rectangle per cell, so a fine space-time map stays small in SVG.
+fn raster(
+    h: &HeatPanel,
+    scale: &Scale<'_>,
+    (w, hgt): (u32, u32),
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Vec<u8> {
+    let (ex, ey) = (cell_edges(&h.xs), cell_edges(&h.ys));
+    let cell = |edges: &[f64], v: f64| -> Option<usize> {
+        let k = edges.partition_point(|&e| e <= v);
+        (k >= 1 && k < edges.len()).then(|| k - 1)
+    };
+    let columns: Vec<Option<usize>> = (0..w)
+        .map(|px| cell(&ex, x0 + (px as f64 + 0.5) / w as f64 * (x1 - x0)))
+        .collect();
+    let mut buf = Vec::with_capacity((w * hgt * 3) as usize);
+    for py in 0..hgt {
+        // Pixel rows run top down; y runs bottom up.
+        let row = cell(&ey, y1 - (py as f64 + 0.5) / hgt as f64 * (y1 - y0));
+        for column in &columns {
+            let colour = match (column, row) {
+                (Some(i), Some(j)) => scale.colour(h.z.get(j * h.xs.len() + i).copied().flatten()),
+                _ => WHITE,
+            };
+            buf.extend_from_slice(&[colour.0, colour.1, colour.2]);
+        }
+    }
+    buf
+}
 
 fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Result<(), String> {
     let width = area.dim_in_pixel().0;
-    let (main, bar) = area.split_horizontally(width.saturating_sub(100));
+    let (main, bar) = area.split_horizontally(width.saturating_sub(112));
     let (ex, ey) = (cell_edges(&h.xs), cell_edges(&h.ys));
-    let (z0, z1) = {
-        let (lo, hi) =
-            h.z.iter()
-                .flatten()
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), &v| {
-                    (l.min(v), u.max(v))
-                });
-        if !lo.is_finite() {
-            (0.0, 1.0)
-        } else if hi > lo {
-            (lo, hi)
-        } else {
-            (lo - 0.5, lo + 0.5)
-        }
-    };
-    let scale = |v: f64| (v - z0) / (z1 - z0);
+    let scale = Scale::of(h);
+    let (x0, x1) = h.view.x.unwrap_or((ex[0], ex[ex.len() - 1]));
+    let (y0, y1) = h.view.y.unwrap_or((ey[0], ey[ey.len() - 1]));
     let mut chart = ChartBuilder::on(&main)
         .caption(&h.title, (FONT, 16))
         .margin(10)
         .x_label_area_size(42)
         .y_label_area_size(58)
-        .build_cartesian_2d(ex[0]..ex[ex.len() - 1], ey[0]..ey[ey.len() - 1])
+        .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(text)?;
     chart
         .configure_mesh()
@@ -196,46 +335,44 @@ fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Res
         .disable_y_mesh()
         .x_desc(&h.x_label)
         .y_desc(&h.y_label)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
         .label_style((FONT, 12))
         .axis_desc_style((FONT, 14))
         .draw()
         .map_err(text)?;
-    let nx = h.xs.len();
-    let cells = (0..h.ys.len())
-        .flat_map(|j| (0..nx).map(move |i| (i, j)))
-        .map(|(i, j)| {
-            let colour = match h.z.get(j * nx + i).copied().flatten() {
-                Some(v) if v.is_finite() => viridis(scale(v)),
-                _ => MISSING,
-            };
-            Rectangle::new([(ex[i], ey[j]), (ex[i + 1], ey[j + 1])], colour.filled())
-        });
-    chart.draw_series(cells).map_err(text)?;
+    let size = chart.plotting_area().dim_in_pixel();
+    if size.0 > 0 && size.1 > 0 {
+        let pixels = raster(h, &scale, size, (x0, x1), (y0, y1));
+        let image = BitMapElement::with_owned_buffer((x0, y1), size, pixels)
+            .ok_or("heat-map raster of the wrong size")?;
+        chart.draw_series([image]).map_err(text)?;
+    }
     if let Some((x, y, label)) = &h.marker {
+        // The label goes above the circle, or below it near the top edge (the title's place).
+        let offset = if *y > y1 - 0.12 * (y1 - y0) {
+            (8, 4)
+        } else {
+            (8, -16)
+        };
         chart
             .draw_series([EmptyElement::at((*x, *y))
                 + Circle::new((0, 0), 6, ShapeStyle::from(&WHITE).stroke_width(2))
-                + Text::new(
-                    label.clone(),
-                    (8, -16),
-                    (FONT, 13).into_font().color(&WHITE),
-                )])
+                + Text::new(label.clone(), offset, (FONT, 13).into_font().color(&WHITE))])
             .map_err(text)?;
     }
-    // Overlay lines, clamped to the map, in colours that read on viridis, with a legend.
-    let (x_range, y_range) = (ex[0]..=ex[ex.len() - 1], ey[0]..=ey[ey.len() - 1]);
+    // Overlay lines, clamped to the view, in colours that read on every map, with a legend.
+    let overlay_colours = match h.colours {
+        Colours::Sequential => OVERLAY_COLOURS,
+        Colours::Diverging | Colours::Categories(_) => OVERLAY_COLOURS_ON_COLOUR,
+    };
     for (k, overlay) in h.overlays.iter().enumerate() {
-        let colour = OVERLAY_COLOURS[k % OVERLAY_COLOURS.len()];
+        let colour = overlay_colours[k % overlay_colours.len()];
         let points: Vec<(f64, f64)> = overlay
             .points
             .iter()
             .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .map(|&(x, y)| {
-                (
-                    x.clamp(*x_range.start(), *x_range.end()),
-                    y.clamp(*y_range.start(), *y_range.end()),
-                )
-            })
+            .map(|&(x, y)| (x.clamp(x0, x1), y.clamp(y0, y1)))
             .collect();
         chart
             .draw_series(LineSeries::new(
@@ -246,15 +383,33 @@ fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Res
             .label(overlay.label.clone())
             .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(3)));
     }
-    if !h.overlays.is_empty() {
+    draw_marks(&mut chart, &h.marks, (x0, x1), (y0, y1))?;
+    if !h.overlays.is_empty() || !h.marks.is_empty() {
         legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     }
-    // Colour bar: the map's scale as a strip with its own labelled axis.
-    let mut bar_chart = ChartBuilder::on(&bar)
+    match &h.colours {
+        Colours::Categories(names) => category_legend(&bar, names),
+        _ => colour_bar(&bar, h, &scale),
+    }
+}
+
+/// Overlay line colours: red and white stand out on every viridis shade.
+const OVERLAY_COLOURS: [RGBColor; 3] = [RGBColor(230, 30, 40), WHITE, RGBColor(255, 140, 0)];
+/// Overlay line colours on red-blue maps and category colours (whose red would hide red).
+const OVERLAY_COLOURS_ON_COLOUR: [RGBColor; 3] = [BLACK, WHITE, RGBColor(148, 103, 189)];
+
+/// The map's scale as a strip with its own labelled axis.
+fn colour_bar<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    h: &HeatPanel,
+    scale: &Scale<'_>,
+) -> Result<(), String> {
+    let (z0, z1) = (scale.lo, scale.hi);
+    let mut bar_chart = ChartBuilder::on(bar)
         .margin_top(40)
         .margin_bottom(52)
-        .margin_right(8)
-        .right_y_label_area_size(62)
+        .margin_right(22)
+        .right_y_label_area_size(60)
         .build_cartesian_2d(0.0..1.0, z0..z1)
         .map_err(text)?;
     bar_chart
@@ -263,6 +418,7 @@ fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Res
         .disable_x_mesh()
         .disable_y_mesh()
         .y_desc(&h.z_label)
+        .y_label_formatter(&tick)
         .label_style((FONT, 11))
         .axis_desc_style((FONT, 13))
         .draw()
@@ -271,9 +427,30 @@ fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Res
     let strip = (0..steps).map(|k| {
         let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
         let (va, vb) = (z0 + a * (z1 - z0), z0 + b * (z1 - z0));
-        Rectangle::new([(0.0, va), (1.0, vb)], viridis(0.5 * (a + b)).filled())
+        let mid = z0 + 0.5 * (a + b) * (z1 - z0);
+        Rectangle::new([(0.0, va), (1.0, vb)], scale.colour(Some(mid)).filled())
     });
     bar_chart.draw_series(strip).map_err(text)?;
+    Ok(())
+}
+
+/// A legend of named categories in place of a colour bar: a swatch and a name each.
+fn category_legend<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    names: &[String],
+) -> Result<(), String> {
+    for (k, name) in names.iter().enumerate() {
+        let y = 50 + 24 * k as i32;
+        let colour = CATEGORIES[k % CATEGORIES.len()];
+        bar.draw(&Rectangle::new([(6, y), (20, y + 14)], colour.filled()))
+            .map_err(text)?;
+        bar.draw(&Text::new(
+            name.clone(),
+            (26, y),
+            (FONT, 12).into_font().color(&BLACK),
+        ))
+        .map_err(text)?;
+    }
     Ok(())
 }
 
@@ -286,5 +463,16 @@ mod tests {
         assert_eq!(cell_edges(&[1.0, 2.0, 4.0]), vec![0.5, 1.5, 3.0, 5.0]);
         assert_eq!(cell_edges(&[3.0]), vec![2.5, 3.5]);
         assert_eq!(range([1.0, f64::NAN, 3.0].into_iter()), (0.9, 3.1));
+    }
+
+    #[test]
+    fn ticks_print_integers_as_integers_and_never_minus_zero() {
+        assert_eq!(tick(&10.0), "10");
+        assert_eq!(tick(&-0.0), "0");
+        assert_eq!(tick(&-1e-17), "0");
+        assert_eq!(tick(&0.25), "0.25");
+        assert_eq!(tick(&(0.1 + 0.2)), "0.3");
+        assert_eq!(tick(&-2.5), "-2.5");
+        assert_eq!(tick(&1.5e-7), "1.50e-7");
     }
 }

@@ -13,8 +13,8 @@ use std::sync::OnceLock;
 
 use plotters::prelude::*;
 
-pub use colour::viridis;
-pub use draw::cell_edges;
+pub use colour::{diverging, viridis};
+pub use draw::{cell_edges, tick};
 
 /// Drawing failed.
 #[derive(Debug, thiserror::Error)]
@@ -46,6 +46,10 @@ pub struct LinePanel {
     pub y_label: String,
     /// The curves.
     pub series: Vec<Series>,
+    /// Straight lines marking a position.
+    pub marks: Vec<Mark>,
+    /// The visible ranges.
+    pub view: View,
 }
 
 /// One heat-map panel on a rectangular grid.
@@ -69,6 +73,53 @@ pub struct HeatPanel {
     pub marker: Option<(f64, f64, String)>,
     /// Lines drawn over the map (e.g. a stability bound), each with a legend entry.
     pub overlays: Vec<Series>,
+    /// How values become colours.
+    pub colours: Colours,
+    /// The value range the colours span; `None`: the data's own (symmetric about zero for
+    /// [`Colours::Diverging`]). Two panels given one range share one colour scale.
+    pub z_range: Option<(f64, f64)>,
+    /// Straight lines marking a position (a defect's site, a switch-on time).
+    pub marks: Vec<Mark>,
+    /// The visible x and y ranges (a zoom); `None`: the whole grid.
+    pub view: View,
+}
+
+/// How a heat map colours its values.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Colours {
+    /// Viridis from the smallest to the largest value.
+    Sequential,
+    /// Blue through white (zero) to red, symmetric about zero: for signed values.
+    Diverging,
+    /// Value k (an integer) is category k, named by the k-th label, in a legend.
+    Categories(Vec<String>),
+}
+
+/// A straight line across a panel at a fixed x or y, with a legend entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mark {
+    /// Vertical (at an x) or horizontal (at a y).
+    pub at: MarkAt,
+    /// Legend label; marks with the same label share one entry.
+    pub label: String,
+}
+
+/// Where a [`Mark`] is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MarkAt {
+    /// A vertical line at this x.
+    X(f64),
+    /// A horizontal line at this y.
+    Y(f64),
+}
+
+/// The visible ranges of a panel; `None` keeps the data's own.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct View {
+    /// x from, to.
+    pub x: Option<(f64, f64)>,
+    /// y from, to.
+    pub y: Option<(f64, f64)>,
 }
 
 /// A panel of either kind.
@@ -173,6 +224,11 @@ mod tests {
                         label: "E_tr".into(),
                         points: vec![(0.0, 0.1), (1.0, 0.3), (2.0, f64::NAN), (3.0, 0.2)],
                     }],
+                    marks: vec![Mark {
+                        at: MarkAt::X(1.5),
+                        label: "switch-on".into(),
+                    }],
+                    view: View::default(),
                 }),
                 Panel::Heat(HeatPanel {
                     title: "map".into(),
@@ -187,6 +243,32 @@ mod tests {
                         label: "bound".into(),
                         points: vec![(1.5, 0.5), (1.5, 3.5)],
                     }],
+                    colours: Colours::Diverging,
+                    z_range: None,
+                    marks: vec![Mark {
+                        at: MarkAt::Y(2.0),
+                        label: "defect".into(),
+                    }],
+                    view: View::default(),
+                }),
+                Panel::Heat(HeatPanel {
+                    title: "classes".into(),
+                    x_label: "dt".into(),
+                    y_label: "p".into(),
+                    z_label: "class".into(),
+                    xs: vec![1.0, 2.0],
+                    ys: vec![3.0, 5.0],
+                    z: vec![Some(0.0), Some(1.0), Some(2.0), None],
+                    marker: None,
+                    overlays: vec![],
+                    colours: Colours::Categories(vec![
+                        "meets".into(),
+                        "misses".into(),
+                        "unstable".into(),
+                    ]),
+                    z_range: None,
+                    marks: vec![],
+                    view: View::default(),
                 }),
             ],
         };
@@ -195,5 +277,14 @@ mod tests {
         let text = figure.svg().unwrap();
         assert!(text.contains("<svg") && text.contains("E_tr") && text.contains("test"));
         assert!(text.contains("bound"), "the overlay has a legend entry");
+        assert!(
+            text.contains("switch-on") && text.contains("defect"),
+            "marks have legends"
+        );
+        assert!(
+            text.contains("unstable"),
+            "categories are named in a legend"
+        );
+        assert!(text.contains("<image"), "heat maps are embedded rasters");
     }
 }
