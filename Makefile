@@ -20,9 +20,9 @@ test: ## Run the whole test suite (what CI runs; release profile, shared with `f
 figures: build ## Bring every stale stage up to date (nothing runs when all are fresh)
 	$(WOODPILE) run
 
-stage: build ## Re-run one stage and what it needs: make stage S=f4_fractions
+stage: build ## Re-run one stage, even when fresh (stale inputs first): make stage S=f4_fractions
 	@test -n "$(S)" || { echo "usage: make stage S=<stage name>  (see: make status)"; exit 2; }
-	$(WOODPILE) run $(S)
+	$(WOODPILE) run $(S) --force
 
 status: build ## Each stage fresh, stale or missing, and why
 	$(WOODPILE) status

@@ -173,7 +173,21 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         figures: args.at.figures.clone(),
     };
     let progress = Progress::new();
+    let started = std::time::Instant::now();
     let steps = run(&pipeline, &options, &progress).map_err(stage_failure)?;
+    if !args.dry_run {
+        let ran = steps.iter().filter(|s| s.runs).count();
+        let scenes: usize = steps
+            .iter()
+            .filter_map(|s| s.points)
+            .map(|(n, cached)| n - cached)
+            .sum();
+        eprintln!(
+            "woodpile run: {ran} stage(s) run, {} fresh, {scenes} scene(s) simulated, {:.1} s",
+            steps.len() - ran,
+            started.elapsed().as_secs_f64()
+        );
+    }
     if args.dry_run {
         for step in &steps {
             let points = step
@@ -182,8 +196,11 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
                     format!(" [{n} scenes: {cached} cached, {} to simulate]", n - cached)
                 })
                 .unwrap_or_default();
-            let verb = if step.runs { "would run" } else { "fresh    " };
-            println!("{verb} {}: {}{points}", step.stage, step.why);
+            if step.runs {
+                println!("would run {}: {}{points}", step.stage, step.why);
+            } else {
+                println!("fresh     {}", step.stage);
+            }
         }
     }
     Ok(())
@@ -191,7 +208,8 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
 
 pub(crate) fn merge_command(args: &MergeArgs) -> Result<(), Failure> {
     let pipeline = load(&args.at)?;
-    let parts = merge(&pipeline, &args.stage, &args.at.results).map_err(stage_failure)?;
+    let parts =
+        merge(&pipeline, &args.stage, &args.at.results, &Progress::new()).map_err(stage_failure)?;
     eprintln!(
         "merged {parts} parts of `{}` into {}",
         args.stage,

@@ -42,8 +42,9 @@
 //! their ranges, so that panels compare by colour (the paper's Fig. 9).
 //!
 //! Titles (the figure's and fixed panel titles) may quote an input's manifest:
-//! `{stage.params.at}` or `{stage.summary.tolerance}` is replaced by that value, so a title
-//! follows the parameters it states.
+//! `{stage.params.at}`, `{stage.summary.tolerance}` or `{stage.params.scene.defect.0.eps}` (a
+//! number indexes an array) is replaced by that value, so a title follows the parameters it
+//! states.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -456,10 +457,14 @@ fn quoted(
             .get(stage)
             .map(|(_, m)| serde_json::to_value(m).unwrap_or(Value::Null))
             .ok_or_else(|| format!("`{{{quote}}}`: no input `{stage}`"))?;
+        // Dotted keys; a number indexes an array (`params.scene.defect.0.eps`).
         let value = path
             .split('.')
             .filter(|k| !k.is_empty())
-            .try_fold(&manifest, |v, k| v.get(k))
+            .try_fold(&manifest, |v, k| match (v, k.parse::<usize>()) {
+                (Value::Array(items), Ok(i)) => items.get(i),
+                _ => v.get(k),
+            })
             .ok_or_else(|| format!("`{{{quote}}}`: the manifest of `{stage}` has no `{path}`"))?;
         let shown = match value {
             Value::Number(n) => n

@@ -93,7 +93,10 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
         let current = state(pipeline, results, &options.figures, stage);
         let why = match (&current, forced) {
             (State::Fresh, false) => {
-                events.stage_skipped(&stage.name);
+                // A dry run's caller lists every stage itself: no second line for this one.
+                if !options.dry_run {
+                    events.stage_skipped(&stage.name);
+                }
                 steps.push(Step {
                     stage: stage.name.clone(),
                     runs: false,

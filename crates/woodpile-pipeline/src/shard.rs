@@ -184,8 +184,13 @@ pub fn run_shard(
 
 /// Joins the complete set of parts of sweep `name` (for its current definition) into
 /// `results/<name>.parquet`. Returns the number of parts merged.
-pub fn merge(pipeline: &Pipeline, name: &str, results: &Path) -> Result<usize> {
-    let _lock = crate::lock::lock_results(results, &crate::events::Silent)?;
+pub fn merge(
+    pipeline: &Pipeline,
+    name: &str,
+    results: &Path,
+    events: &dyn Events,
+) -> Result<usize> {
+    let _lock = crate::lock::lock_results(results, events)?;
     let (stage, sweep) = sweep_of(pipeline, name)?;
     let key = pipeline.key(name).to_string();
     let dir = parts_dir(results, name);

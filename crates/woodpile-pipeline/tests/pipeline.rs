@@ -437,7 +437,7 @@ fn sharded_runs_merge_into_the_single_machine_result() {
         .unwrap();
     }
     // Incomplete: the error names the missing shards, and nothing is written.
-    let err = merge(&pipeline, "sweep", &sharded.results)
+    let err = merge(&pipeline, "sweep", &sharded.results, &Counter::default())
         .unwrap_err()
         .to_string();
     assert!(err.contains("missing shard(s) 1, 3 of 4"), "{err}");
@@ -451,7 +451,7 @@ fn sharded_runs_merge_into_the_single_machine_result() {
         &events,
     )
     .unwrap();
-    let err = merge(&pipeline, "sweep", &sharded.results)
+    let err = merge(&pipeline, "sweep", &sharded.results, &Counter::default())
         .unwrap_err()
         .to_string();
     assert!(err.contains("different shard counts"), "{err}");
@@ -479,7 +479,10 @@ fn sharded_runs_merge_into_the_single_machine_result() {
     .unwrap();
     assert!(rerun.already_done);
     assert_eq!(again.points.load(Ordering::SeqCst), 0);
-    assert_eq!(merge(&pipeline, "sweep", &sharded.results).unwrap(), 4);
+    assert_eq!(
+        merge(&pipeline, "sweep", &sharded.results, &Counter::default()).unwrap(),
+        4
+    );
     let report = diff(&single.results, &sharded.results, &DiffOptions::default()).unwrap();
     assert!(report.agrees(), "{report:?}");
     let (a, b) = (
