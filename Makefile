@@ -6,13 +6,19 @@ SCRATCH := scratch/check
 # Wall times (work-precision stages) belong to the machine that measured them: not compared.
 CHECK_TOL := --abs 1e-9 --rel 1e-9 --tol wall_ms=inf --tol log10_wall_ms=inf
 
-.PHONY: help build test figures stage status check read-check bench work-precision lint slurm-test
+.PHONY: help build install test docs figures stage status check read-check bench work-precision lint slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
 
 build: ## Build the woodpile binary (release)
 	$(CARGO) build --release -p woodpile-cli
+
+install: ## Put `woodpile` on the PATH (cargo install into ~/.cargo/bin)
+	$(CARGO) install --locked --path crates/woodpile-cli
+
+docs: ## Regenerate docs/stage-kinds.md from the stage kinds' module documentation
+	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-pipeline --test docs
 
 test: ## Run the whole test suite (what CI runs; release profile, shared with `figures`)
 	$(CARGO) test --workspace --release --exclude woodpile-bench

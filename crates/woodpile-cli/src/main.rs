@@ -16,7 +16,7 @@ use clap::{Parser, Subcommand};
 
 /// Granular chains with internal resonator defects: simulate scenes, reproduce the paper.
 #[derive(Debug, Parser)]
-#[command(name = "woodpile", version, about)]
+#[command(name = "woodpile", version = version(), about)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -36,6 +36,19 @@ enum Command {
     Slurm(pipeline_cmd::SlurmArgs),
     /// Compare two result files or trees; exit 1 when they differ beyond tolerance.
     Diff(pipeline_cmd::DiffArgs),
+}
+
+/// The package version and the numerics revision every cache key includes (`woodpile 0.1.0 r5`):
+/// the one place a user reads the code version, so no document has to state it.
+fn version() -> &'static str {
+    static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    VERSION
+        .get_or_init(|| {
+            woodpile_pipeline::canonical::code_version()
+                .trim_start_matches("woodpile ")
+                .to_string()
+        })
+        .as_str()
 }
 
 /// A failure with the exit code it maps to.

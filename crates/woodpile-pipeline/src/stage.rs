@@ -1,13 +1,13 @@
 //! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # sweep | spacetime | reduce | optimize | fit | approximate | render
+//! kind = "sweep"               # one of KINDS (docs/stage-kinds.md lists each with its keys)
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
 //!
-//! The remaining keys belong to the kind (see [`crate::sweep`], [`crate::reduce`]); unknown
-//! keys anywhere are errors naming the file and key.
+//! The remaining keys belong to the kind (its module documents them); unknown keys anywhere
+//! are errors naming the file and key.
 
 use std::path::{Path, PathBuf};
 
@@ -27,11 +27,13 @@ use crate::stability::Stability;
 use crate::sweep::Sweep;
 use crate::workprecision::WorkPrecision;
 
-/// The kinds of stage, in pipeline order.
+/// The kinds of stage, in pipeline order; each is documented by its module (`src/<kind>.rs`),
+/// from which `docs/stage-kinds.md` is generated (and tested current).
 pub const KINDS: &[&str] = &[
     "sweep",
     "spacetime",
     "reduce",
+    "optimize",
     "fit",
     "approximate",
     "render",
