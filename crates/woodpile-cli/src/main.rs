@@ -6,6 +6,22 @@
 //! go to stderr as one `error: ...` line naming the file, key and reason.
 #![allow(clippy::print_stdout)]
 
+/// `println!` that ends the process quietly when the reader has gone (`woodpile status |
+/// head`): std's `println!` panics on a broken pipe. The exit code is 141, a shell's code for
+/// a process ended by SIGPIPE, so `set -o pipefail` still sees it.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let mut out = std::io::stdout().lock();
+        if let Err(e) = writeln!(out, $($arg)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(141);
+            }
+            eprintln!("error: writing to stdout: {e}");
+            std::process::exit(1);
+        }
+    }};
+}
 mod pipeline_cmd;
 mod progress;
 mod simulate;

@@ -197,9 +197,9 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
                 })
                 .unwrap_or_default();
             if step.runs {
-                println!("would run {}: {}{points}", step.stage, step.why);
+                say!("would run {}: {}{points}", step.stage, step.why);
             } else {
-                println!("fresh     {}", step.stage);
+                say!("fresh     {}", step.stage);
             }
         }
     }
@@ -263,9 +263,9 @@ pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
     write(&submit, job.submit_script(&array, &merge))?;
     std::fs::create_dir_all(&logs)
         .map_err(|e| Failure::input(anyhow::anyhow!("{}: {e}", logs.display())))?;
-    println!("{}", array.display());
-    println!("{}", merge.display());
-    println!("{}", submit.display());
+    say!("{}", array.display());
+    say!("{}", merge.display());
+    say!("{}", submit.display());
     eprintln!("submit with: bash {}", submit.display());
     Ok(())
 }
@@ -278,12 +278,12 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
         .map(|s| s.name.len())
         .max()
         .unwrap_or(5);
-    println!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
+    say!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
     let mut not_fresh = 0;
     for stage in pipeline.stages() {
         let st = state(&pipeline, &args.at.results, &args.at.figures, stage);
         not_fresh += usize::from(st != State::Fresh);
-        println!(
+        say!(
             "{:width$}  {:11}  {:7}  {}",
             stage.name,
             stage.spec.kind(),
@@ -346,21 +346,35 @@ fn parse_tolerance(spec: &str) -> Result<(String, Tolerance), String> {
 
 fn print_report(report: &DiffReport) {
     for p in &report.problems {
-        println!("problem: {p}");
+        say!("problem: {p}");
     }
     if !report.worst.is_empty() {
-        println!(
+        say!(
             "{:<28} {:<16} {:>8} {:>24} {:>24} {:>10} {:>10} {:>8}",
-            "file", "column", "row", "a", "b", "abs", "rel", "excess"
+            "file",
+            "column",
+            "row",
+            "a",
+            "b",
+            "abs",
+            "rel",
+            "excess"
         );
         for d in &report.worst {
-            println!(
+            say!(
                 "{:<28} {:<16} {:>8} {:>24} {:>24} {:>10.3e} {:>10.3e} {:>8.2}",
-                d.file, d.column, d.row, d.a, d.b, d.abs, d.rel, d.excess
+                d.file,
+                d.column,
+                d.row,
+                d.a,
+                d.b,
+                d.abs,
+                d.rel,
+                d.excess
             );
         }
     }
-    println!(
+    say!(
         "{} files, {} values compared: {} beyond tolerance, {} structural problems -> {}",
         report.files,
         report.values,

@@ -34,7 +34,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     } else {
         serde_json::to_string(&report)
     };
-    println!("{}", text.map_err(Failure::simulation)?);
+    say!("{}", text.map_err(Failure::simulation)?);
     Ok(())
 }
 

@@ -246,3 +246,26 @@ fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
     }
     out
 }
+
+/// A reader that goes away (`woodpile status | head -1`) ends the command quietly with the
+/// SIGPIPE exit code, never a panic.
+#[test]
+fn a_closed_pipe_is_not_a_panic() {
+    let dir = project();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .current_dir(dir.path())
+        .args(["run", "--dry-run"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = text(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(
+        matches!(out.status.code(), Some(0 | 141)),
+        "{:?}",
+        out.status
+    );
+}

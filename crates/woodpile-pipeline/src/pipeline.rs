@@ -1,4 +1,5 @@
-//! The DAG of stages in a pipeline directory: every `*.toml` file is a stage named by its stem.
+//! The DAG of stages in a pipeline directory: every `*.toml` file (in it or in a subdirectory)
+//! is a stage named by its stem.
 //! Loading checks what no single file can: inputs that name no stage, inputs of the wrong kind,
 //! and cycles; then it orders the stages upstream first and computes every cache key.
 
@@ -23,19 +24,29 @@ pub struct Pipeline {
 }
 
 impl Pipeline {
-    /// Loads every stage file in `dir`.
+    /// Loads every stage file in `dir` and its subdirectories (one folder per figure, say):
+    /// a stage is named by its file's stem, wherever it lies, so names must be unique.
     pub fn load(dir: &Path) -> Result<Pipeline> {
-        let entries = std::fs::read_dir(dir).map_err(|e| PipelineError::io(dir, e))?;
-        let mut files: Vec<PathBuf> = entries
-            .flatten()
-            .map(|e| e.path())
-            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-            .collect();
+        let mut files = Vec::new();
+        stage_files(dir, &mut files)?;
         files.sort();
         let stages = files
             .iter()
             .map(|f| Stage::load(f))
             .collect::<Result<Vec<_>>>()?;
+        let mut seen: HashMap<&str, &Path> = HashMap::new();
+        for stage in &stages {
+            if let Some(other) = seen.insert(&stage.name, &stage.file) {
+                return Err(PipelineError::Syntax {
+                    file: stage.file.clone(),
+                    reason: format!(
+                        "stage `{}` is defined twice: here and in {}",
+                        stage.name,
+                        other.display()
+                    ),
+                });
+            }
+        }
         Pipeline::from_stages(dir, stages)
     }
 
@@ -184,6 +195,20 @@ fn check_names(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
 }
 
 /// Every input is of a kind the stage can read.
+/// Every `*.toml` under `dir`, recursively.
+fn stage_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
+    let entries = std::fs::read_dir(dir).map_err(|e| PipelineError::io(dir, e))?;
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            stage_files(&path, out)?;
+        } else if path.extension().is_some_and(|x| x == "toml") {
+            out.push(path);
+        }
+    }
+    Ok(())
+}
+
 /// Two reports may not write the same Markdown file: each would overwrite the other's.
 fn check_markdown_distinct(stages: &[Stage]) -> Result<()> {
     let mut owner: BTreeMap<&str, &str> = BTreeMap::new();

@@ -1,4 +1,5 @@
-//! One stage file: `pipeline/<name>.toml`. Top-level keys common to every kind:
+//! One stage file: `pipeline/<figure>/<name>.toml` (any folder under `pipeline/`; the name is
+//! the file stem). Top-level keys common to every kind:
 //!
 //! ```toml
 //! kind = "sweep"               # one of KINDS (docs/stage-kinds.md lists each with its keys)
