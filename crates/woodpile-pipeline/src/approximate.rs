@@ -11,7 +11,12 @@
 //! inputs = ["f9_fits", "f7_fine"]     # the fits, then the numerics
 //! transmission = "T1"                 # model names in the fit table
 //! reflection = "R"
+//! axes = ["eps1", "eps2"]             # the numerics' columns of the first and second defect
+//! numerics = "E_tr"                   # the numerics' column the product approximates
 //! ```
+//!
+//! Output: one row per row of the numerics: the two axes, the numerics, `approx` (our
+//! coefficients), `approx_paper`, `error` and `on_diagonal` (1 where the axes are equal).
 
 use polars::prelude::DataFrame;
 use serde_json::json;
@@ -29,6 +34,10 @@ pub struct Approximate {
     pub transmission: String,
     /// Model name of R in the fit table.
     pub reflection: String,
+    /// The numerics' columns of the first and the second defect's parameter.
+    pub axes: [String; 2],
+    /// The numerics' column the product approximates.
+    pub numerics: String,
 }
 
 /// A fitted form with our and the paper's coefficients.
@@ -40,9 +49,17 @@ struct Fitted {
 
 impl Approximate {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Approximate> {
+        let transmission = fields.required("transmission")?;
+        let reflection = fields.required("reflection")?;
+        let axes: Vec<String> = fields.required("axes")?;
+        let Ok(axes) = <[String; 2]>::try_from(axes) else {
+            return Err(fields.error("axes", "expected two column names [first, second]"));
+        };
         Ok(Approximate {
-            transmission: fields.required("transmission")?,
-            reflection: fields.required("reflection")?,
+            transmission,
+            reflection,
+            axes,
+            numerics: fields.required("numerics")?,
         })
     }
 
@@ -51,7 +68,8 @@ impl Approximate {
         let t1 = fitted(fits, &self.transmission).map_err(&fail)?;
         let r = fitted(fits, &self.reflection).map_err(&fail)?;
         let col = |name: &str| f64_column(data, name).map_err(|e| fail(e.to_string()));
-        let (e1, e2, e_tr) = (col("eps1")?, col("eps2")?, col("E_tr")?);
+        let [first, second] = &self.axes;
+        let (e1, e2, e_tr) = (col(first)?, col(second)?, col(&self.numerics)?);
         let product = |p_t: [f64; 3], p_r: [f64; 3], a: f64, b: f64| {
             t1.form.eval(p_t, a) * r.form.eval(p_r, b) * r.form.eval(p_r, a) * r.form.eval(p_r, b)
         };
@@ -61,7 +79,7 @@ impl Approximate {
         let mut diagonal = Vec::with_capacity(n);
         for i in 0..n {
             let (Some(a), Some(b)) = (e1[i], e2[i]) else {
-                return Err(fail(format!("row {i} lacks eps1 or eps2")));
+                return Err(fail(format!("row {i} lacks `{first}` or `{second}`")));
             };
             ours.push(Some(product(t1.ours, r.ours, a, b)));
             paper.push(match (t1.paper, r.paper) {
@@ -107,9 +125,9 @@ impl Approximate {
         let error: Vec<Option<f64>> = (0..n).map(|i| Some(ours[i]? - e_tr[i]?)).collect();
         let mut columns = Columns::new();
         columns
-            .f64("eps1", e1)
-            .f64("eps2", e2)
-            .f64("E_tr", e_tr)
+            .f64(first, e1)
+            .f64(second, e2)
+            .f64(&self.numerics, e_tr)
             .f64("approx", ours)
             .f64("approx_paper", paper)
             .f64("error", error)

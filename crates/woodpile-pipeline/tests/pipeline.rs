@@ -676,6 +676,8 @@ kind = "approximate"
 inputs = ["fits", "pair_at_end"]
 transmission = "T1"
 reflection = "R"
+axes = ["eps1", "eps2"]
+numerics = "E_tr"
 "#;
     let p = Project::new(&[
         ("single", &single),
@@ -1392,8 +1394,15 @@ fn stages_in_folders_load_and_a_name_twice_is_an_error() {
     std::fs::write(folder.join("sweep.toml"), SWEEP).unwrap();
     let pipeline = p.load();
     assert_eq!(pipeline.stages().len(), 2);
-    assert!(pipeline.stage("sweep").unwrap().file.ends_with("f1/sweep.toml"));
+    assert!(pipeline
+        .stage("sweep")
+        .unwrap()
+        .file
+        .ends_with("f1/sweep.toml"));
     std::fs::write(p.pipeline.join("sweep.toml"), SWEEP).unwrap();
     let e = Pipeline::load(&p.pipeline).unwrap_err().to_string();
-    assert!(e.contains("defined twice") && e.contains("f1/sweep.toml"), "{e}");
+    assert!(
+        e.contains("defined twice") && e.contains("f1/sweep.toml"),
+        "{e}"
+    );
 }
