@@ -10,6 +10,7 @@
 //! - [`optimize`]: Nelder–Mead refinement of a grid maximum, simulating between grid points.
 //! - [`fit`] (with [`lm`]): Levenberg–Marquardt fits of the paper's power and tanh forms.
 //! - [`approximate`]: the product approximation of two-defect trapping (paper Fig. 9).
+//! - [`design`]: inverse design, the best resonator layout by differential evolution.
 //! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
 //! - [`lock`]: one writer of a results tree at a time.
@@ -23,6 +24,7 @@
 pub mod approximate;
 pub mod atomic;
 pub mod canonical;
+pub mod design;
 pub mod diff;
 pub mod error;
 pub mod events;

@@ -148,7 +148,8 @@ impl Optimize {
         let start: Vec<f64> = searched.iter().map(|&k| grid_values[k].as_f64()).collect();
         let grid_value = objective(&start)?;
         let steps: Vec<f64> = bounds.iter().map(|b| b.2).collect();
-        let (best_x, best_value) = nelder_mead(&mut objective, &start, &steps, grid_value)?;
+        let (best_x, best_value) =
+            nelder_mead(&mut objective, &start, &steps, grid_value, MAX_EVALUATIONS)?;
         let clamped: Vec<f64> = best_x
             .iter()
             .zip(&bounds)
@@ -173,12 +174,14 @@ impl Optimize {
     }
 }
 
-/// Maximises `f` by Nelder–Mead from `start` with initial steps `steps`; `f(start)` is given.
-fn nelder_mead(
+/// Maximises `f` by Nelder–Mead from `start` with initial steps `steps`, in at most `budget`
+/// evaluations; `f(start)` is given.
+pub(crate) fn nelder_mead(
     f: &mut dyn FnMut(&[f64]) -> Result<f64>,
     start: &[f64],
     steps: &[f64],
     f_start: f64,
+    budget: usize,
 ) -> Result<(Vec<f64>, f64)> {
     let n = start.len();
     // Minimise -f.
@@ -202,7 +205,7 @@ fn nelder_mead(
             .fold(0.0, f64::max)
     };
     let mut spent = n + 1;
-    while spent < MAX_EVALUATIONS && size(&simplex) > 1e-3 {
+    while spent < budget && size(&simplex) > 1e-3 {
         simplex.sort_by(|a, b| a.1.total_cmp(&b.1));
         let centroid: Vec<f64> = (0..n)
             .map(|i| simplex[..n].iter().map(|p| p.0[i]).sum::<f64>() / n as f64)
@@ -259,7 +262,7 @@ mod tests {
         };
         let start = [0.0, 0.0];
         let f0 = f(&start).unwrap();
-        let (x, v) = nelder_mead(&mut f, &start, &[0.1, 0.1], f0).unwrap();
+        let (x, v) = nelder_mead(&mut f, &start, &[0.1, 0.1], f0, MAX_EVALUATIONS).unwrap();
         assert!(
             (x[0] - 0.37).abs() < 1e-3 && (x[1] + 0.21).abs() < 1e-3,
             "{x:?}"

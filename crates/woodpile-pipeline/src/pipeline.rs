@@ -11,6 +11,7 @@ use serde_json::json;
 use crate::canonical::{code_version, Key};
 use crate::error::{PipelineError, Result};
 use crate::grid::Axis;
+use crate::spacetime::{Source, SpaceTime};
 use crate::stage::{Spec, Stage};
 
 /// A loaded, validated pipeline.
@@ -230,15 +231,29 @@ fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
     let kind_of = |name: &str| &by_name[name].spec;
     let error = |key: &str, reason: String| Err(definition_error(stage, key, reason));
     match &stage.spec {
-        Spec::Sweep(_) | Spec::SpaceTime(_) | Spec::WorkPrecision(_) | Spec::Stability(_) => {
-            match stage.inputs.is_empty() {
-                true => Ok(()),
-                false => error(
-                    "inputs",
-                    format!("a {} stage reads no other stage", stage.spec.kind()),
+        Spec::SpaceTime(SpaceTime {
+            source: Source::Design(design),
+            ..
+        }) => match stage.inputs.as_slice() {
+            [input] if input == design && matches!(kind_of(input), Spec::Design(_)) => Ok(()),
+            _ => error(
+                "inputs",
+                format!(
+                    "a spacetime stage of `design = \"{design}\"` reads exactly that design stage"
                 ),
-            }
-        }
+            ),
+        },
+        Spec::Sweep(_)
+        | Spec::SpaceTime(_)
+        | Spec::WorkPrecision(_)
+        | Spec::Stability(_)
+        | Spec::Design(_) => match stage.inputs.is_empty() {
+            true => Ok(()),
+            false => error(
+                "inputs",
+                format!("a {} stage reads no other stage", stage.spec.kind()),
+            ),
+        },
         Spec::Reduce(reduce) => {
             let [input] = stage.inputs.as_slice() else {
                 return error("inputs", "a reduce stage reads exactly one sweep".into());

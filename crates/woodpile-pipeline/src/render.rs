@@ -218,10 +218,13 @@ impl Render {
         let fail = |e: PipelineError| PipelineError::stage(stage, e.to_string());
         let quote = |text: &str| quoted(text, inputs).map_err(|r| PipelineError::stage(stage, r));
         let mut panels = Vec::new();
+        let mut names = Vec::new();
         for spec in &self.panels {
             let (frame, _) = &inputs[&spec.input];
             let title = spec.title.as_deref().map(quote).transpose()?;
-            panels.extend(spec.draw(frame, title).map_err(fail)?);
+            let drawn = spec.draw(frame, title).map_err(fail)?;
+            names.extend(std::iter::repeat_n(spec.columns(), drawn.len()));
+            panels.extend(drawn);
         }
         if self.same_colour_scale {
             share_colour_scale(&mut panels);
@@ -241,7 +244,7 @@ impl Render {
         crate::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
         Ok(Output {
             failures: Vec::new(),
-            frame: plotted(&figure.panels).into_frame()?,
+            frame: plotted(&figure.panels, &names).into_frame()?,
             summary: json!({
                 "figures": [format!("{stage}.png"), format!("{stage}.svg")],
                 "panels": figure.panels.len(),
@@ -503,36 +506,66 @@ fn share_colour_scale(panels: &mut [Panel]) {
     }
 }
 
-/// The plotted numbers of `panels`: one row per curve point or heat-map cell, with the
-/// panel's index, the curve's (or the colour bar's) label, and x, y, z.
-fn plotted(panels: &[Panel]) -> Columns {
-    let (mut panel, mut label) = (Vec::new(), Vec::new());
-    let (mut xs, mut ys, mut zs) = (Vec::new(), Vec::new(), Vec::new());
-    let mut push = |p: usize, l: &str, x: f64, y: f64, z: Option<f64>| {
-        panel.push(Some(p as i64));
-        label.push(Some(l.to_string()));
-        xs.push(Some(x));
-        ys.push(Some(y));
-        zs.push(z);
+/// The source columns a panel plots: x, the y of each curve (by curve label; `None`: the
+/// panel's single y), and for heat maps y and z.
+#[derive(Clone)]
+struct PlottedColumns {
+    x: String,
+    y: Option<String>,
+    z: Option<String>,
+    overlays: Vec<(String, String)>,
+}
+
+/// The plotted numbers of `panels`: one row per curve point or heat-map cell, with the panel's
+/// index and the curve's (or the colour bar's) label, each number under the name of the column
+/// it was drawn from, so a diff can give a column (a wall time, say) its own tolerance.
+fn plotted(panels: &[Panel], names: &[PlottedColumns]) -> Columns {
+    let mut order: Vec<String> = Vec::new();
+    let mut rows: Vec<(usize, String, Vec<(String, Option<f64>)>)> = Vec::new();
+    let mut push = |p: usize, label: &str, cells: Vec<(String, Option<f64>)>| {
+        for (name, _) in &cells {
+            if !order.contains(name) {
+                order.push(name.clone());
+            }
+        }
+        rows.push((p, label.to_string(), cells));
     };
-    for (p, drawn) in panels.iter().enumerate() {
+    for (p, (drawn, cols)) in panels.iter().zip(names).enumerate() {
         match drawn {
             Panel::Lines(l) => {
                 for s in &l.series {
-                    for &(x, y) in &s.points {
-                        push(p, &s.label, x, y, None);
+                    let y = cols.y.clone().unwrap_or_else(|| s.label.clone());
+                    for &(x, v) in &s.points {
+                        push(
+                            p,
+                            &s.label,
+                            vec![(cols.x.clone(), Some(x)), (y.clone(), Some(v))],
+                        );
                     }
                 }
             }
             Panel::Heat(h) => {
-                for (j, &y) in h.ys.iter().enumerate() {
-                    for (i, &x) in h.xs.iter().enumerate() {
-                        push(p, &h.z_label, x, y, h.z[j * h.xs.len() + i]);
+                let (y, z) = (
+                    cols.y.clone().unwrap_or_default(),
+                    cols.z.clone().unwrap_or_default(),
+                );
+                for (j, &yv) in h.ys.iter().enumerate() {
+                    for (i, &xv) in h.xs.iter().enumerate() {
+                        let cells = vec![
+                            (cols.x.clone(), Some(xv)),
+                            (y.clone(), Some(yv)),
+                            (z.clone(), h.z[j * h.xs.len() + i]),
+                        ];
+                        push(p, &h.z_label, cells);
                     }
                 }
-                for s in &h.overlays {
-                    for &(x, y) in &s.points {
-                        push(p, &s.label, x, y, None);
+                for (s, (column, _)) in h.overlays.iter().zip(&cols.overlays) {
+                    for &(xv, yv) in &s.points {
+                        push(
+                            p,
+                            &s.label,
+                            vec![(column.clone(), Some(xv)), (y.clone(), Some(yv))],
+                        );
                     }
                 }
             }
@@ -540,15 +573,40 @@ fn plotted(panels: &[Panel]) -> Columns {
     }
     let mut columns = Columns::new();
     columns
-        .i64("panel", panel)
-        .str("series", label)
-        .f64("x", xs)
-        .f64("y", ys)
-        .f64("z", zs);
+        .i64("panel", rows.iter().map(|r| Some(r.0 as i64)).collect())
+        .str("series", rows.iter().map(|r| Some(r.1.clone())).collect());
+    for name in &order {
+        let values = rows
+            .iter()
+            .map(|r| r.2.iter().find(|(n, _)| n == name).and_then(|(_, v)| *v))
+            .collect();
+        columns.f64(name, values);
+    }
     columns
 }
 
 impl PanelSpec {
+    /// The source columns this spec plots.
+    fn columns(&self) -> PlottedColumns {
+        match &self.plot {
+            Plot::Lines { x, y, series, .. } => PlottedColumns {
+                x: x.clone(),
+                // Curves named by their y column carry it as label; a `series` split has one y.
+                y: series.as_ref().and(y.first().cloned()),
+                z: None,
+                overlays: Vec::new(),
+            },
+            Plot::Heatmap {
+                x, y, z, overlays, ..
+            } => PlottedColumns {
+                x: x.clone(),
+                y: Some(y.clone()),
+                z: Some(z.clone()),
+                overlays: overlays.clone(),
+            },
+        }
+    }
+
     /// The panels this spec draws from `input`: one, or one per value of `panels`.
     fn draw(&self, input: &DataFrame, title: Option<String>) -> Result<Vec<Panel>> {
         let keep = matching_rows(input, &self.filter)?;

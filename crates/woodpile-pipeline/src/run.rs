@@ -169,7 +169,7 @@ fn execute(
     let results = &options.results;
     let output = match &stage.spec {
         Spec::Sweep(sweep) => sweep.run(&stage.name, store, events)?,
-        Spec::SpaceTime(field) => field.run(&stage.name)?,
+        Spec::SpaceTime(field) => field.run(&stage.name, results)?,
         Spec::Reduce(reduce) => {
             let input = &stage.inputs[0];
             let path = output_path(results, input);
@@ -215,6 +215,7 @@ fn execute(
         Spec::Report(report) => report.run(&stage.name, results)?,
         Spec::WorkPrecision(wp) => wp.run(&stage.name)?,
         Spec::Stability(map) => map.run(&stage.name)?,
+        Spec::Design(design) => design.run(&stage.name, store, results, events)?,
     };
     let manifest = manifest_for(pipeline, stage, output.summary.clone());
     let rows = output.frame.height();

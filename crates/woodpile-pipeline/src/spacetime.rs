@@ -19,15 +19,21 @@
 //!
 //! Output: one row per point, sample and site: `point`, the axes, `t`, `site` (paper
 //! numbering), `velocity`. A scene whose simulation fails stops the stage with its reason.
+//!
+//! Instead of a grid, `design = "stage"` (with `inputs = ["stage"]` and `field.sites`) maps
+//! the best design a `design` stage found, from its `results/<stage>.best.toml`.
+
+use std::path::Path;
 
 use rayon::prelude::*;
 use serde_json::json;
+use woodpile_scene::Scene;
 use woodpile_sim::observe::SpaceTimeField;
 use woodpile_sim::run::simulate;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::grid::AxisValue;
+use crate::grid::{Axis, AxisValue};
 use crate::sweep::Sweep;
 use crate::table::Columns;
 use crate::Output;
@@ -35,31 +41,40 @@ use crate::Output;
 /// A parsed spacetime stage.
 #[derive(Debug, Clone)]
 pub struct SpaceTime {
-    /// The scenes.
-    pub sweep: Sweep,
-    /// Paper sites kept, inclusive.
+    /// The scenes: a grid, or the best design of a `design` stage.
+    pub source: Source,
+    /// Paper sites kept, inclusive (for a design: checked when its scene is known).
     pub sites: [i64; 2],
+}
+
+/// Where a spacetime stage's scenes come from.
+#[derive(Debug, Clone)]
+pub enum Source {
+    /// A sweep's grid of scenes (`[axes]`, `[scene]`).
+    Grid(Sweep),
+    /// `design = "stage"`: the best design that stage found (its `<stage>.best.toml`), which
+    /// must be the spacetime stage's one input.
+    Design(String),
 }
 
 impl SpaceTime {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<SpaceTime> {
+        if let Some(design) = fields.optional::<String>("design")? {
+            let table: toml::Table = fields.optional("field")?.unwrap_or_default();
+            let mut f = fields.nested("field", table);
+            let sites = field_sites(&mut f)?.ok_or_else(|| {
+                f.error("sites", "is required with `design`: [lo, hi] paper sites")
+            })?;
+            f.finish()?;
+            return Ok(SpaceTime {
+                source: Source::Design(design),
+                sites,
+            });
+        }
         let sweep = Sweep::parse(fields)?;
         let table: toml::Table = fields.optional("field")?.unwrap_or_default();
         let mut f = fields.nested("field", table);
-        let sites = match f.take("sites") {
-            None => None,
-            Some(v) => {
-                let pair: Option<Vec<i64>> = v
-                    .as_array()
-                    .map(|a| a.iter().filter_map(|x| x.as_integer()).collect());
-                match pair.as_deref() {
-                    Some(&[lo, hi]) if lo <= hi => Some([lo, hi]),
-                    _ => {
-                        return Err(f.error("sites", "expected [lo, hi] paper sites with lo <= hi"))
-                    }
-                }
-            }
-        };
+        let sites = field_sites(&mut f)?;
         f.finish()?;
         let scene = sweep.scene_at(0)?;
         let (first, last) = (scene.first_site, scene.last_site);
@@ -67,24 +82,51 @@ impl SpaceTime {
         if sites[0] < first || sites[1] > last {
             return Err(fields.error("field.sites", format!("sites must lie in {first}..{last}")));
         }
-        Ok(SpaceTime { sweep, sites })
+        Ok(SpaceTime {
+            source: Source::Grid(sweep),
+            sites,
+        })
     }
 
-    pub(crate) fn run(&self, stage: &str) -> Result<Output> {
-        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> = (0..self.sweep.count())
+    pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
+        let (scenes, axes): (Vec<(Vec<AxisValue>, Scene)>, &[Axis]) = match &self.source {
+            Source::Grid(sweep) => (
+                (0..sweep.count())
+                    .map(|i| Ok((sweep.values(i), sweep.scene_at(i)?)))
+                    .collect::<Result<_>>()?,
+                &sweep.axes,
+            ),
+            Source::Design(design) => {
+                let path = crate::design::best_path(results, design);
+                let scene = woodpile_scene::load(&path)
+                    .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
+                if self.sites[0] < scene.first_site || self.sites[1] > scene.last_site {
+                    return Err(PipelineError::stage(
+                        stage,
+                        format!(
+                            "field.sites must lie in {}..{}",
+                            scene.first_site, scene.last_site
+                        ),
+                    ));
+                }
+                (vec![(Vec::new(), scene)], &[])
+            }
+        };
+        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> = scenes
             .into_par_iter()
-            .map(|i| {
-                let scene = self.sweep.scene_at(i)?;
+            .enumerate()
+            .map(|(i, (values, scene))| {
                 let model = &scene.scenario.model;
                 let mut field = SpaceTimeField::new(model, 1, 1);
                 simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;
-                Ok((self.sweep.values(i), field, scene.first_site))
+                Ok((values, field, scene.first_site))
             })
             .collect::<Result<_>>()?;
         let mut point = Vec::new();
-        let mut axes: Vec<Vec<AxisValue>> = vec![Vec::new(); self.sweep.axes.len()];
+        let points = fields.len();
+        let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::new(); axes.len()];
         let (mut t, mut site, mut velocity) = (Vec::new(), Vec::new(), Vec::new());
         for (i, (values, field, first)) in fields.iter().enumerate() {
             let n_sites = field.sites.len();
@@ -95,7 +137,7 @@ impl SpaceTime {
                         continue;
                     }
                     point.push(Some(i as i64));
-                    for (column, v) in axes.iter_mut().zip(values) {
+                    for (column, v) in axis_values.iter_mut().zip(values) {
                         column.push(*v);
                     }
                     t.push(Some(time));
@@ -106,7 +148,7 @@ impl SpaceTime {
         }
         let mut columns = Columns::new();
         columns.i64("point", point);
-        for (axis, values) in self.sweep.axes.iter().zip(axes) {
+        for (axis, values) in axes.iter().zip(axis_values) {
             if axis.is_integer() {
                 columns.i64(
                     &axis.name,
@@ -126,7 +168,23 @@ impl SpaceTime {
         Ok(Output {
             failures: Vec::new(),
             frame: columns.into_frame()?,
-            summary: json!({"points": self.sweep.count(), "sites": self.sites}),
+            summary: json!({"points": points, "sites": self.sites}),
         })
+    }
+}
+
+/// `field.sites = [lo, hi]`, if given.
+fn field_sites(f: &mut Fields<'_>) -> Result<Option<[i64; 2]>> {
+    match f.take("sites") {
+        None => Ok(None),
+        Some(v) => {
+            let pair: Option<Vec<i64>> = v
+                .as_array()
+                .map(|a| a.iter().filter_map(|x| x.as_integer()).collect());
+            match pair.as_deref() {
+                Some(&[lo, hi]) if lo <= hi => Ok(Some([lo, hi])),
+                _ => Err(f.error("sites", "expected [lo, hi] paper sites with lo <= hi")),
+            }
+        }
     }
 }

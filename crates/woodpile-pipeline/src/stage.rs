@@ -16,6 +16,7 @@ use serde_json::Value;
 
 use crate::approximate::Approximate;
 use crate::canonical::toml_to_json;
+use crate::design::Design;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::fit::FitStage;
@@ -41,6 +42,7 @@ pub const KINDS: &[&str] = &[
     "report",
     "workprecision",
     "stability",
+    "design",
 ];
 
 /// What a stage does, with its kind-specific parameters.
@@ -66,6 +68,8 @@ pub enum Spec {
     WorkPrecision(WorkPrecision),
     /// Where each fixed-step method blows up or misses the tolerance.
     Stability(Stability),
+    /// Search resonator layouts for the best trap (inverse design).
+    Design(Design),
 }
 
 impl Spec {
@@ -82,6 +86,7 @@ impl Spec {
             Spec::Report(_) => "report",
             Spec::WorkPrecision(_) => "workprecision",
             Spec::Stability(_) => "stability",
+            Spec::Design(_) => "design",
         }
     }
 }
@@ -139,6 +144,7 @@ impl Stage {
             "report" => Spec::Report(Report::parse(&mut fields)?),
             "workprecision" => Spec::WorkPrecision(WorkPrecision::parse(&mut fields)?),
             "stability" => Spec::Stability(Stability::parse(&mut fields)?),
+            "design" => Spec::Design(Design::parse(&mut fields)?),
             other => {
                 return Err(fields.error(
                     "kind",

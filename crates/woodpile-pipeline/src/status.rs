@@ -86,6 +86,12 @@ pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage)
                 return State::Stale(missing);
             }
         }
+        if let Spec::Design(_) = &stage.spec {
+            let best = crate::design::best_path(results, &stage.name);
+            if !best.exists() {
+                return State::Stale(vec![format!("{} missing", best.display())]);
+            }
+        }
         if let Spec::Report(report) = &stage.spec {
             let markdown = report.markdown_path(results);
             if !markdown.exists() {

@@ -549,7 +549,8 @@ mark_max = true
         .iter()
         .map(|n| n.to_string())
         .collect();
-    assert_eq!(names, ["panel", "series", "x", "y", "z"]);
+    // Each number under the name of the column it was drawn from.
+    assert_eq!(names, ["panel", "series", "eps", "R", "E_tr"]);
     let reduced = table::read(&p.output("at_end")).unwrap();
     assert_eq!(
         plotted.height(),
@@ -557,8 +558,8 @@ mark_max = true
         "R and E_tr of every row"
     );
     let (x, y) = (
-        table::f64_column(&plotted, "x").unwrap(),
-        table::f64_column(&plotted, "y").unwrap(),
+        table::f64_column(&plotted, "eps").unwrap(),
+        table::f64_column(&plotted, "E_tr").unwrap(),
     );
     let series = table::str_column(&plotted, "series").unwrap();
     let (eps, e_tr) = (
@@ -1405,4 +1406,106 @@ fn stages_in_folders_load_and_a_name_twice_is_an_error() {
         e.contains("defined twice") && e.contains("f1/sweep.toml"),
         "{e}"
     );
+}
+
+const DESIGN: &str = r#"
+kind = "design"
+seed = 7
+budget = 40
+refine = 10
+objective = "E_tr"
+verify_tolerance = 1e-8
+robustness = { samples = 6, spreads = [0.01, 0.05] }
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "auto", tolerance = 1e-6 }
+fractions = { region = [-1, 4] }
+[space]
+resonators = [1, 2]
+sites = [0, 3]
+eps = { min = 0.1, max = 10.0, log = true }
+kappa = { min = 0.5, max = 2.0 }
+"#;
+
+fn count_files(dir: &Path) -> usize {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .flatten()
+                .map(|e| {
+                    if e.path().is_dir() {
+                        count_files(&e.path())
+                    } else {
+                        1
+                    }
+                })
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+/// The design stage searches, verifies its best design, and writes it as a scene file that
+/// loads as it is and gives the verified number; the search depends on the seed alone (any
+/// thread count), and a repeated search finds every trial in the point cache.
+#[test]
+fn a_design_stage_finds_verifies_and_writes_its_best_design() {
+    let outputs: Vec<Vec<u8>> = [1, 2]
+        .into_iter()
+        .map(|threads| {
+            let p = Project::new(&[("trap", DESIGN)]);
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| p.run(&[]));
+            std::fs::read(p.output("trap")).unwrap()
+        })
+        .collect();
+    assert_eq!(
+        outputs[0], outputs[1],
+        "the search depends on the seed alone"
+    );
+
+    let p = Project::new(&[("trap", DESIGN)]);
+    p.run(&[]);
+    let table = table::read(&p.output("trap")).unwrap();
+    let search = table::str_column(&table, "search").unwrap();
+    let e_tr = table::f64_column(&table, "E_tr").unwrap();
+    let count = |s: &str| search.iter().filter(|x| x.as_deref() == Some(s)).count();
+    assert_eq!(count("differential evolution"), 40);
+    assert_eq!(count("random"), 40);
+    assert_eq!(count("verification"), 1);
+    assert_eq!(count("robustness ±5%"), 6);
+    let verified = (0..table.height())
+        .find(|&r| search[r].as_deref() == Some("verification"))
+        .unwrap();
+    let best_searched = (0..table.height())
+        .filter(|&r| {
+            matches!(
+                search[r].as_deref(),
+                Some("differential evolution" | "refinement")
+            )
+        })
+        .filter_map(|r| e_tr[r])
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!((e_tr[verified].unwrap() - best_searched).abs() < 1e-5);
+
+    let best = p.results.join("trap.best.toml");
+    let scene = woodpile_scene::load(&best).unwrap();
+    assert_eq!(scene.region_paper, [-1, 4]);
+    let again = woodpile_sim::run::simulate(&scene.scenario, &mut ()).unwrap();
+    assert_eq!(Some(again.fractions.trapped), e_tr[verified]);
+
+    let points = count_files(&points_dir(&p.results));
+    p.run_with(&["trap"], true);
+    assert_eq!(
+        count_files(&points_dir(&p.results)),
+        points,
+        "nothing simulated twice"
+    );
+
+    // A missing best design makes the stage stale.
+    std::fs::remove_file(&best).unwrap();
+    assert!(matches!(p.state("trap"), State::Stale(_)));
 }
