@@ -101,6 +101,32 @@ impl<'a> Fields<'a> {
             .collect()
     }
 
+    /// `key = [{ ... }, ...]`: each table as its own [`Fields`] (keys `key[i].…`), none when
+    /// the key is absent; anything else is an error saying what was `expected`.
+    pub(crate) fn table_array(
+        &mut self,
+        key: &str,
+        expected: &str,
+    ) -> Result<Vec<Fields<'a>>, PipelineError> {
+        let Some(value) = self.take(key) else {
+            return Ok(Vec::new());
+        };
+        let toml::Value::Array(items) = value else {
+            return Err(self.error(key, format!("expected an array of {expected} tables")));
+        };
+        items
+            .into_iter()
+            .enumerate()
+            .map(|(i, item)| {
+                let at = format!("{key}[{i}]");
+                match item {
+                    toml::Value::Table(table) => Ok(self.nested(&at, table)),
+                    _ => Err(self.error(&at, format!("expected a table {expected}"))),
+                }
+            })
+            .collect()
+    }
+
     /// Rejects every key left unconsumed.
     pub(crate) fn finish(self) -> Result<(), PipelineError> {
         match self.table.keys().next() {

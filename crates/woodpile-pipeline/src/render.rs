@@ -151,15 +151,11 @@ impl Render {
         }
         let same_colour_scale = flag(fields, "same_colour_scale")?;
         check_quotes(&title, inputs).map_err(|reason| fields.error("title", reason))?;
-        let panels = match fields.take("panel") {
-            Some(toml::Value::Array(items)) => {
-                let mut panels = Vec::with_capacity(items.len());
-                for (i, item) in items.into_iter().enumerate() {
-                    let key = format!("panel[{i}]");
-                    let toml::Value::Table(table) = item else {
-                        return Err(fields.error(&key, "expected a table"));
-                    };
-                    let mut f = fields.nested(&key, table);
+        let panel_tables = fields.table_array("panel", "[[panel]]")?;
+        let panels = match panel_tables.is_empty() {
+            false => {
+                let mut panels = Vec::with_capacity(panel_tables.len());
+                for mut f in panel_tables {
                     let input: String = f.required("input")?;
                     if !inputs.contains(&input) {
                         return Err(f.error(
@@ -175,13 +171,9 @@ impl Render {
                     f.finish()?;
                     panels.push(panel);
                 }
-                if panels.is_empty() {
-                    return Err(fields.error("panel", "expected one or more [[panel]] tables"));
-                }
                 panels
             }
-            Some(_) => return Err(fields.error("panel", "expected [[panel]] tables")),
-            None => {
+            true => {
                 let [input] = inputs else {
                     return Err(fields.error(
                         "inputs",
@@ -372,21 +364,9 @@ fn parse_panel(f: &mut Fields<'_>, input: String, title: Option<String>) -> Resu
 
 /// `mark = [{ x = value, label = "text" } | { y = value, label = "text" }, ...]`.
 fn parse_marks(f: &mut Fields<'_>) -> Result<Vec<Mark>> {
-    let Some(value) = f.take("mark") else {
-        return Ok(Vec::new());
-    };
-    let toml::Value::Array(items) = value else {
-        return Err(f.error("mark", "expected an array of { x or y, label } tables"));
-    };
-    items
+    f.table_array("mark", "{ x or y, label }")?
         .into_iter()
-        .enumerate()
-        .map(|(i, item)| {
-            let key = format!("mark[{i}]");
-            let toml::Value::Table(table) = item else {
-                return Err(f.error(&key, "expected a table { x = 0.0, label = \"text\" }"));
-            };
-            let mut m = f.nested(&key, table);
+        .map(|mut m| {
             let at = match (m.optional::<f64>("x")?, m.optional::<f64>("y")?) {
                 (Some(x), None) => MarkAt::X(x),
                 (None, Some(y)) => MarkAt::Y(y),
@@ -404,24 +384,9 @@ fn parse_marks(f: &mut Fields<'_>) -> Result<Vec<Mark>> {
 
 /// `overlay = [{ x = "column", label = "text" }, ...]` of a `[heatmap]`.
 fn parse_overlays(f: &mut Fields<'_>) -> Result<Vec<(String, String)>> {
-    let Some(value) = f.take("overlay") else {
-        return Ok(Vec::new());
-    };
-    let toml::Value::Array(items) = value else {
-        return Err(f.error("overlay", "expected an array of { x, label } tables"));
-    };
-    items
+    f.table_array("overlay", "{ x = \"column\", label = \"text\" }")?
         .into_iter()
-        .enumerate()
-        .map(|(i, item)| {
-            let key = format!("overlay[{i}]");
-            let toml::Value::Table(table) = item else {
-                return Err(f.error(
-                    &key,
-                    "expected a table { x = \"column\", label = \"text\" }",
-                ));
-            };
-            let mut o = f.nested(&key, table);
+        .map(|mut o| {
             let overlay = (o.required("x")?, o.required("label")?);
             o.finish()?;
             Ok(overlay)
