@@ -23,9 +23,10 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::lm::Form;
 use crate::table::{f64_column, str_column, Columns};
 use crate::Output;
+use woodpile_analysis::lm::Form;
+use woodpile_analysis::product::{errors, product, Fitted};
 
 /// A parsed approximate stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,7 +42,7 @@ pub struct Approximate {
 }
 
 /// A fitted form with our and the paper's coefficients.
-struct Fitted {
+struct Coefficients {
     form: Form,
     ours: [f64; 3],
     paper: Option<[f64; 3]>,
@@ -71,7 +72,18 @@ impl Approximate {
         let [first, second] = &self.axes;
         let (e1, e2, e_tr) = (col(first)?, col(second)?, col(&self.numerics)?);
         let product = |p_t: [f64; 3], p_r: [f64; 3], a: f64, b: f64| {
-            t1.form.eval(p_t, a) * r.form.eval(p_r, b) * r.form.eval(p_r, a) * r.form.eval(p_r, b)
+            product(
+                Fitted {
+                    form: t1.form,
+                    params: p_t,
+                },
+                Fitted {
+                    form: r.form,
+                    params: p_r,
+                },
+                a,
+                b,
+            )
         };
         let n = data.height();
         let mut ours = Vec::with_capacity(n);
@@ -88,25 +100,10 @@ impl Approximate {
             });
             diagonal.push(Some(if a == b { 1 } else { 0 }));
         }
-        // Two error measures: the relative L2 error ‖f − y‖/‖y‖, and the root-mean-square
-        // difference sqrt(mean (f − y)²), which is the measure that reproduces the paper's
-        // "relative error ~0.0369" (REPRODUCTION.md).
+        // The relative L2 error, and the RMS difference that reproduces the paper's "relative
+        // error ~0.0369" (REPRODUCTION.md).
         let errors =
-            |approx: &[Option<f64>], keep: &dyn Fn(usize) -> bool| -> (Option<f64>, Option<f64>) {
-                let (mut num, mut den, mut count) = (0.0, 0.0, 0usize);
-                for i in (0..n).filter(|&i| keep(i)) {
-                    let (Some(y), Some(f)) = (e_tr[i], approx[i]) else {
-                        continue;
-                    };
-                    num += (f - y) * (f - y);
-                    den += y * y;
-                    count += 1;
-                }
-                (
-                    (den > 0.0).then(|| (num / den).sqrt()),
-                    (count > 0).then(|| (num / count as f64).sqrt()),
-                )
-            };
+            |approx: &[Option<f64>], keep: &dyn Fn(usize) -> bool| errors(&e_tr, approx, keep);
         let all = |_: usize| true;
         let diag = |i: usize| diagonal[i] == Some(1);
         let (ours_all, ours_diag) = (errors(&ours, &all), errors(&ours, &diag));
@@ -140,7 +137,7 @@ impl Approximate {
     }
 }
 
-fn fitted(fits: &DataFrame, name: &str) -> std::result::Result<Fitted, String> {
+fn fitted(fits: &DataFrame, name: &str) -> std::result::Result<Coefficients, String> {
     let names = str_column(fits, "model").map_err(|e| e.to_string())?;
     let row = names
         .iter()
@@ -160,7 +157,7 @@ fn fitted(fits: &DataFrame, name: &str) -> std::result::Result<Fitted, String> {
     let [Some(a), Some(b), Some(c)] = ours else {
         return Err(format!("model `{name}` has no coefficients"));
     };
-    Ok(Fitted {
+    Ok(Coefficients {
         form,
         ours: [a, b, c],
         paper: match paper {

@@ -550,7 +550,7 @@ impl Design {
             let start: Vec<f64> = slots.iter().map(|&j| best_genome[j]).collect();
             let steps = vec![0.05; start.len()];
             if !start.is_empty() {
-                crate::optimize::nelder_mead(
+                woodpile_analysis::nelder_mead::maximise(
                     &mut objective,
                     &start,
                     &steps,

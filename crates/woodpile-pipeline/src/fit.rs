@@ -25,9 +25,9 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::lm::{fit, Form};
 use crate::table::{f64_column, matching_rows, Columns};
 use crate::Output;
+use woodpile_analysis::lm::{fit, Fit, Form};
 
 /// A parsed fit stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -191,7 +191,7 @@ impl Rows {
     fn push(
         &mut self,
         m: &Model,
-        f: &crate::lm::Fit,
+        f: &Fit,
         (x_min, x_max): (Option<f64>, Option<f64>),
         n: usize,
         paper_error: Option<f64>,

@@ -8,7 +8,8 @@
 //! - [`spacetime`]: site velocities over time for space-time maps (paper Figs. 3, 8).
 //! - [`reduce`]: read fractions at a time, maximise over axes.
 //! - [`optimize`]: Nelder–Mead refinement of a grid maximum, simulating between grid points.
-//! - [`fit`] (with [`lm`]): Levenberg–Marquardt fits of the paper's power and tanh forms.
+//! - [`fit`]: Levenberg–Marquardt fits of the paper's power and tanh forms (the numerics are
+//!   `woodpile-analysis`'s, as are Nelder–Mead and the product approximation).
 //! - [`approximate`]: the product approximation of two-defect trapping (paper Fig. 9).
 //! - [`design`]: inverse design, the best resonator layout by differential evolution.
 //! - [`render`]: draw a table as PNG and SVG (through `woodpile-plot`).
@@ -31,7 +32,6 @@ pub mod events;
 mod fields;
 pub mod fit;
 pub mod grid;
-pub mod lm;
 pub mod lock;
 pub mod manifest;
 pub mod optimize;
