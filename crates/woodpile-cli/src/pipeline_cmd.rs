@@ -225,7 +225,7 @@ pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
         return Err(Failure::input(anyhow::anyhow!(
             "`{}` is a {} stage: only sweeps are sharded",
             stage.name,
-            stage.spec.kind()
+            stage.kind
         )));
     }
     if args.tasks == 0 || args.cpus == 0 {
@@ -286,7 +286,7 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
         say!(
             "{:width$}  {:11}  {:7}  {}",
             stage.name,
-            stage.spec.kind(),
+            stage.kind,
             st.label(),
             st.why()
         );

@@ -23,6 +23,8 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::kind::{Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
 use crate::table::{f64_column, str_column, Columns};
 use crate::Output;
 use woodpile_analysis::lm::Form;
@@ -165,4 +167,27 @@ fn fitted(fits: &DataFrame, name: &str) -> std::result::Result<Coefficients, Str
             _ => None,
         },
     })
+}
+
+impl Kind for Approximate {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        match stage.inputs.as_slice() {
+            [fits, data]
+                if inputs.get::<crate::fit::FitStage>(fits).is_some()
+                    && inputs.get::<crate::reduce::Reduce>(data).is_some() =>
+            {
+                Ok(())
+            }
+            _ => Err((
+                "inputs".into(),
+                "expected [a fit stage, a reduce stage]".into(),
+            )),
+        }
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let fits = ctx.input(&ctx.stage.inputs[0])?;
+        let data = ctx.input(&ctx.stage.inputs[1])?;
+        self.run(ctx.name(), &fits, &data)
+    }
 }

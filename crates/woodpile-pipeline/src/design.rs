@@ -50,7 +50,9 @@ use woodpile_scene::Scene;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::fields::Fields;
+use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
 use crate::points::{simulate_point, PointResult, PointStore, Series};
+use crate::stage::Stage;
 use crate::sweep::point_key;
 use crate::table::Columns;
 use crate::Output;
@@ -857,6 +859,20 @@ fn parse_space(mut f: Fields<'_>) -> Result<Space> {
         p,
         max_total_eps,
     })
+}
+
+impl Kind for Design {
+    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
+        no_inputs(stage)
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name(), ctx.store, ctx.results, ctx.events)
+    }
+
+    fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
+        vec![best_path(results, stage)]
+    }
 }
 
 #[cfg(test)]

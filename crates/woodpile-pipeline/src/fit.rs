@@ -25,6 +25,8 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::kind::{Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
 use crate::table::{f64_column, matching_rows, Columns};
 use crate::Output;
 use woodpile_analysis::lm::{fit, Fit, Form};
@@ -249,5 +251,28 @@ impl Rows {
         c.f64("paper_relative_error", self.paper_relative_error);
         c.str("failure", self.failure);
         c
+    }
+}
+
+impl Kind for FitStage {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        let [input] = stage.inputs.as_slice() else {
+            return Err((
+                "inputs".into(),
+                "a fit stage reads exactly one table".into(),
+            ));
+        };
+        match inputs.get::<crate::render::Render>(input) {
+            Some(_) => Err((
+                "inputs[0]".into(),
+                format!("`{input}` is a render stage: read a data table"),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let frame = ctx.input(&ctx.stage.inputs[0])?;
+        self.run(ctx.name(), &frame)
     }
 }

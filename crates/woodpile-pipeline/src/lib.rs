@@ -2,6 +2,7 @@
 //! writing one parquet table under `results/` whose metadata records its cache key and
 //! everything the key was computed from.
 //!
+//! - [`kind`]: the `Kind` trait every stage kind implements, and `KINDS`, the one list of them.
 //! - [`stage`], [`pipeline`]: parse stage files, check the DAG, compute the keys.
 //! - [`sweep`] (with [`grid`], [`template`], [`points`]): simulate parameter grids, cached
 //!   per scene so that overlapping and interrupted sweeps never repeat a simulation.
@@ -32,6 +33,7 @@ pub mod events;
 mod fields;
 pub mod fit;
 pub mod grid;
+pub mod kind;
 pub mod lock;
 pub mod manifest;
 pub mod optimize;

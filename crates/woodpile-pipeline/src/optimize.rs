@@ -20,7 +20,10 @@ use woodpile_sim::run::simulate;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::grid::AxisValue;
+use crate::kind::{Context, Inputs, Kind, KindCheck};
+use crate::reduce::Reduce;
 use crate::reduce::MAXIMIZABLE;
+use crate::stage::Stage;
 use crate::sweep::Sweep;
 use crate::table::{f64_column, Columns};
 use crate::Output;
@@ -176,5 +179,57 @@ impl Optimize {
             frame: columns.into_frame()?,
             summary: json!({"grid": grid_value, "refined": best_value, "gain": best_value - grid_value, "simulations": evaluations}),
         })
+    }
+}
+
+impl Kind for Optimize {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        let error = |key: &str, reason: String| Err((key.to_string(), reason));
+        let [input] = stage.inputs.as_slice() else {
+            return error(
+                "inputs",
+                "an optimize stage reads exactly one reduce stage".into(),
+            );
+        };
+        let Some(reduce) = inputs.get::<Reduce>(input) else {
+            return error(
+                "inputs[0]",
+                format!(
+                    "`{input}` is a {} stage; expected a reduce stage",
+                    inputs.kind_of(input)
+                ),
+            );
+        };
+        if reduce.maximize.is_some() {
+            return error(
+                "inputs[0]",
+                format!("`{input}` maximises already; read a plain reduce"),
+            );
+        }
+        let sweep = inputs
+            .stage(input)
+            .and_then(|s| s.inputs.first())
+            .and_then(|s| inputs.get::<Sweep>(s));
+        match sweep {
+            Some(sweep) => self
+                .check_axes(sweep)
+                .map_err(|reason| ("over".to_string(), reason)),
+            None => error("inputs[0]", format!("`{input}` does not read a sweep")),
+        }
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let input = &ctx.stage.inputs[0];
+        let frame = ctx.input(input)?;
+        let sweep = ctx
+            .pipeline
+            .stage(input)?
+            .inputs
+            .first()
+            .and_then(|s| ctx.pipeline.sweep(s))
+            .ok_or_else(|| {
+                PipelineError::stage(ctx.name(), format!("`{input}` does not read a sweep"))
+            })?;
+        self.run(ctx.name(), &frame, sweep)
     }
 }

@@ -11,8 +11,10 @@ use serde_json::json;
 use crate::canonical::{code_version, Key};
 use crate::error::{PipelineError, Result};
 use crate::grid::Axis;
-use crate::spacetime::{Source, SpaceTime};
-use crate::stage::{Spec, Stage};
+use crate::kind::Inputs;
+use crate::report::Report;
+use crate::stage::Stage;
+use crate::sweep::Sweep;
 
 /// A loaded, validated pipeline.
 #[derive(Debug, Clone)]
@@ -77,7 +79,7 @@ impl Pipeline {
                 .map(|name| (name.as_str(), keys[index[name]].as_str()))
                 .collect();
             keys.push(Key::of(&json!({
-                "kind": stage.spec.kind(),
+                "kind": stage.kind,
                 "params": stage.params,
                 "inputs": inputs,
                 "code": code_version(),
@@ -123,19 +125,13 @@ impl Pipeline {
     }
 
     /// The sweep definition of stage `name`, if it is one.
-    pub fn sweep(&self, name: &str) -> Option<&crate::sweep::Sweep> {
-        match &self.stages[*self.index.get(name)?].spec {
-            Spec::Sweep(s) => Some(s),
-            _ => None,
-        }
+    pub fn sweep(&self, name: &str) -> Option<&Sweep> {
+        self.stages[*self.index.get(name)?].get::<Sweep>()
     }
 
     /// The grid axes of sweep `name`, if it is one.
     pub fn sweep_axes(&self, name: &str) -> Option<&[Axis]> {
-        match &self.stages[*self.index.get(name)?].spec {
-            Spec::Sweep(s) => Some(&s.axes),
-            _ => None,
-        }
+        Some(&self.sweep(name)?.axes)
     }
 
     /// `targets` and everything upstream of them, upstream first; every stage if `targets` is
@@ -214,7 +210,7 @@ fn stage_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
 fn check_markdown_distinct(stages: &[Stage]) -> Result<()> {
     let mut owner: BTreeMap<&str, &str> = BTreeMap::new();
     for stage in stages {
-        if let Spec::Report(report) = &stage.spec {
+        if let Some(report) = stage.get::<Report>() {
             if let Some(other) = owner.insert(report.markdown.as_str(), stage.name.as_str()) {
                 return Err(definition_error(
                     stage,
@@ -227,135 +223,12 @@ fn check_markdown_distinct(stages: &[Stage]) -> Result<()> {
     Ok(())
 }
 
+/// The stage's kind checks its inputs (whose existence is already checked).
 fn check_kinds(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
-    let kind_of = |name: &str| &by_name[name].spec;
-    let error = |key: &str, reason: String| Err(definition_error(stage, key, reason));
-    match &stage.spec {
-        Spec::SpaceTime(SpaceTime {
-            source: Source::Design(design),
-            ..
-        }) => match stage.inputs.as_slice() {
-            [input] if input == design && matches!(kind_of(input), Spec::Design(_)) => Ok(()),
-            _ => error(
-                "inputs",
-                format!(
-                    "a spacetime stage of `design = \"{design}\"` reads exactly that design stage"
-                ),
-            ),
-        },
-        Spec::Sweep(_)
-        | Spec::SpaceTime(_)
-        | Spec::WorkPrecision(_)
-        | Spec::Stability(_)
-        | Spec::Design(_) => match stage.inputs.is_empty() {
-            true => Ok(()),
-            false => error(
-                "inputs",
-                format!("a {} stage reads no other stage", stage.spec.kind()),
-            ),
-        },
-        Spec::Reduce(reduce) => {
-            let [input] = stage.inputs.as_slice() else {
-                return error("inputs", "a reduce stage reads exactly one sweep".into());
-            };
-            match kind_of(input) {
-                Spec::Sweep(sweep) => reduce
-                    .check_axes(&sweep.axes)
-                    .map_err(|reason| definition_error(stage, "maximize.over", reason)),
-                other => error(
-                    "inputs[0]",
-                    format!(
-                        "`{input}` is a {} stage; a reduce reads a sweep",
-                        other.kind()
-                    ),
-                ),
-            }
-        }
-        Spec::Optimize(optimize) => {
-            let [input] = stage.inputs.as_slice() else {
-                return error(
-                    "inputs",
-                    "an optimize stage reads exactly one reduce stage".into(),
-                );
-            };
-            let reduce = by_name[input.as_str()];
-            let Spec::Reduce(r) = &reduce.spec else {
-                return error(
-                    "inputs[0]",
-                    format!(
-                        "`{input}` is a {} stage; expected a reduce stage",
-                        reduce.spec.kind()
-                    ),
-                );
-            };
-            if r.maximize.is_some() {
-                return error(
-                    "inputs[0]",
-                    format!("`{input}` maximises already; read a plain reduce"),
-                );
-            }
-            match reduce.inputs.first().map(|s| kind_of(s)) {
-                Some(Spec::Sweep(sweep)) => optimize
-                    .check_axes(sweep)
-                    .map_err(|reason| definition_error(stage, "over", reason)),
-                _ => error("inputs[0]", format!("`{input}` does not read a sweep")),
-            }
-        }
-        Spec::Approximate(_) => match stage.inputs.as_slice() {
-            [fits, data]
-                if matches!(
-                    (kind_of(fits), kind_of(data)),
-                    (Spec::Fit(_), Spec::Reduce(_))
-                ) =>
-            {
-                Ok(())
-            }
-            _ => error("inputs", "expected [a fit stage, a reduce stage]".into()),
-        },
-        Spec::Report(report) => {
-            if stage.inputs.is_empty() {
-                return error("inputs", "a report reads the stages its quotes name".into());
-            }
-            for (key, source) in report.sources() {
-                if !stage.inputs.contains(&source.stage) {
-                    return error(
-                        &key,
-                        format!("`{}` is not among this stage's inputs", source.stage),
-                    );
-                }
-            }
-            Ok(())
-        }
-        Spec::Render(_) => match stage
-            .inputs
-            .iter()
-            .position(|i| matches!(kind_of(i), Spec::Render(_)))
-        {
-            Some(k) => error(
-                &format!("inputs[{k}]"),
-                format!("`{}` is a render stage: read a data table", stage.inputs[k]),
-            ),
-            None if stage.inputs.is_empty() => {
-                error("inputs", "a render stage reads one or more tables".into())
-            }
-            None => Ok(()),
-        },
-        Spec::Fit(_) => {
-            let [input] = stage.inputs.as_slice() else {
-                return error(
-                    "inputs",
-                    format!("a {} stage reads exactly one table", stage.spec.kind()),
-                );
-            };
-            match kind_of(input) {
-                Spec::Render(_) => error(
-                    "inputs[0]",
-                    format!("`{input}` is a render stage: read a data table"),
-                ),
-                _ => Ok(()),
-            }
-        }
-    }
+    stage
+        .spec
+        .check_inputs(stage, &Inputs { by_name })
+        .map_err(|(key, reason)| definition_error(stage, &key, reason))
 }
 
 /// Stage indices, every stage after its inputs; a cycle is an error naming its path.

@@ -17,6 +17,9 @@ use serde_json::json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::grid::Axis;
+use crate::kind::{Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
+use crate::sweep::Sweep;
 use crate::table::{f64_column, str_column, Columns};
 use crate::Output;
 
@@ -290,4 +293,37 @@ fn maximize(picks: &[Pick], axes: &[Axis], m: &Maximize) -> Vec<Pick> {
         }
     }
     order.into_iter().filter_map(|g| best.remove(&g)).collect()
+}
+
+impl Kind for Reduce {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        let [input] = stage.inputs.as_slice() else {
+            return Err((
+                "inputs".into(),
+                "a reduce stage reads exactly one sweep".into(),
+            ));
+        };
+        match inputs.get::<Sweep>(input) {
+            Some(sweep) => self
+                .check_axes(&sweep.axes)
+                .map_err(|reason| ("maximize.over".to_string(), reason)),
+            None => Err((
+                "inputs[0]".into(),
+                format!(
+                    "`{input}` is a {} stage; a reduce reads a sweep",
+                    inputs.kind_of(input)
+                ),
+            )),
+        }
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let input = &ctx.stage.inputs[0];
+        let frame = ctx.input(input)?;
+        let axes = ctx
+            .pipeline
+            .sweep_axes(input)
+            .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?;
+        self.run(ctx.name(), &frame, axes)
+    }
 }

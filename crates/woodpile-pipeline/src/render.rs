@@ -57,7 +57,9 @@ use woodpile_plot::{
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::kind::{Context, Inputs, Kind, KindCheck};
 use crate::manifest::Manifest;
+use crate::stage::Stage;
 use crate::table::{f64_column, matching_rows, str_column, Columns};
 use crate::Output;
 
@@ -806,5 +808,41 @@ impl PanelSpec {
             marks: self.marks.clone(),
             view: self.view,
         })
+    }
+}
+
+impl Kind for Render {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        if stage.inputs.is_empty() {
+            return Err((
+                "inputs".into(),
+                "a render stage reads one or more tables".into(),
+            ));
+        }
+        match stage
+            .inputs
+            .iter()
+            .position(|i| inputs.get::<Render>(i).is_some())
+        {
+            Some(k) => Err((
+                format!("inputs[{k}]"),
+                format!("`{}` is a render stage: read a data table", stage.inputs[k]),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let inputs = ctx
+            .stage
+            .inputs
+            .iter()
+            .map(|name| Ok((name.clone(), ctx.input_with_manifest(name)?)))
+            .collect::<Result<_>>()?;
+        self.run(ctx.name(), &inputs, ctx.figures)
+    }
+
+    fn files(&self, stage: &str, _: &Path, figures: &Path) -> Vec<PathBuf> {
+        Render::files(figures, stage).to_vec()
     }
 }

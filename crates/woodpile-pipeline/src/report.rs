@@ -40,6 +40,8 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::kind::{Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
 use crate::status::output_path;
 use crate::table::{self, f64_column, matching_rows, str_column, Columns};
 use crate::Output;
@@ -918,6 +920,34 @@ impl Rows {
             .f64("sensitivity", self.sensitivity)
             .str("failure", self.failure);
         c
+    }
+}
+
+impl Kind for Report {
+    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
+        if stage.inputs.is_empty() {
+            return Err((
+                "inputs".into(),
+                "a report reads the stages its quotes name".into(),
+            ));
+        }
+        for (key, source) in self.sources() {
+            if !stage.inputs.contains(&source.stage) {
+                return Err((
+                    key,
+                    format!("`{}` is not among this stage's inputs", source.stage),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name(), ctx.results)
+    }
+
+    fn files(&self, _: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
+        vec![self.markdown_path(results)]
     }
 }
 

@@ -8,13 +8,15 @@ use crate::atomic;
 use crate::canonical::code_version;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
+use crate::kind::Context;
 use crate::lock::lock_results;
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
 use crate::points::PointStore;
-use crate::stage::{Spec, Stage};
+use crate::stage::Stage;
 use crate::status::{output_path, state, State};
 use crate::sweep::points_dir;
+use crate::sweep::Sweep;
 use crate::table;
 
 /// How to run.
@@ -117,9 +119,9 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
             }
             (other, _) => format!("{}: {}", other.label(), other.why()),
         };
-        let points = match &stage.spec {
-            Spec::Sweep(sweep) => Some((sweep.count(), sweep.cached(&store)?)),
-            _ => None,
+        let points = match stage.get::<Sweep>() {
+            Some(sweep) => Some((sweep.count(), sweep.cached(&store)?)),
+            None => None,
         };
         steps.push(Step {
             stage: stage.name.clone(),
@@ -167,56 +169,14 @@ fn execute(
     events: &dyn Events,
 ) -> Result<(String, Vec<String>)> {
     let results = &options.results;
-    let output = match &stage.spec {
-        Spec::Sweep(sweep) => sweep.run(&stage.name, store, events)?,
-        Spec::SpaceTime(field) => field.run(&stage.name, results)?,
-        Spec::Reduce(reduce) => {
-            let input = &stage.inputs[0];
-            let path = output_path(results, input);
-            let frame = table::read(&path)?;
-            let axes = pipeline.sweep_axes(input).ok_or_else(|| {
-                PipelineError::stage(&stage.name, format!("`{input}` is not a sweep"))
-            })?;
-            reduce.run(&stage.name, &frame, axes)?
-        }
-        Spec::Optimize(optimize) => {
-            let input = &stage.inputs[0];
-            let frame = table::read(&output_path(results, input))?;
-            let sweep = pipeline
-                .stage(input)?
-                .inputs
-                .first()
-                .and_then(|s| pipeline.sweep(s))
-                .ok_or_else(|| {
-                    PipelineError::stage(&stage.name, format!("`{input}` does not read a sweep"))
-                })?;
-            optimize.run(&stage.name, &frame, sweep)?
-        }
-        Spec::Fit(fit) => {
-            let frame = table::read(&output_path(results, &stage.inputs[0]))?;
-            fit.run(&stage.name, &frame)?
-        }
-        Spec::Approximate(approximate) => {
-            let fits = table::read(&output_path(results, &stage.inputs[0]))?;
-            let data = table::read(&output_path(results, &stage.inputs[1]))?;
-            approximate.run(&stage.name, &fits, &data)?
-        }
-        Spec::Render(render) => {
-            let inputs = stage
-                .inputs
-                .iter()
-                .map(|name| {
-                    let table = table::read_with_manifest(&output_path(results, name))?;
-                    Ok((name.clone(), table))
-                })
-                .collect::<Result<_>>()?;
-            render.run(&stage.name, &inputs, &options.figures)?
-        }
-        Spec::Report(report) => report.run(&stage.name, results)?,
-        Spec::WorkPrecision(wp) => wp.run(&stage.name)?,
-        Spec::Stability(map) => map.run(&stage.name)?,
-        Spec::Design(design) => design.run(&stage.name, store, results, events)?,
-    };
+    let output = stage.spec.run(&Context {
+        stage,
+        pipeline,
+        results,
+        figures: &options.figures,
+        store,
+        events,
+    })?;
     let manifest = manifest_for(pipeline, stage, output.summary.clone());
     let rows = output.frame.height();
     table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
@@ -236,7 +196,7 @@ pub(crate) fn manifest_for(
 ) -> Manifest {
     Manifest {
         stage: stage.name.clone(),
-        kind: stage.spec.kind().to_string(),
+        kind: stage.kind.to_string(),
         key: pipeline.key(&stage.name).to_string(),
         code_version: code_version(),
         params: stage.params.clone(),

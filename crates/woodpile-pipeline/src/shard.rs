@@ -19,7 +19,7 @@ use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
 use crate::points::PointStore;
 use crate::run::manifest_for;
-use crate::stage::{Spec, Stage};
+use crate::stage::Stage;
 use crate::status::output_path;
 use crate::sweep::{points_dir, Sweep, SweepStats};
 use crate::table::{self, f64_column};
@@ -117,13 +117,13 @@ fn parse_part_name(name: &str) -> Option<(String, Shard)> {
 
 fn sweep_of<'p>(pipeline: &'p Pipeline, name: &str) -> Result<(&'p Stage, &'p Sweep)> {
     let stage = pipeline.stage(name)?;
-    match &stage.spec {
-        Spec::Sweep(sweep) => Ok((stage, sweep)),
-        other => Err(PipelineError::stage(
+    match stage.get::<Sweep>() {
+        Some(sweep) => Ok((stage, sweep)),
+        None => Err(PipelineError::stage(
             name,
             format!(
                 "only sweeps are sharded; `{name}` is a {} stage (run it after `woodpile merge`)",
-                other.kind()
+                stage.kind
             ),
         )),
     }

@@ -34,6 +34,8 @@ use woodpile_sim::run::simulate;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::grid::{Axis, AxisValue};
+use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
 use crate::sweep::Sweep;
 use crate::table::Columns;
 use crate::Output;
@@ -186,5 +188,28 @@ fn field_sites(f: &mut Fields<'_>) -> Result<Option<[i64; 2]>> {
                 _ => Err(f.error("sites", "expected [lo, hi] paper sites with lo <= hi")),
             }
         }
+    }
+}
+
+impl Kind for SpaceTime {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        let Source::Design(design) = &self.source else {
+            return no_inputs(stage);
+        };
+        match stage.inputs.as_slice() {
+            [input] if input == design && inputs.get::<crate::design::Design>(input).is_some() => {
+                Ok(())
+            }
+            _ => Err((
+                "inputs".into(),
+                format!(
+                    "a spacetime stage of `design = \"{design}\"` reads exactly that design stage"
+                ),
+            )),
+        }
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name(), ctx.results)
     }
 }

@@ -35,6 +35,8 @@ use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
 use crate::table::Columns;
 use crate::Output;
 
@@ -353,4 +355,14 @@ struct Run {
     status: i64,
     error: Option<f64>,
     failure: Option<String>,
+}
+
+impl Kind for Stability {
+    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
+        no_inputs(stage)
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name())
+    }
 }

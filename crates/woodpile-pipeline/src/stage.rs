@@ -2,7 +2,7 @@
 //! the file stem). Top-level keys common to every kind:
 //!
 //! ```toml
-//! kind = "sweep"               # one of KINDS (docs/stage-kinds.md lists each with its keys)
+//! kind = "sweep"               # one of the kinds below
 //! description = "F4: ..."      # free text, not part of the cache key
 //! inputs = ["f4_sweep"]        # upstream stages (by file name), read by this one
 //! ```
@@ -11,85 +11,14 @@
 //! are errors naming the file and key.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use serde_json::Value;
 
-use crate::approximate::Approximate;
 use crate::canonical::toml_to_json;
-use crate::design::Design;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::fit::FitStage;
-use crate::optimize::Optimize;
-use crate::reduce::Reduce;
-use crate::render::Render;
-use crate::report::Report;
-use crate::spacetime::SpaceTime;
-use crate::stability::Stability;
-use crate::sweep::Sweep;
-use crate::workprecision::WorkPrecision;
-
-/// The kinds of stage, in pipeline order; each is documented by its module (`src/<kind>.rs`),
-/// from which `docs/stage-kinds.md` is generated (and tested current).
-pub const KINDS: &[&str] = &[
-    "sweep",
-    "spacetime",
-    "reduce",
-    "optimize",
-    "fit",
-    "approximate",
-    "render",
-    "report",
-    "workprecision",
-    "stability",
-    "design",
-];
-
-/// What a stage does, with its kind-specific parameters.
-#[derive(Debug, Clone)]
-pub enum Spec {
-    /// Simulate a grid of scenes; output their fraction time series.
-    Sweep(Sweep),
-    /// Record site velocities over time for a few scenes.
-    SpaceTime(SpaceTime),
-    /// Read the fractions of a sweep at a time, optionally maximised over axes.
-    Reduce(Reduce),
-    /// Refine a grid maximum with a continuous search.
-    Optimize(Optimize),
-    /// Fit the paper's forms to columns of a table.
-    Fit(FitStage),
-    /// The product approximation of two-defect trapping from single-defect fits.
-    Approximate(Approximate),
-    /// Draw a table as a figure.
-    Render(Render),
-    /// The reproduction report: the paper's numbers against ours.
-    Report(Report),
-    /// Speed against accuracy for every method on a few scenes.
-    WorkPrecision(WorkPrecision),
-    /// Where each fixed-step method blows up or misses the tolerance.
-    Stability(Stability),
-    /// Search resonator layouts for the best trap (inverse design).
-    Design(Design),
-}
-
-impl Spec {
-    /// The kind's name.
-    pub fn kind(&self) -> &'static str {
-        match self {
-            Spec::Sweep(_) => "sweep",
-            Spec::SpaceTime(_) => "spacetime",
-            Spec::Reduce(_) => "reduce",
-            Spec::Optimize(_) => "optimize",
-            Spec::Fit(_) => "fit",
-            Spec::Approximate(_) => "approximate",
-            Spec::Render(_) => "render",
-            Spec::Report(_) => "report",
-            Spec::WorkPrecision(_) => "workprecision",
-            Spec::Stability(_) => "stability",
-            Spec::Design(_) => "design",
-        }
-    }
-}
+use crate::kind::{Kind, KINDS};
 
 /// A parsed stage file.
 #[derive(Debug, Clone)]
@@ -102,8 +31,10 @@ pub struct Stage {
     pub description: String,
     /// Upstream stages, in the order given.
     pub inputs: Vec<String>,
-    /// What it does.
-    pub spec: Spec,
+    /// Its kind's name (one of [`crate::kind::names`]).
+    pub kind: &'static str,
+    /// What it does: the kind's parameters and behaviour.
+    pub spec: Arc<dyn Kind>,
     /// The file's content without `description`, as canonical JSON: what the key hashes.
     pub params: Value,
 }
@@ -133,34 +64,30 @@ impl Stage {
         let kind: String = fields.required("kind")?;
         let description: String = fields.optional("description")?.unwrap_or_default();
         let inputs: Vec<String> = fields.optional("inputs")?.unwrap_or_default();
-        let spec = match kind.as_str() {
-            "sweep" => Spec::Sweep(Sweep::parse(&mut fields)?),
-            "spacetime" => Spec::SpaceTime(SpaceTime::parse(&mut fields)?),
-            "reduce" => Spec::Reduce(Reduce::parse(&mut fields)?),
-            "optimize" => Spec::Optimize(Optimize::parse(&mut fields)?),
-            "fit" => Spec::Fit(FitStage::parse(&mut fields)?),
-            "approximate" => Spec::Approximate(Approximate::parse(&mut fields)?),
-            "render" => Spec::Render(Render::parse(&mut fields, &inputs)?),
-            "report" => Spec::Report(Report::parse(&mut fields)?),
-            "workprecision" => Spec::WorkPrecision(WorkPrecision::parse(&mut fields)?),
-            "stability" => Spec::Stability(Stability::parse(&mut fields)?),
-            "design" => Spec::Design(Design::parse(&mut fields)?),
-            other => {
-                return Err(fields.error(
-                    "kind",
-                    format!("unknown kind `{other}` (kinds: {})", KINDS.join(", ")),
-                ))
-            }
+        let Some(&(kind, parse)) = KINDS.iter().find(|(name, _)| *name == kind) else {
+            let names: Vec<&str> = crate::kind::names().collect();
+            return Err(fields.error(
+                "kind",
+                format!("unknown kind `{kind}` (kinds: {})", names.join(", ")),
+            ));
         };
+        let spec = parse(&mut fields, &inputs)?;
         fields.finish()?;
         Ok(Stage {
             name,
             file: file.to_path_buf(),
             description,
             inputs,
+            kind,
             spec,
             params,
         })
+    }
+
+    /// The stage's parameters as kind `K`, if it is one.
+    pub fn get<K: Kind>(&self) -> Option<&K> {
+        let any: &dyn std::any::Any = self.spec.as_ref();
+        any.downcast_ref::<K>()
     }
 }
 

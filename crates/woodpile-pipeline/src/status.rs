@@ -5,8 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::canonical::{changed_paths, code_version};
 use crate::pipeline::Pipeline;
-use crate::render::Render;
-use crate::stage::{Spec, Stage};
+use crate::stage::Stage;
 use crate::table::{self, Integrity};
 
 /// Freshness of one stage output.
@@ -76,27 +75,15 @@ pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage)
     };
     let key = pipeline.key(&stage.name);
     if stored.key == key.as_str() {
-        if let Spec::Render(_) = stage.spec {
-            let missing: Vec<String> = Render::files(figures, &stage.name)
-                .iter()
-                .filter(|f| !f.exists())
-                .map(|f| format!("figure {} missing", f.display()))
-                .collect();
-            if !missing.is_empty() {
-                return State::Stale(missing);
-            }
-        }
-        if let Spec::Design(_) = &stage.spec {
-            let best = crate::design::best_path(results, &stage.name);
-            if !best.exists() {
-                return State::Stale(vec![format!("{} missing", best.display())]);
-            }
-        }
-        if let Spec::Report(report) = &stage.spec {
-            let markdown = report.markdown_path(results);
-            if !markdown.exists() {
-                return State::Stale(vec![format!("{} missing", markdown.display())]);
-            }
+        let missing: Vec<String> = stage
+            .spec
+            .files(&stage.name, results, figures)
+            .iter()
+            .filter(|f| !f.exists())
+            .map(|f| format!("{} missing", f.display()))
+            .collect();
+        if !missing.is_empty() {
+            return State::Stale(missing);
         }
         return State::Fresh;
     }

@@ -38,7 +38,9 @@ use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::fields::Fields;
 use crate::grid::{parse_axes, point, point_count, Axis, AxisValue};
+use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
 use crate::points::{simulate_point, PointResult, PointStore, Series};
+use crate::stage::Stage;
 use crate::table::Columns;
 use crate::template::Template;
 use crate::Output;
@@ -485,4 +487,14 @@ impl RowColumns {
 /// The directory a results tree keeps its point cache in.
 pub fn points_dir(results: &Path) -> PathBuf {
     results.join("points")
+}
+
+impl Kind for Sweep {
+    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
+        no_inputs(stage)
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name(), ctx.store, ctx.events)
+    }
 }

@@ -36,6 +36,8 @@ use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
+use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use crate::stage::Stage;
 use crate::table::Columns;
 use crate::Output;
 
@@ -345,5 +347,15 @@ impl Rows {
             .f64("log10_wall_ms", self.log10_wall_ms)
             .str("failure", self.failure);
         c
+    }
+}
+
+impl Kind for WorkPrecision {
+    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
+        no_inputs(stage)
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name())
     }
 }

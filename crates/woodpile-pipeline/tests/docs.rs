@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use woodpile_pipeline::stage::KINDS;
+use woodpile_pipeline::kind;
 
 fn module_doc(path: &Path) -> String {
     let text = std::fs::read_to_string(path).unwrap();
@@ -30,7 +30,7 @@ fn generated() -> String {
     );
     out.push_str(&module_doc(&src.join("stage.rs")));
     out.push('\n');
-    for kind in KINDS {
+    for kind in kind::names() {
         out.push_str(&format!("\n## `{kind}`\n\n"));
         out.push_str(&module_doc(&src.join(format!("{kind}.rs"))));
         out.push('\n');

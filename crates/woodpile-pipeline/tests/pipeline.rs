@@ -252,10 +252,11 @@ fn an_interrupted_sweep_resumes_without_repeating_finished_points() {
     std::fs::remove_file(p.output("sweep")).unwrap();
     let store = PointStore::new(points_dir(&p.results));
     let pipeline = p.load();
-    let woodpile_pipeline::stage::Spec::Sweep(sweep) = &pipeline.stage("sweep").unwrap().spec
-    else {
-        panic!()
-    };
+    let sweep = pipeline
+        .stage("sweep")
+        .unwrap()
+        .get::<woodpile_pipeline::sweep::Sweep>()
+        .unwrap();
     let points = sweep.points().unwrap();
     std::fs::remove_file(store.path(&points[1].0)).unwrap();
     std::fs::remove_file(store.path(&points[4].0)).unwrap();
@@ -1508,4 +1509,14 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
     // A missing best design makes the stage stale.
     std::fs::remove_file(&best).unwrap();
     assert!(matches!(p.state("trap"), State::Stale(_)));
+}
+
+/// The kinds are listed once: the unknown-kind error names every one of them.
+#[test]
+fn an_unknown_kind_lists_every_kind() {
+    let e = load_error(&[("x", "kind = \"plot\"")]);
+    for kind in woodpile_pipeline::kind::names() {
+        assert!(e.contains(kind), "{kind} missing from: {e}");
+    }
+    assert!(woodpile_pipeline::kind::names().any(|k| k == "design"));
 }
