@@ -34,12 +34,13 @@ pub enum PipelineError {
         known: String,
     },
     /// A file could not be read or written.
-    #[error("{path}: {reason}")]
+    #[error("{path}: {source}")]
     Io {
         /// The file.
         path: PathBuf,
-        /// What went wrong.
-        reason: String,
+        /// What went wrong: the underlying error (the OS's, polars', ...), kept as the source.
+        #[source]
+        source: BoxError,
     },
     /// The run finished what it could, but stages failed (or failed in part, or were skipped
     /// because an input failed): each named with its reason.
@@ -60,11 +61,11 @@ pub enum PipelineError {
 }
 
 impl PipelineError {
-    /// An IO error on `path`.
-    pub fn io(path: impl Into<PathBuf>, e: impl std::fmt::Display) -> Self {
+    /// An IO error on `path`, keeping `e` as its source.
+    pub fn io(path: impl Into<PathBuf>, e: impl Into<BoxError>) -> Self {
         Self::Io {
             path: path.into(),
-            reason: e.to_string(),
+            source: e.into(),
         }
     }
 
@@ -93,6 +94,9 @@ impl PipelineError {
         }
     }
 }
+
+/// Any error, as a source.
+pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
 /// Result alias of this crate.
 pub type Result<T, E = PipelineError> = std::result::Result<T, E>;
