@@ -1,6 +1,6 @@
 //! `method = "auto"` against a tight reference, on one scene of each of the paper's kinds or,
-//! with `--survey N`, on N scenes of each sweep kind drawn from the sweeps' grids
-//! ([`sampled_sweep_scenes`]): the step auto accepted, its Richardson estimate, the true error
+//! with `--survey N`, on N scenes of each sweep kind drawn from the stage files' grids
+//! (`woodpile_pipeline::sampling`, run from the repository's root): the step auto accepted, its Richardson estimate, the true error
 //! (largest over R, T and E_tr), whether it met the tolerance, the force evaluations of the whole
 //! verification ladder, and the wall time. The reference is `rk4-contact` at dt = 0.001
 //! (0.00025 for nonlinear resonators), which agrees with RK4 at 0.001 and Yoshida-6 at 5e-4 to
@@ -13,13 +13,16 @@
 
 use std::time::Instant;
 use woodpile_bench::on_two_cores;
+use woodpile_pipeline::sampling::sampled_sweep_scenes;
+use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::run::simulate;
+use woodpile_sim::run::Scenario;
 use woodpile_sim::testing::{
-    paper_scene, reference_dt, reference_fractions, sampled_sweep_scenes, tolerance, PaperDefect,
+    paper_scene, reference_dt, reference_fractions, tolerance, PaperDefect,
 };
 
-fn hand_picked() -> Vec<(String, Vec<PaperDefect>)> {
+fn hand_picked() -> Vec<(String, Scenario)> {
     let pd = |site, eps, p| PaperDefect {
         p,
         ..PaperDefect::linear(site, eps, 1.0)
@@ -49,6 +52,9 @@ fn hand_picked() -> Vec<(String, Vec<PaperDefect>)> {
         ("F6 p=3 eps=0.16".into(), vec![pd(0, 0.16, 3)]),
         ("F6 p=19 eps=0.01".into(), vec![pd(0, 0.01, 19)]),
     ]
+    .into_iter()
+    .map(|(name, d)| (name, paper_scene(&d, MethodChoice::Auto, tolerance(1e-6))))
+    .collect()
 }
 
 /// One auto run against the reference.
@@ -61,8 +67,14 @@ struct Verdict {
 }
 
 /// One scene at every tolerance.
-fn survey_scene(name: &str, d: &[PaperDefect], tols: &[f64]) -> Vec<Verdict> {
-    let scene = |tol| paper_scene(d, MethodChoice::Auto, tolerance(tol));
+fn survey_scene(name: &str, scenario: &Scenario, tols: &[f64]) -> Vec<Verdict> {
+    // Sampled every time unit, as auto was calibrated (the step tiles each sample interval).
+    let scene = |tol| Scenario {
+        method: MethodChoice::Auto,
+        accuracy: tolerance(tol),
+        sample_every: 1.0,
+        ..scenario.clone()
+    };
     let first = scene(tols[0]);
     let reference = reference_fractions(&first, reference_dt(&first.model)).unwrap();
     tols.iter()
@@ -105,7 +117,7 @@ fn main() {
         tols.push(1e-6);
     }
     let scenes = match survey {
-        Some(n) => sampled_sweep_scenes(n),
+        Some(n) => sampled_sweep_scenes(&Pipeline::load("pipeline".as_ref()).unwrap(), n).unwrap(),
         None => hand_picked(),
     };
     let results: Vec<Vec<Verdict>> =

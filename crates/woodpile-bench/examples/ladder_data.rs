@@ -1,5 +1,5 @@
 //! Raw data for designing `auto`'s verification ladder: the fractions of sampled sweep scenes
-//! ([`sampled_sweep_scenes`]) at a geometric ladder of fixed steps (ratio 0.85) for
+//! (`woodpile_pipeline::sampling`, run from the repository's root) at a geometric ladder of fixed steps (ratio 0.85) for
 //! `rk4-contact` and `rkn4-contact`, with the reference (`rk4-contact` at dt = 0.001). CSV on
 //! stdout, the label quoted.
 //!
@@ -9,12 +9,15 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_bench::on_two_cores;
+use woodpile_pipeline::sampling::sampled_sweep_scenes;
+use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::run::simulate;
-use woodpile_sim::testing::{fixed_dt, paper_scene, sampled_sweep_scenes, PaperDefect};
+use woodpile_sim::run::Scenario;
+use woodpile_sim::testing::fixed_dt;
 
-fn scene_rows(i: usize, label: &str, d: &[PaperDefect]) -> Vec<String> {
-    let nonlinear = d.iter().any(|x| x.p > 1);
+fn scene_rows(i: usize, label: &str, scenario: &Scenario) -> Vec<String> {
+    let nonlinear = scenario.model.resonators().iter().any(|r| r.p > 1);
     let mut runs = vec![(Method::Rk4Contact, 0.001, "ref")];
     let mut dt = 0.25;
     while dt >= if nonlinear { 0.0015 } else { 0.004 } {
@@ -25,7 +28,11 @@ fn scene_rows(i: usize, label: &str, d: &[PaperDefect]) -> Vec<String> {
     runs.into_iter()
         .map(|(m, dt, name)| {
             match simulate(
-                &paper_scene(d, MethodChoice::Named(m), fixed_dt(dt)),
+                &Scenario {
+                    method: MethodChoice::Named(m),
+                    accuracy: fixed_dt(dt),
+                    ..scenario.clone()
+                },
                 &mut (),
             ) {
                 Ok(o) => {
@@ -47,9 +54,10 @@ fn scene_rows(i: usize, label: &str, d: &[PaperDefect]) -> Vec<String> {
 
 fn main() {
     let per_kind = std::env::args().nth(1).map_or(10, |s| s.parse().unwrap());
-    let scenes = sampled_sweep_scenes(per_kind);
+    let pipeline = Pipeline::load("pipeline".as_ref()).unwrap();
+    let scenes = sampled_sweep_scenes(&pipeline, per_kind).unwrap();
     println!("scene,label,method,dt,R,T,E_tr,evals");
-    let indexed: Vec<(usize, &(String, Vec<PaperDefect>))> = scenes.iter().enumerate().collect();
+    let indexed: Vec<(usize, &(String, Scenario))> = scenes.iter().enumerate().collect();
     let rows: Vec<String> =
         on_two_cores(&indexed, |(i, (label, d))| scene_rows(*i, label, d)).concat();
     for row in rows {

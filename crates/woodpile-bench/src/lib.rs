@@ -1,6 +1,6 @@
 //! The scene every speed claim is measured on, shared by the divan benchmarks and the
 //! comparison binary: the paper's standard chain (N = 100, fixed walls, impulse at -25, t = 150)
-//! with one linear defect eps = 10, kappa = 1 at site 0, the scene of SPEC §4's C and numba
+//! with one linear defect eps = 10, kappa = 1 at site 0, the scene of the C and numba
 //! timings (`baseline/`).
 
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};

@@ -1,4 +1,4 @@
-//! `woodpile simulate SCENE.toml`: the SPEC §3 contract. One JSON object on stdout, or one error
+//! `woodpile simulate SCENE.toml`: the contract of docs/scene.md. One JSON object on stdout, or one error
 //! on stderr and a non-zero exit.
 
 use std::path::PathBuf;
@@ -38,7 +38,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The JSON object: SPEC §3 keys first, then what makes the number trustworthy and traceable.
+/// The JSON object: the contract's keys first, then what makes the number trustworthy and traceable.
 fn report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
     let f = out.fractions;
     let accuracy = scene.scenario.accuracy;

@@ -1,4 +1,4 @@
-//! `woodpile simulate` through the real binary: the SPEC §3 contract and its error cases
+//! `woodpile simulate` through the real binary: the contract of docs/scene.md and its error cases
 //! (issue 2: unknown key, eps <= 0, even p > 1, defect or impulse off the chain, t_end <= 0,
 //! non-finite value, unreadable file).
 #![allow(clippy::unwrap_used)]

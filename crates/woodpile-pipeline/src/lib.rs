@@ -43,6 +43,8 @@ pub mod reduce;
 pub mod render;
 pub mod report;
 pub mod run;
+#[cfg(feature = "testing")]
+pub mod sampling;
 pub mod shard;
 pub mod slurm;
 pub mod spacetime;

@@ -1,4 +1,4 @@
-//! The scene file of `woodpile simulate` (SPEC §3): TOML in two stages, ripgrep-style.
+//! The scene file of `woodpile simulate` (docs/scene.md): TOML in two stages, ripgrep-style.
 //!
 //! [`raw`] mirrors the file exactly (`deny_unknown_fields`, no defaults applied); [`Scene`] is the
 //! validated, typed result with the paper's defaults filled in and paper site numbers (-n..n)

@@ -13,7 +13,7 @@ use woodpile_sim::SimError;
 
 use crate::raw;
 
-/// Defaults of SPEC §2 ("unless stated").
+/// The paper's defaults ("unless stated").
 const DEFAULT_N: i64 = 100;
 const DEFAULT_IMPULSE_SITE: i64 = -25;
 const DEFAULT_T_END: f64 = 150.0;
@@ -421,7 +421,7 @@ fn reject_present(
     }
 }
 
-/// SPEC §1: the region spans the defects and one neighbour on each side, [min - 1, max + 1]
+/// The paper's region (Eqs. 10 and 11) spans the defects and one neighbour on each side, [min - 1, max + 1]
 /// (adjacent defects 0..L give [-1, L + 1]; separated d1 < d2 give [d1 - 1, d2 + 1]). Without
 /// defects, the single-defect region [-1, 1].
 fn default_region(defects: &[raw::Defect]) -> [i64; 2] {
@@ -483,7 +483,7 @@ mod tests {
         }
     }
 
-    /// Defaults of SPEC §2 and the paper numbering: site n is index n + N.
+    /// The paper's defaults and numbering: site n is index n + N.
     #[test]
     fn defaults_and_numbering() {
         let scene = parse("[[defect]]\nsite = 0\neps = 10.0\n", Path::new("s.toml")).unwrap();

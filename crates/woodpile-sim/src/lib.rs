@@ -25,6 +25,7 @@ pub mod integrate;
 pub mod model;
 pub mod observe;
 pub mod run;
+#[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod units;
 

@@ -1,4 +1,8 @@
-//! Known-answer cases and scene builders shared by tests and benchmarks.
+//! Known-answer cases, fixtures and reference helpers shared by tests, surveys and
+//! benchmarks; compiled only for them (`cfg(test)` or the `testing` feature). The fixtures
+//! are small and explicit (the standard scene below is the one every speed claim uses); scenes
+//! drawn from the paper's grids come from the stage files themselves
+//! (`woodpile_pipeline::sampling`), never from copies of them.
 //!
 //! The known answers are exact: a host–resonator pair is a linear oscillator with
 //! omega^2 = kappa (1/m + 1/eps); a head-on Hertz collision of two equal free beads exchanges
@@ -185,48 +189,4 @@ pub fn reference_fractions(scenario: &Scenario, dt: f64) -> Result<Fractions, Si
         ..scenario.clone()
     };
     Ok(simulate(&reference, &mut ())?.fractions)
-}
-
-/// `per_kind` scenes of each of the paper's sweep kinds (F4, F5, F6, F7 coarse, F7 fine), their
-/// parameters drawn from the sweeps' own grids by a fixed-seed generator: scenes the
-/// calibration did not choose, for surveying a method's or `auto`'s accuracy. Each comes with a
-/// label naming its sweep and parameters.
-pub fn sampled_sweep_scenes(per_kind: usize) -> Vec<(String, Vec<PaperDefect>)> {
-    let linear = |site, eps| PaperDefect::linear(site, eps, 1.0);
-    let mut rng = Lcg(20_261_123);
-    let mut scenes = Vec::with_capacity(5 * per_kind);
-    for _ in 0..per_kind {
-        let l = rng.pick(&[0, 2, 5, 6]);
-        let eps = rng.grid(0.1, 60.0, 0.1);
-        scenes.push((
-            format!("F4 L={l} eps={eps:.1}"),
-            (0..=l).map(|s| linear(s, eps)).collect(),
-        ));
-        let l = rng.pick(&[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]);
-        let eps = rng.grid(0.1, 60.0, 0.1);
-        scenes.push((
-            format!("F5 L={l} eps={eps:.1}"),
-            (0..=l).map(|s| linear(s, eps)).collect(),
-        ));
-        let p = rng.pick(&[3, 5, 7, 9, 11, 13, 15, 17, 19]);
-        let eps = rng.grid(0.01, 0.5, 0.01);
-        scenes.push((
-            format!("F6 p={p} eps={eps:.2}"),
-            vec![PaperDefect {
-                p,
-                ..linear(0, eps)
-            }],
-        ));
-        let (e1, e2) = (rng.grid(1.0, 100.0, 1.0), rng.grid(1.0, 100.0, 1.0));
-        scenes.push((
-            format!("F7 coarse ({e1:.0}, {e2:.0})"),
-            vec![linear(0, e1), linear(20, e2)],
-        ));
-        let (e1, e2) = (rng.grid(0.1, 1.0, 0.01), rng.grid(0.1, 1.0, 0.01));
-        scenes.push((
-            format!("F7 fine ({e1:.2}, {e2:.2})"),
-            vec![linear(0, e1), linear(20, e2)],
-        ));
-    }
-    scenes
 }

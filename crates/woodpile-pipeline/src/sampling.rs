@@ -1,0 +1,47 @@
+//! Scenes drawn from the pipeline's own sweeps by a fixed seed: the scenes of accuracy surveys
+//! and of the tests that `auto` meets its tolerance on scenes no calibration chose. The grids
+//! are read from the stage files, so a survey follows the sweeps as they are defined.
+
+use woodpile_sim::run::Scenario;
+use woodpile_sim::testing::Lcg;
+
+use crate::error::{PipelineError, Result};
+use crate::pipeline::Pipeline;
+
+/// The sweeps a survey draws from, with their labels: one of each kind of the paper's scenes.
+pub const SURVEY_SWEEPS: &[(&str, &str)] = &[
+    ("f4_sweep", "F4"),
+    ("f5_sweep", "F5"),
+    ("f6_sweep", "F6"),
+    ("f7_coarse_sweep", "F7 coarse"),
+    ("f7_fine_sweep", "F7 fine"),
+];
+
+/// `per_sweep` scenes of each of [`SURVEY_SWEEPS`], each axis value drawn uniformly from the
+/// sweep's grid, in rounds (one scene of every sweep per round), labelled by the sweep and the
+/// values. The scenario is the sweep's own (its run settings); callers set the method and
+/// accuracy they survey.
+pub fn sampled_sweep_scenes(
+    pipeline: &Pipeline,
+    per_sweep: usize,
+) -> Result<Vec<(String, Scenario)>> {
+    let mut rng = Lcg(20_261_123);
+    let mut scenes = Vec::with_capacity(per_sweep * SURVEY_SWEEPS.len());
+    for _ in 0..per_sweep {
+        for &(stage, label) in SURVEY_SWEEPS {
+            let sweep = pipeline.sweep(stage).ok_or_else(|| {
+                PipelineError::stage(stage, "a survey draws from this sweep, which is missing")
+            })?;
+            let values: Vec<_> = sweep.axes.iter().map(|a| rng.pick(&a.values)).collect();
+            let named: Vec<String> = sweep
+                .axes
+                .iter()
+                .zip(&values)
+                .map(|(a, v)| format!("{}={v}", a.name))
+                .collect();
+            let scene = sweep.scene_with(&values, None)?;
+            scenes.push((format!("{label} {}", named.join(" ")), scene.scenario));
+        }
+    }
+    Ok(scenes)
+}
