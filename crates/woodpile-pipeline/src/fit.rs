@@ -27,7 +27,7 @@ use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::kind::{Context, Inputs, Kind, KindCheck};
 use crate::stage::Stage;
-use crate::table::{f64_column, matching_rows, Columns};
+use crate::table::{f64_column, matching_rows, rows_frame, Cell, Row};
 use crate::Output;
 use woodpile_analysis::lm::{fit, Fit, Form};
 
@@ -127,7 +127,7 @@ impl FitStage {
         let keep = matching_rows(input, &self.filter)
             .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
         let xs = column(&self.x)?;
-        let mut out = Rows::default();
+        let mut out = Vec::with_capacity(self.models.len());
         let mut failures = Vec::new();
         for m in &self.models {
             let ys = column(&m.y)?;
@@ -137,120 +137,88 @@ impl FitStage {
                 .filter(|(a, b)| a.is_finite() && b.is_finite())
                 .filter(|(a, _)| m.x_range.is_none_or(|[lo, hi]| (lo..=hi).contains(a)))
                 .unzip();
-            let result = match fit(m.form, &x, &y, m.start) {
-                Ok(result) => result,
-                Err(reason) => {
-                    // A fit that fails is a row with its reason, as a failed scene is.
-                    failures.push(format!("model `{}`: {reason}", m.name));
-                    out.push_failure(m, x.len(), reason);
-                    continue;
+            let fitted = fit(m.form, &x, &y, m.start).map(|result| {
+                let paper_error = m.paper.map(|p| {
+                    let ssr: f64 = x
+                        .iter()
+                        .zip(&y)
+                        .map(|(&a, &b)| (m.form.eval(p, a) - b).powi(2))
+                        .sum();
+                    ssr.sqrt() / y.iter().map(|v| v * v).sum::<f64>().sqrt()
+                });
+                let span = |pick: fn(f64, f64) -> f64| x.iter().copied().reduce(pick);
+                Fitted {
+                    fit: result,
+                    x_range: (span(f64::min), span(f64::max)),
+                    paper_error,
                 }
-            };
-            let paper_error = m.paper.map(|p| {
-                let ssr: f64 = x
-                    .iter()
-                    .zip(&y)
-                    .map(|(&a, &b)| (m.form.eval(p, a) - b).powi(2))
-                    .sum();
-                ssr.sqrt() / y.iter().map(|v| v * v).sum::<f64>().sqrt()
             });
-            let span = |pick: fn(f64, f64) -> f64| x.iter().copied().reduce(pick);
-            out.push(
-                m,
-                &result,
-                (span(f64::min), span(f64::max)),
-                x.len(),
-                paper_error,
-            );
+            // A fit that fails is a row with its reason, as a failed scene is.
+            if let Err(reason) = &fitted {
+                failures.push(format!("model `{}`: {reason}", m.name));
+            }
+            out.push(ModelRow {
+                model: m,
+                n: x.len(),
+                fitted,
+            });
         }
-        let rows = out.name.len();
+        let rows = out.len();
         Ok(Output {
-            frame: out.into_columns().into_frame()?,
+            frame: rows_frame(&out)?,
             summary: json!({"models": rows, "rows_used": keep.len(), "failed": failures.len()}),
             failures,
         })
     }
 }
 
-#[derive(Default)]
-struct Rows {
-    name: Vec<Option<String>>,
-    form: Vec<Option<String>>,
-    y: Vec<Option<String>>,
-    params: [Vec<Option<f64>>; 3],
-    errors: [Vec<Option<f64>>; 3],
-    relative_error: Vec<Option<f64>>,
-    x_min: Vec<Option<f64>>,
-    x_max: Vec<Option<f64>>,
-    n: Vec<Option<i64>>,
-    iterations: Vec<Option<i64>>,
-    paper: [Vec<Option<f64>>; 3],
-    paper_relative_error: Vec<Option<f64>>,
-    failure: Vec<Option<String>>,
+/// What fitting one model gave.
+struct Fitted {
+    fit: Fit,
+    /// The x range of the points used.
+    x_range: (Option<f64>, Option<f64>),
+    /// The paper's coefficients' relative error on the same points.
+    paper_error: Option<f64>,
 }
 
-impl Rows {
-    fn push(
-        &mut self,
-        m: &Model,
-        f: &Fit,
-        (x_min, x_max): (Option<f64>, Option<f64>),
-        n: usize,
-        paper_error: Option<f64>,
-    ) {
-        self.x_min.push(x_min);
-        self.x_max.push(x_max);
-        self.name.push(Some(m.name.clone()));
-        self.form.push(Some(m.form.name().to_string()));
-        self.y.push(Some(m.y.clone()));
-        for k in 0..3 {
-            self.params[k].push(Some(f.params[k]));
-            self.errors[k].push(Some(f.std_errors[k]));
-            self.paper[k].push(m.paper.map(|p| p[k]));
-        }
-        self.relative_error.push(Some(f.relative_error));
-        self.n.push(Some(n as i64));
-        self.iterations.push(Some(f.iterations as i64));
-        self.paper_relative_error.push(paper_error);
-        self.failure.push(None);
-    }
+/// One output row: a model, the points it used, and its fit or why there is none.
+struct ModelRow<'a> {
+    model: &'a Model,
+    n: usize,
+    fitted: std::result::Result<Fitted, String>,
+}
 
-    /// A model that could not be fitted: its name and inputs, null coefficients, the reason.
-    fn push_failure(&mut self, m: &Model, n: usize, reason: String) {
-        self.name.push(Some(m.name.clone()));
-        self.form.push(Some(m.form.name().to_string()));
-        self.y.push(Some(m.y.clone()));
-        for k in 0..3 {
-            self.params[k].push(None);
-            self.errors[k].push(None);
-            self.paper[k].push(m.paper.map(|p| p[k]));
-        }
-        self.relative_error.push(None);
-        self.x_min.push(None);
-        self.x_max.push(None);
-        self.n.push(Some(n as i64));
-        self.iterations.push(None);
-        self.paper_relative_error.push(None);
-        self.failure.push(Some(reason));
-    }
-
-    fn into_columns(self) -> Columns {
-        let mut c = Columns::new();
-        c.str("model", self.name)
-            .str("form", self.form)
-            .str("y", self.y);
-        let [a, b, cc] = self.params;
-        let [sa, sb, sc] = self.errors;
-        let [pa, pb, pc] = self.paper;
-        c.f64("A", a).f64("B", b).f64("C", cc);
-        c.f64("se_A", sa).f64("se_B", sb).f64("se_C", sc);
-        c.f64("relative_error", self.relative_error);
-        c.f64("x_min", self.x_min).f64("x_max", self.x_max);
-        c.i64("n", self.n).i64("iterations", self.iterations);
-        c.f64("paper_A", pa).f64("paper_B", pb).f64("paper_C", pc);
-        c.f64("paper_relative_error", self.paper_relative_error);
-        c.str("failure", self.failure);
-        c
+impl Row for ModelRow<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let m = self.model;
+        let ok = self.fitted.as_ref().ok();
+        let param = |k: usize| ok.map(|f| f.fit.params[k]);
+        let error = |k: usize| ok.map(|f| f.fit.std_errors[k]);
+        let paper = |k: usize| m.paper.map(|p| p[k]);
+        vec![
+            ("model", m.name.clone().into()),
+            ("form", m.form.name().into()),
+            ("y", m.y.clone().into()),
+            ("A", param(0).into()),
+            ("B", param(1).into()),
+            ("C", param(2).into()),
+            ("se_A", error(0).into()),
+            ("se_B", error(1).into()),
+            ("se_C", error(2).into()),
+            ("relative_error", ok.map(|f| f.fit.relative_error).into()),
+            ("x_min", ok.and_then(|f| f.x_range.0).into()),
+            ("x_max", ok.and_then(|f| f.x_range.1).into()),
+            ("n", Cell::from(self.n as i64)),
+            ("iterations", ok.map(|f| f.fit.iterations as i64).into()),
+            ("paper_A", paper(0).into()),
+            ("paper_B", paper(1).into()),
+            ("paper_C", paper(2).into()),
+            (
+                "paper_relative_error",
+                ok.and_then(|f| f.paper_error).into(),
+            ),
+            ("failure", self.fitted.as_ref().err().cloned().into()),
+        ]
     }
 }
 

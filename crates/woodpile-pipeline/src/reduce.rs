@@ -20,7 +20,7 @@ use crate::grid::Axis;
 use crate::kind::{Context, Inputs, Kind, KindCheck};
 use crate::stage::Stage;
 use crate::sweep::Sweep;
-use crate::table::{f64_column, str_column, Columns};
+use crate::table::{f64_column, rows_frame, str_column, Cell, Row as TableRow};
 use crate::Output;
 
 /// Columns a maximisation may target.
@@ -97,41 +97,53 @@ impl Reduce {
             None => picks,
             Some(m) => maximize(&picks, axes, m),
         };
-        let mut columns = Columns::new();
-        for (k, axis) in axes.iter().enumerate() {
-            let values = rows.iter().map(|p| Some(p.axes[k]));
-            if axis.is_integer() {
-                columns.i64(&axis.name, values.map(|v| v.map(|x| x as i64)).collect());
-            } else {
-                columns.f64(&axis.name, values.collect());
-            }
-        }
-        let col = |f: fn(&Pick) -> Option<f64>| rows.iter().map(f).collect::<Vec<_>>();
-        columns
-            .f64("t", col(|p| p.row.map(|r| r.t)))
-            .f64("R", col(|p| p.row.map(|r| r.r)))
-            .f64("T", col(|p| p.row.map(|r| r.tr)))
-            .f64("E_tr", col(|p| p.row.map(|r| r.e_tr)))
-            .f64("E", col(|p| p.row.map(|r| r.e)))
-            .f64(
-                "error_estimate",
-                col(|p| p.row.and_then(|r| r.error_estimate)),
-            )
-            .i64(
-                "points",
-                rows.iter().map(|p| Some(p.points as i64)).collect(),
-            )
-            .i64(
-                "failed",
-                rows.iter().map(|p| Some(p.failed as i64)).collect(),
-            )
-            .str("failure", rows.iter().map(|p| p.failure.clone()).collect());
+        let reduced: Vec<Reduced> = rows.iter().map(|pick| Reduced { axes, pick }).collect();
         let failed: usize = rows.iter().map(|p| p.failed).sum();
         Ok(Output {
             failures: Vec::new(),
-            frame: columns.into_frame()?,
+            frame: rows_frame(&reduced)?,
             summary: json!({"rows": rows.len(), "failed_points": failed, "at": self.at}),
         })
+    }
+}
+
+/// An output row: a point (or the best of a group) read out at the time.
+struct Reduced<'a> {
+    axes: &'a [Axis],
+    pick: &'a Pick,
+}
+
+impl TableRow for Reduced<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let p = self.pick;
+        let mut cells: Vec<(&str, Cell)> = self
+            .axes
+            .iter()
+            .zip(&p.axes)
+            .map(|(axis, &v)| {
+                let cell = match axis.is_integer() {
+                    true => Cell::from(v as i64),
+                    false => Cell::from(v),
+                };
+                (axis.name.as_str(), cell)
+            })
+            .collect();
+        let at = |f: fn(&Row) -> f64| p.row.as_ref().map(f);
+        cells.extend([
+            ("t", at(|r| r.t).into()),
+            ("R", at(|r| r.r).into()),
+            ("T", at(|r| r.tr).into()),
+            ("E_tr", at(|r| r.e_tr).into()),
+            ("E", at(|r| r.e).into()),
+            (
+                "error_estimate",
+                p.row.and_then(|r| r.error_estimate).into(),
+            ),
+            ("points", Cell::from(p.points as i64)),
+            ("failed", Cell::from(p.failed as i64)),
+            ("failure", p.failure.clone().into()),
+        ]);
+        cells
     }
 }
 

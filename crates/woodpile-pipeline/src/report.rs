@@ -43,7 +43,7 @@ use crate::fields::Fields;
 use crate::kind::{Context, Inputs, Kind, KindCheck};
 use crate::stage::Stage;
 use crate::status::output_path;
-use crate::table::{self, f64_column, matching_rows, str_column, Columns};
+use crate::table::{self, f64_column, matching_rows, rows_frame, str_column, Cell, Row};
 use crate::Output;
 
 /// A parsed report stage.
@@ -259,7 +259,6 @@ impl Report {
             results,
             frames: HashMap::new(),
         };
-        let mut rows = Rows::default();
         let mut evaluated = Vec::with_capacity(self.quotes.len());
         let mut failures = Vec::new();
         for (i, q) in self.quotes.iter().enumerate() {
@@ -280,10 +279,6 @@ impl Report {
             for (j, c) in q.conventions.iter().enumerate() {
                 let m = read(&c.source, &format!("convention[{j}]"));
                 conventions.push((c.name.clone(), m));
-            }
-            rows.push(q, &format!("as run: {}", q.as_run), &ours);
-            for (name, m) in &conventions {
-                rows.push(q, name, m);
             }
             evaluated.push((ours, conventions));
         }
@@ -306,8 +301,25 @@ impl Report {
                         .any(|(_, m)| reproduces(&q.paper, m) == Some(true))
             })
             .count();
+        let rows: Vec<QuoteRow> = self
+            .quotes
+            .iter()
+            .zip(&evaluated)
+            .flat_map(|(q, (ours, conventions))| {
+                std::iter::once(QuoteRow {
+                    quote: q,
+                    convention: format!("as run: {}", q.as_run),
+                    measured: ours,
+                })
+                .chain(conventions.iter().map(move |(name, m)| QuoteRow {
+                    quote: q,
+                    convention: name.clone(),
+                    measured: m,
+                }))
+            })
+            .collect();
         Ok(Output {
-            frame: rows.into_columns().into_frame()?,
+            frame: rows_frame(&rows)?,
             summary: json!({
                 "quotes": self.quotes.len(),
                 "reproduced_as_run": reproduced,
@@ -857,69 +869,45 @@ fn markdown(report: &Report, evaluated: &[(Measured, Vec<(String, Measured)>)]) 
     out
 }
 
-/// The parquet rows: one per quote and convention.
-#[derive(Default)]
-struct Rows {
-    figure: Vec<Option<String>>,
-    quantity: Vec<Option<String>>,
-    convention: Vec<Option<String>>,
-    paper: Vec<Option<f64>>,
-    paper_text: Vec<Option<String>>,
-    value: Vec<Option<f64>>,
-    location: Vec<Option<String>>,
-    difference: Vec<Option<f64>>,
-    relative_difference: Vec<Option<f64>>,
-    reproduces: Vec<Option<i64>>,
-    scan_column: Vec<Option<String>>,
-    scan_closest: Vec<Option<f64>>,
-    scan_runs: Vec<Option<String>>,
-    sensitivity: Vec<Option<f64>>,
-    failure: Vec<Option<String>>,
+/// A parquet row: one quote under one convention (`as run` or a searched one).
+struct QuoteRow<'a> {
+    quote: &'a Quote,
+    convention: String,
+    measured: &'a Measured,
 }
 
-impl Rows {
-    fn push(&mut self, q: &Quote, convention: &str, m: &Measured) {
+impl Row for QuoteRow<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let (q, m) = (self.quote, self.measured);
         let (diff, rel) = difference(&q.paper, m);
-        self.figure.push(Some(q.figure.clone()));
-        self.quantity.push(Some(q.quantity.clone()));
-        self.convention.push(Some(convention.to_string()));
-        self.paper.push(match q.paper {
-            Paper::Value { value, .. } => Some(value),
-            Paper::Text { .. } => None,
-        });
-        self.paper_text.push(Some(paper_text(&q.paper)));
-        self.value.push(m.failure.is_none().then_some(m.value));
-        self.location
-            .push((!m.location.is_empty()).then(|| m.location.clone()));
-        self.failure.push(m.failure.clone());
-        self.difference.push(diff);
-        self.relative_difference.push(rel);
-        self.reproduces.push(reproduces(&q.paper, m).map(i64::from));
-        self.scan_column
-            .push(m.scan.as_ref().map(|s| s.column.clone()));
-        self.scan_closest.push(m.scan.as_ref().map(|s| s.closest));
-        self.scan_runs.push(m.scan.as_ref().map(runs_text));
-        self.sensitivity.push(m.scan.as_ref().map(|s| s.slope));
-    }
-
-    fn into_columns(self) -> Columns {
-        let mut c = Columns::new();
-        c.str("figure", self.figure)
-            .str("quantity", self.quantity)
-            .str("convention", self.convention)
-            .f64("paper", self.paper)
-            .str("paper_text", self.paper_text)
-            .f64("value", self.value)
-            .str("location", self.location)
-            .f64("difference", self.difference)
-            .f64("relative_difference", self.relative_difference)
-            .i64("reproduces", self.reproduces)
-            .str("scan_column", self.scan_column)
-            .f64("scan_closest", self.scan_closest)
-            .str("scan_within_tolerance", self.scan_runs)
-            .f64("sensitivity", self.sensitivity)
-            .str("failure", self.failure);
-        c
+        let scan = m.scan.as_ref();
+        vec![
+            ("figure", q.figure.clone().into()),
+            ("quantity", q.quantity.clone().into()),
+            ("convention", self.convention.clone().into()),
+            (
+                "paper",
+                match q.paper {
+                    Paper::Value { value, .. } => Some(value),
+                    Paper::Text { .. } => None,
+                }
+                .into(),
+            ),
+            ("paper_text", paper_text(&q.paper).into()),
+            ("value", m.failure.is_none().then_some(m.value).into()),
+            (
+                "location",
+                (!m.location.is_empty()).then(|| m.location.clone()).into(),
+            ),
+            ("difference", diff.into()),
+            ("relative_difference", rel.into()),
+            ("reproduces", reproduces(&q.paper, m).map(i64::from).into()),
+            ("scan_column", scan.map(|s| s.column.clone()).into()),
+            ("scan_closest", scan.map(|s| s.closest).into()),
+            ("scan_within_tolerance", scan.map(runs_text).into()),
+            ("sensitivity", scan.map(|s| s.slope).into()),
+            ("failure", m.failure.clone().into()),
+        ]
     }
 }
 

@@ -39,9 +39,9 @@ use crate::events::Events;
 use crate::fields::Fields;
 use crate::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::points::{simulate_point, PointResult, PointStore, Series};
+use crate::points::{simulate_point, PointData, PointResult, PointStore, Series};
 use crate::stage::Stage;
-use crate::table::Columns;
+use crate::table::{rows_frame, Cell, Row};
 use crate::template::Template;
 use crate::Output;
 
@@ -245,52 +245,34 @@ impl Sweep {
                 stats.failed, stats.points
             ));
         }
-        let frame = self.table(indices, &points, &results)?.into_frame()?;
+        let frame = self.table(indices, &points, &results)?;
         Ok((frame, stats))
     }
 
+    /// The output rows of the points `indices`: one per sample of each point, or one with the
+    /// reason for a point that failed.
     fn table(
         &self,
         indices: &[usize],
         points: &[(Key, Scene)],
         results: &[PointResult],
-    ) -> Result<Columns> {
-        let rows: usize = results
-            .iter()
-            .map(|r| r.as_ref().map_or(1, |p| p.t.len()))
-            .sum();
-        let mut index = Vec::with_capacity(rows);
-        let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::with_capacity(rows); self.axes.len()];
-        let mut c = RowColumns::with_capacity(rows);
+    ) -> Result<DataFrame> {
+        let mut rows = Vec::new();
         for ((&i, (key, _)), result) in indices.iter().zip(points).zip(results) {
             let values = self.values(i);
-            let n = result.as_ref().map_or(1, |p| p.t.len());
-            for _ in 0..n {
-                index.push(Some(i as i64));
-                for (column, v) in axis_values.iter_mut().zip(&values) {
-                    column.push(*v);
-                }
-            }
-            c.push(key, result);
-        }
-        let mut columns = Columns::new();
-        columns.i64("point", index);
-        for (axis, values) in self.axes.iter().zip(axis_values) {
-            if axis.is_integer() {
-                let ints = values.iter().map(|v| match v {
-                    AxisValue::Int(i) => Some(*i),
-                    AxisValue::Float(x) => Some(*x as i64),
+            let samples = result.as_ref().map_or(1, |p| p.t.len());
+            for k in 0..samples {
+                rows.push(SampleRow {
+                    point: i,
+                    axes: &self.axes,
+                    values: values.clone(),
+                    key,
+                    result,
+                    sample: k,
                 });
-                columns.i64(&axis.name, ints.collect());
-            } else {
-                columns.f64(
-                    &axis.name,
-                    values.iter().map(|v| Some(v.as_f64())).collect(),
-                );
             }
         }
-        c.append_to(&mut columns);
-        Ok(columns)
+        rows_frame(&rows)
     }
 
     /// The manifest summary of a whole sweep with statistics `stats`.
@@ -394,93 +376,44 @@ pub fn point_key(scene: &Scene, series: Series) -> Key {
     Key::of(&key)
 }
 
-/// The per-row columns of a sweep output (everything but the point index and the axes).
-struct RowColumns {
-    t: Vec<Option<f64>>,
-    r: Vec<Option<f64>>,
-    tr: Vec<Option<f64>>,
-    e_tr: Vec<Option<f64>>,
-    e: Vec<Option<f64>>,
-    method: Vec<Option<String>>,
-    dt: Vec<Option<f64>>,
-    steps: Vec<Option<i64>>,
-    error_estimate: Vec<Option<f64>>,
-    energy_drift: Vec<Option<f64>>,
-    failure: Vec<Option<String>>,
-    scene_key: Vec<Option<String>>,
+/// One output row: a sample of a point's series, or the one row of a failed point.
+struct SampleRow<'a> {
+    point: usize,
+    axes: &'a [Axis],
+    values: Vec<AxisValue>,
+    key: &'a Key,
+    result: &'a PointResult,
+    sample: usize,
 }
 
-impl RowColumns {
-    fn with_capacity(n: usize) -> Self {
-        Self {
-            t: Vec::with_capacity(n),
-            r: Vec::with_capacity(n),
-            tr: Vec::with_capacity(n),
-            e_tr: Vec::with_capacity(n),
-            e: Vec::with_capacity(n),
-            method: Vec::with_capacity(n),
-            dt: Vec::with_capacity(n),
-            steps: Vec::with_capacity(n),
-            error_estimate: Vec::with_capacity(n),
-            energy_drift: Vec::with_capacity(n),
-            failure: Vec::with_capacity(n),
-            scene_key: Vec::with_capacity(n),
+impl Row for SampleRow<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let mut cells = vec![("point", Cell::from(self.point as i64))];
+        for (axis, value) in self.axes.iter().zip(&self.values) {
+            let cell = match (axis.is_integer(), *value) {
+                (true, AxisValue::Int(i)) => Cell::from(i),
+                (true, AxisValue::Float(x)) => Cell::from(x as i64),
+                (false, v) => Cell::from(v.as_f64()),
+            };
+            cells.push((axis.name.as_str(), cell));
         }
-    }
-
-    fn push(&mut self, key: &Key, result: &PointResult) {
-        match result {
-            Ok(p) => {
-                for k in 0..p.t.len() {
-                    self.t.push(Some(p.t[k]));
-                    self.r.push(Some(p.reflected[k]));
-                    self.tr.push(Some(p.transmitted[k]));
-                    self.e_tr.push(Some(p.trapped[k]));
-                    self.e.push(Some(p.energy[k]));
-                    self.method.push(Some(p.method.clone()));
-                    self.dt.push(p.dt);
-                    self.steps.push(Some(p.steps as i64));
-                    self.error_estimate.push(p.error_estimate);
-                    self.energy_drift.push(p.energy_drift);
-                    self.failure.push(None);
-                    self.scene_key.push(Some(key.to_string()));
-                }
-            }
-            Err(reason) => {
-                for v in [
-                    &mut self.t,
-                    &mut self.r,
-                    &mut self.tr,
-                    &mut self.e_tr,
-                    &mut self.e,
-                ] {
-                    v.push(None);
-                }
-                self.method.push(None);
-                self.dt.push(None);
-                self.steps.push(None);
-                self.error_estimate.push(None);
-                self.energy_drift.push(None);
-                self.failure.push(Some(reason.clone()));
-                self.scene_key.push(Some(key.to_string()));
-            }
-        }
-    }
-
-    fn append_to(self, columns: &mut Columns) {
-        columns
-            .f64("t", self.t)
-            .f64("R", self.r)
-            .f64("T", self.tr)
-            .f64("E_tr", self.e_tr)
-            .f64("E", self.e)
-            .str("method", self.method)
-            .f64("dt", self.dt)
-            .i64("steps", self.steps)
-            .f64("error_estimate", self.error_estimate)
-            .f64("energy_drift", self.energy_drift)
-            .str("failure", self.failure)
-            .str("scene_key", self.scene_key);
+        let ok = self.result.as_ref().ok();
+        let at = |series: fn(&PointData) -> &Vec<f64>| ok.map(|p| series(p)[self.sample]);
+        cells.extend([
+            ("t", at(|p| &p.t).into()),
+            ("R", at(|p| &p.reflected).into()),
+            ("T", at(|p| &p.transmitted).into()),
+            ("E_tr", at(|p| &p.trapped).into()),
+            ("E", at(|p| &p.energy).into()),
+            ("method", ok.map(|p| p.method.clone()).into()),
+            ("dt", ok.and_then(|p| p.dt).into()),
+            ("steps", ok.map(|p| p.steps as i64).into()),
+            ("error_estimate", ok.and_then(|p| p.error_estimate).into()),
+            ("energy_drift", ok.and_then(|p| p.energy_drift).into()),
+            ("failure", self.result.as_ref().err().cloned().into()),
+            ("scene_key", self.key.to_string().into()),
+        ]);
+        cells
     }
 }
 

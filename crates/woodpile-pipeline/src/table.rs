@@ -11,7 +11,8 @@ use crate::atomic;
 use crate::error::{PipelineError, Result};
 use crate::manifest::{Manifest, METADATA_KEY};
 
-/// Columns of a table under construction, in output order.
+/// Columns of a table under construction, in output order: for tables whose columns are
+/// computed whole (a grid, a field); tables built row by row use [`Row`] and [`rows_frame`].
 #[derive(Default)]
 pub struct Columns(Vec<Column>);
 
@@ -44,6 +45,127 @@ impl Columns {
         DataFrame::new_infer_height(self.0)
             .map_err(|e| PipelineError::stage("table", e.to_string()))
     }
+}
+
+/// One cell of an output row.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// A float (or null).
+    F64(Option<f64>),
+    /// An integer (or null).
+    I64(Option<i64>),
+    /// A string (or null).
+    Str(Option<String>),
+}
+
+impl From<f64> for Cell {
+    fn from(x: f64) -> Self {
+        Cell::F64(Some(x))
+    }
+}
+impl From<Option<f64>> for Cell {
+    fn from(x: Option<f64>) -> Self {
+        Cell::F64(x)
+    }
+}
+impl From<i64> for Cell {
+    fn from(x: i64) -> Self {
+        Cell::I64(Some(x))
+    }
+}
+impl From<Option<i64>> for Cell {
+    fn from(x: Option<i64>) -> Self {
+        Cell::I64(x)
+    }
+}
+impl From<String> for Cell {
+    fn from(x: String) -> Self {
+        Cell::Str(Some(x))
+    }
+}
+impl From<&str> for Cell {
+    fn from(x: &str) -> Self {
+        Cell::Str(Some(x.to_string()))
+    }
+}
+impl From<Option<String>> for Cell {
+    fn from(x: Option<String>) -> Self {
+        Cell::Str(x)
+    }
+}
+
+/// A row of an output table: its cells, each under its column's name, in column order. A
+/// kind describes its rows once, as a type, and [`rows_frame`] makes the table.
+pub trait Row {
+    /// The cells of this row.
+    fn cells(&self) -> Vec<(&str, Cell)>;
+}
+
+/// The table of `rows`: one column per cell name, in the first row's order. Every row must
+/// give the same names with the same kinds of cell (an error names the first that does not).
+pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
+    let bad = |reason: String| PipelineError::stage("table", reason);
+    let Some(first) = rows.first() else {
+        return Ok(DataFrame::empty());
+    };
+    let names: Vec<String> = first.cells().iter().map(|(n, _)| n.to_string()).collect();
+    let mut columns: Vec<Vec<Cell>> = vec![Vec::with_capacity(rows.len()); names.len()];
+    for (r, row) in rows.iter().enumerate() {
+        let cells = row.cells();
+        if cells.len() != names.len() {
+            return Err(bad(format!(
+                "row {r} has {} cells, not {}",
+                cells.len(),
+                names.len()
+            )));
+        }
+        for (k, (name, cell)) in cells.into_iter().enumerate() {
+            if name != names[k] {
+                return Err(bad(format!(
+                    "row {r}: column {k} is `{name}`, not `{}`",
+                    names[k]
+                )));
+            }
+            columns[k].push(cell);
+        }
+    }
+    let mut out = Columns::new();
+    for (name, cells) in names.iter().zip(columns) {
+        let mismatch = || bad(format!("column `{name}` mixes kinds of values"));
+        match cells.first() {
+            Some(Cell::F64(_)) | None => out.f64(
+                name,
+                cells
+                    .into_iter()
+                    .map(|c| match c {
+                        Cell::F64(x) => Ok(x),
+                        _ => Err(mismatch()),
+                    })
+                    .collect::<Result<_>>()?,
+            ),
+            Some(Cell::I64(_)) => out.i64(
+                name,
+                cells
+                    .into_iter()
+                    .map(|c| match c {
+                        Cell::I64(x) => Ok(x),
+                        _ => Err(mismatch()),
+                    })
+                    .collect::<Result<_>>()?,
+            ),
+            Some(Cell::Str(_)) => out.str(
+                name,
+                cells
+                    .into_iter()
+                    .map(|c| match c {
+                        Cell::Str(x) => Ok(x),
+                        _ => Err(mismatch()),
+                    })
+                    .collect::<Result<_>>()?,
+            ),
+        };
+    }
+    out.into_frame()
 }
 
 /// Writes `frame` to `path` atomically, with `manifest` in the metadata, sealed: the manifest's

@@ -38,7 +38,7 @@ use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
 use crate::stage::Stage;
-use crate::table::Columns;
+use crate::table::{rows_frame, Cell, Row};
 use crate::Output;
 
 /// A parsed work-precision stage.
@@ -160,7 +160,7 @@ impl WorkPrecision {
     }
 
     pub(crate) fn run(&self, stage: &str) -> Result<Output> {
-        let mut rows = Rows::default();
+        let mut rows = Vec::new();
         let mut references = Vec::new();
         for (index, (name, scene)) in self.scenes.iter().enumerate() {
             let (e_ref, ref_drift) =
@@ -186,14 +186,22 @@ impl WorkPrecision {
                         break;
                     }
                 }
-                if let Some(o) = outcome {
-                    rows.push(index, name, setting, e_ref, best, &o, &scenario);
+                if let Some(outcome) = outcome {
+                    rows.push(Run {
+                        scene: index,
+                        name,
+                        setting,
+                        e_ref,
+                        wall_ms: best,
+                        outcome,
+                        conserves_energy: !scenario.model.is_time_dependent(),
+                    });
                 }
             }
         }
         Ok(Output {
             failures: Vec::new(),
-            frame: rows.into_columns().into_frame()?,
+            frame: rows_frame(&rows)?,
             summary: json!({
                 "reference": {"method": "dop853", "tolerance": self.reference_tolerance},
                 "references": references,
@@ -249,104 +257,49 @@ fn log10_floor(x: f64) -> f64 {
     x.max(1e-16).log10()
 }
 
-#[derive(Default)]
-struct Rows {
-    scene: Vec<Option<i64>>,
-    scene_name: Vec<Option<String>>,
-    method: Vec<Option<String>>,
-    method_index: Vec<Option<i64>>,
-    dt: Vec<Option<f64>>,
-    tolerance: Vec<Option<f64>>,
-    e_tr: Vec<Option<f64>>,
-    error: Vec<Option<f64>>,
-    log10_error: Vec<Option<f64>>,
-    energy_drift: Vec<Option<f64>>,
-    log10_energy_drift: Vec<Option<f64>>,
-    steps: Vec<Option<i64>>,
-    rhs_evals: Vec<Option<i64>>,
-    wall_ms: Vec<Option<f64>>,
-    log10_wall_ms: Vec<Option<f64>>,
-    failure: Vec<Option<String>>,
+/// One run: a scene, a method at a setting, and what it gave (or why it failed).
+struct Run<'a> {
+    scene: usize,
+    name: &'a str,
+    setting: &'a Setting,
+    /// The reference's E_tr.
+    e_ref: f64,
+    /// Best wall time of the repeats.
+    wall_ms: f64,
+    outcome: std::result::Result<Outcome, String>,
+    /// Whether the scene conserves energy (so a drift is measured).
+    conserves_energy: bool,
 }
 
-impl Rows {
-    #[allow(clippy::too_many_arguments)]
-    fn push(
-        &mut self,
-        scene: usize,
-        name: &str,
-        setting: &Setting,
-        e_ref: f64,
-        wall_ms: f64,
-        outcome: &std::result::Result<Outcome, String>,
-        scenario: &woodpile_sim::run::Scenario,
-    ) {
-        self.scene.push(Some(scene as i64));
-        self.scene_name.push(Some(name.to_string()));
-        self.method.push(Some(setting.method.clone()));
-        self.method_index.push(Some(setting.method_index as i64));
-        self.dt.push(setting.accuracy.dt);
-        self.tolerance.push(
-            setting
-                .accuracy
-                .dt
-                .is_none()
-                .then_some(setting.accuracy.tolerance),
-        );
-        match outcome {
-            Ok(o) => {
-                let error = (o.fractions.trapped - e_ref).abs();
-                let drift =
-                    (!scenario.model.is_time_dependent()).then_some(o.stats.max_energy_drift);
-                self.e_tr.push(Some(o.fractions.trapped));
-                self.error.push(Some(error));
-                self.log10_error.push(Some(log10_floor(error)));
-                self.energy_drift.push(drift);
-                self.log10_energy_drift.push(drift.map(log10_floor));
-                self.steps.push(Some(o.stats.steps as i64));
-                self.rhs_evals.push(Some(o.total_rhs_evals as i64));
-                self.wall_ms.push(Some(wall_ms));
-                self.log10_wall_ms.push(Some(wall_ms.log10()));
-                self.failure.push(None);
-            }
-            Err(reason) => {
-                for column in [
-                    &mut self.e_tr,
-                    &mut self.error,
-                    &mut self.log10_error,
-                    &mut self.energy_drift,
-                    &mut self.log10_energy_drift,
-                    &mut self.wall_ms,
-                    &mut self.log10_wall_ms,
-                ] {
-                    column.push(None);
-                }
-                self.steps.push(None);
-                self.rhs_evals.push(None);
-                self.failure.push(Some(reason.clone()));
-            }
-        }
-    }
-
-    fn into_columns(self) -> Columns {
-        let mut c = Columns::new();
-        c.i64("scene", self.scene)
-            .str("scene_name", self.scene_name)
-            .str("method", self.method)
-            .i64("method_index", self.method_index)
-            .f64("dt", self.dt)
-            .f64("tolerance", self.tolerance)
-            .f64("E_tr", self.e_tr)
-            .f64("error", self.error)
-            .f64("log10_error", self.log10_error)
-            .f64("energy_drift", self.energy_drift)
-            .f64("log10_energy_drift", self.log10_energy_drift)
-            .i64("steps", self.steps)
-            .i64("rhs_evals", self.rhs_evals)
-            .f64("wall_ms", self.wall_ms)
-            .f64("log10_wall_ms", self.log10_wall_ms)
-            .str("failure", self.failure);
-        c
+impl Row for Run<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let ok = self.outcome.as_ref().ok();
+        let error = ok.map(|o| (o.fractions.trapped - self.e_ref).abs());
+        let drift = ok
+            .filter(|_| self.conserves_energy)
+            .map(|o| o.stats.max_energy_drift);
+        let accuracy = &self.setting.accuracy;
+        vec![
+            ("scene", Cell::from(self.scene as i64)),
+            ("scene_name", self.name.into()),
+            ("method", self.setting.method.clone().into()),
+            ("method_index", Cell::from(self.setting.method_index as i64)),
+            ("dt", accuracy.dt.into()),
+            (
+                "tolerance",
+                accuracy.dt.is_none().then_some(accuracy.tolerance).into(),
+            ),
+            ("E_tr", ok.map(|o| o.fractions.trapped).into()),
+            ("error", error.into()),
+            ("log10_error", error.map(log10_floor).into()),
+            ("energy_drift", drift.into()),
+            ("log10_energy_drift", drift.map(log10_floor).into()),
+            ("steps", ok.map(|o| o.stats.steps as i64).into()),
+            ("rhs_evals", ok.map(|o| o.total_rhs_evals as i64).into()),
+            ("wall_ms", ok.map(|_| self.wall_ms).into()),
+            ("log10_wall_ms", ok.map(|_| self.wall_ms.log10()).into()),
+            ("failure", self.outcome.as_ref().err().cloned().into()),
+        ]
     }
 }
 
