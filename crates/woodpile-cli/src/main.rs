@@ -128,9 +128,12 @@ fn one_line(error: &anyhow::Error) -> String {
     let mut text = error.to_string();
     for cause in error.chain().skip(1) {
         let cause = cause.to_string();
-        if !text.contains(&cause) {
+        let cause = cause.trim_end();
+        // Said already, whole or as its last part (a scene error under a stage key).
+        let last = cause.rsplit(": ").next().unwrap_or(cause);
+        if !text.contains(cause) && !text.contains(last) {
             text.push_str(": ");
-            text.push_str(&cause);
+            text.push_str(cause);
         }
     }
     text

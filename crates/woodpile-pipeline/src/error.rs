@@ -1,4 +1,6 @@
-//! Everything that can stop the pipeline, each naming the file (and key) it concerns.
+//! Everything that can stop the pipeline, each naming the file (and key) it concerns, and
+//! keeping the error behind it (the OS's, polars', the TOML parser's, an embedded scene's
+//! `SceneError`) as its `source`.
 
 use std::path::{Path, PathBuf};
 
@@ -16,6 +18,9 @@ pub enum PipelineError {
         key: String,
         /// Why it is rejected.
         reason: String,
+        /// The error behind it, if another layer found it (an embedded scene's `SceneError`).
+        #[source]
+        source: Option<BoxError>,
     },
     /// A stage file could not be read or parsed as TOML.
     #[error("{file}: {reason}")]
@@ -24,6 +29,9 @@ pub enum PipelineError {
         file: PathBuf,
         /// The parser's or the OS's message.
         reason: String,
+        /// The parser's error, when there is one.
+        #[source]
+        source: Option<BoxError>,
     },
     /// A stage named on the command line does not exist.
     #[error("no stage named `{name}` (stages: {known})")]
@@ -73,16 +81,17 @@ impl PipelineError {
     /// woodpile-scene rejects: the scene's own key is appended to the prefix, and `context`
     /// (say, the grid point) to the reason. One mapping for every kind that embeds scenes.
     pub fn scene(file: &Path, prefix: &str, e: SceneError, context: &str) -> Self {
-        let (key, reason) = match e {
-            SceneError::Invalid { key, reason, .. } => (format!("{prefix}.{key}"), reason),
+        let (key, reason) = match &e {
+            SceneError::Invalid { key, reason, .. } => (format!("{prefix}.{key}"), reason.clone()),
             SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
-                (prefix.to_string(), reason)
+                (prefix.to_string(), reason.clone())
             }
         };
         Self::Definition {
             file: file.to_path_buf(),
             key,
             reason: reason + context,
+            source: Some(Box::new(e)),
         }
     }
 

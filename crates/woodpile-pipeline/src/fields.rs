@@ -38,6 +38,7 @@ impl<'a> Fields<'a> {
             file: self.file.to_path_buf(),
             key: self.path(key),
             reason: reason.into(),
+            source: None,
         }
     }
 
@@ -47,6 +48,7 @@ impl<'a> Fields<'a> {
             file: self.file.to_path_buf(),
             key: self.prefix.clone(),
             reason: reason.into(),
+            source: None,
         }
     }
 

@@ -47,6 +47,7 @@ impl Pipeline {
                         stage.name,
                         other.display()
                     ),
+                    source: None,
                 });
             }
         }
@@ -166,6 +167,7 @@ fn definition_error(stage: &Stage, key: &str, reason: impl Into<String>) -> Pipe
         file: stage.file.clone(),
         key: key.to_string(),
         reason: reason.into(),
+        source: None,
     }
 }
 

@@ -143,6 +143,7 @@ impl Stability {
                 file: self.file.clone(),
                 key: "scene.defect".into(),
                 reason: "the scene needs a first [[defect]] to vary".into(),
+                source: None,
             })?;
         match self.vary {
             Vary::Eps => defect.insert("eps".into(), toml::Value::Float(value)),

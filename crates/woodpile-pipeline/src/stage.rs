@@ -45,6 +45,7 @@ impl Stage {
         let text = woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: format!("cannot read: {e}"),
+            source: None,
         })?;
         Stage::parse(&text, file)
     }
@@ -54,6 +55,7 @@ impl Stage {
         let table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: e.to_string().trim_end().to_string(),
+            source: Some(Box::new(e)),
         })?;
         let name = stage_name(file)?;
         let mut params = toml_to_json(&toml::Value::Table(table.clone()));
@@ -106,6 +108,7 @@ fn stage_name(file: &Path) -> Result<String> {
         Err(PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: "a stage file's name must be lowercase letters, digits, `_` or `-`".into(),
+            source: None,
         })
     }
 }

@@ -153,6 +153,7 @@ impl Sweep {
             file: self.file.clone(),
             key,
             reason,
+            source: None,
         }
     }
 

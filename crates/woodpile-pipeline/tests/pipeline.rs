@@ -1520,3 +1520,25 @@ fn an_unknown_kind_lists_every_kind() {
     }
     assert!(woodpile_pipeline::kind::names().any(|k| k == "design"));
 }
+
+/// Errors keep their causes: a scene the scene crate rejects, a stage file the TOML parser
+/// rejects, a file the OS cannot read.
+#[test]
+fn errors_keep_their_sources() {
+    use std::error::Error;
+    let p = Project::new(&[("sweep", &SWEEP.replace("from = 0.5, to", "from = -0.5, to"))]);
+    let e = Pipeline::load(&p.pipeline).unwrap_err();
+    assert!(e.to_string().contains("scene.defect[0].eps"), "{e}");
+    let scene = e
+        .source()
+        .and_then(|s| s.downcast_ref::<woodpile_scene::SceneError>());
+    assert!(
+        matches!(scene, Some(woodpile_scene::SceneError::Invalid { key, .. }) if key == "defect[0].eps"),
+        "{scene:?}"
+    );
+    let p = Project::new(&[("sweep", "kind = \"sweep\"\n[scene\n")]);
+    let e = Pipeline::load(&p.pipeline).unwrap_err();
+    assert!(e.source().is_some_and(|s| s.is::<toml::de::Error>()), "{e}");
+    let e = table::read(&p.results.join("absent.parquet")).unwrap_err();
+    assert!(e.source().is_some_and(|s| s.is::<std::io::Error>()), "{e}");
+}
