@@ -42,7 +42,7 @@ pub type KindCheck = std::result::Result<(), (String, String)>;
 pub(crate) type Parse = fn(&mut Fields<'_>, &[String]) -> Result<Arc<dyn Kind>>;
 
 /// Every kind, in pipeline order: its name in stage files, and its parser. Each kind is
-/// documented by its module (`src/<name>.rs`), from which `docs/stage-kinds.md` is generated.
+/// documented by its module (`src/kinds/<name>.rs`), from which `docs/stage-kinds.md` is generated.
 pub(crate) const KINDS: &[(&str, Parse)] = &[
     ("sweep", |f, _| Ok(Arc::new(crate::sweep::Sweep::parse(f)?))),
     ("spacetime", |f, _| {

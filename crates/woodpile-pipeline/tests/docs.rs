@@ -24,7 +24,7 @@ fn generated() -> String {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut out = String::from(
         "# Stage kinds\n\n<!-- Generated from the module documentation of each kind \
-         (crates/woodpile-pipeline/src/<kind>.rs) by `make docs`; do not edit by hand. -->\n\n\
+         (crates/woodpile-pipeline/src/kinds/<kind>.rs) by `make docs`; do not edit by hand. -->\n\n\
          Every stage file takes the common keys below; the rest belong to its kind. Unknown keys \
          are errors that name the file and the key.\n\n",
     );
@@ -32,7 +32,7 @@ fn generated() -> String {
     out.push('\n');
     for kind in kind::names() {
         out.push_str(&format!("\n## `{kind}`\n\n"));
-        out.push_str(&module_doc(&src.join(format!("{kind}.rs"))));
+        out.push_str(&module_doc(&src.join(format!("kinds/{kind}.rs"))));
         out.push('\n');
     }
     out
