@@ -1,5 +1,5 @@
 //! `docs/stage-kinds.md` is generated from the module documentation of every stage kind
-//! (`src/<kind>.rs`, the one place each kind's keys are described), so the reference a user
+//! (`src/kinds/<kind>.rs`, the one place each kind's keys are described), so the reference a user
 //! reads cannot drift from the code. This test fails when it is out of date;
 //! `UPDATE_DOCS=1 cargo test -p woodpile-pipeline --test docs` (or `make docs`) rewrites it.
 #![allow(clippy::unwrap_used)]
