@@ -131,37 +131,51 @@ pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
     }
     let mut out = Columns::new();
     for (name, cells) in names.iter().zip(columns) {
+        // One kind of value per column: the first cell's.
+        fn unpack<T>(
+            cells: Vec<Cell>,
+            pick: fn(Cell) -> Option<Option<T>>,
+            mismatch: impl Fn() -> PipelineError,
+        ) -> Result<Vec<Option<T>>> {
+            cells
+                .into_iter()
+                .map(|c| pick(c).ok_or_else(&mismatch))
+                .collect()
+        }
         let mismatch = || bad(format!("column `{name}` mixes kinds of values"));
         match cells.first() {
             Some(Cell::F64(_)) | None => out.f64(
                 name,
-                cells
-                    .into_iter()
-                    .map(|c| match c {
-                        Cell::F64(x) => Ok(x),
-                        _ => Err(mismatch()),
-                    })
-                    .collect::<Result<_>>()?,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::F64(x) => Some(x),
+                        _ => None,
+                    },
+                    mismatch,
+                )?,
             ),
             Some(Cell::I64(_)) => out.i64(
                 name,
-                cells
-                    .into_iter()
-                    .map(|c| match c {
-                        Cell::I64(x) => Ok(x),
-                        _ => Err(mismatch()),
-                    })
-                    .collect::<Result<_>>()?,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::I64(x) => Some(x),
+                        _ => None,
+                    },
+                    mismatch,
+                )?,
             ),
             Some(Cell::Str(_)) => out.str(
                 name,
-                cells
-                    .into_iter()
-                    .map(|c| match c {
-                        Cell::Str(x) => Ok(x),
-                        _ => Err(mismatch()),
-                    })
-                    .collect::<Result<_>>()?,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::Str(x) => Some(x),
+                        _ => None,
+                    },
+                    mismatch,
+                )?,
             ),
         };
     }
@@ -445,6 +459,28 @@ mod tests {
             summary: serde_json::json!({"points": 3}),
             checksum: None,
         }
+    }
+
+    struct Pair(i64, Option<f64>, bool);
+
+    impl Row for Pair {
+        fn cells(&self) -> Vec<(&str, Cell)> {
+            let second = match self.2 {
+                true => Cell::from("text"),
+                false => Cell::from(self.1),
+            };
+            vec![("n", Cell::from(self.0)), ("x", second)]
+        }
+    }
+
+    #[test]
+    fn rows_make_typed_columns_and_mixed_kinds_are_an_error() {
+        let frame = rows_frame(&[Pair(1, Some(0.5), false), Pair(2, None, false)]).unwrap();
+        assert_eq!(frame.height(), 2);
+        assert_eq!(f64_column(&frame, "x").unwrap(), vec![Some(0.5), None]);
+        assert_eq!(frame.column("n").unwrap().dtype(), &DataType::Int64);
+        let e = rows_frame(&[Pair(1, Some(0.5), false), Pair(2, None, true)]).unwrap_err();
+        assert!(e.to_string().contains("`x` mixes"), "{e}");
     }
 
     #[test]
