@@ -14,8 +14,8 @@ help: ## List the targets
 build: ## Build the woodpile binary (release)
 	$(CARGO) build --release -p woodpile-cli
 
-install: ## Put `woodpile` on the PATH (cargo install into ~/.cargo/bin)
-	$(CARGO) install --locked --path crates/woodpile-cli
+install: ## Put `woodpile` on the PATH (cargo install into ~/.cargo/bin, reusing this build)
+	$(CARGO) install --locked --path crates/woodpile-cli --target-dir $(or $(CARGO_TARGET_DIR),target)
 
 docs: ## Regenerate docs/stage-kinds.md from the stage kinds' module documentation
 	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-pipeline --test docs
