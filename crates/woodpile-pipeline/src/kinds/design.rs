@@ -51,10 +51,10 @@ use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::fields::Fields;
 use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::points::{simulate_point, PointResult, PointStore, Series};
+use crate::points::{simulate_point, PointData, PointResult, PointStore, Series};
 use crate::stage::Stage;
 use crate::sweep::point_key;
-use crate::table::Columns;
+use crate::table::{rows_frame, Cell, Row};
 use crate::Output;
 
 /// A parsed design stage.
@@ -679,116 +679,97 @@ impl Design {
     }
 
     fn frame(&self, rows: &[Evaluated]) -> Result<DataFrame> {
-        let searches = [
-            "differential evolution",
-            "random",
-            "refinement",
-            "verification",
-            "robustness ±1%",
-            "robustness ±5%",
-            "robustness",
-        ];
-        let mut evaluation = Vec::new();
-        let mut best_so_far = Vec::new();
-        let mut counters = [0i64; 7];
-        let mut bests = [f64::NEG_INFINITY; 7];
-        for e in rows {
-            let s = searches.iter().position(|s| *s == e.search).unwrap_or(6);
-            counters[s] += 1;
-            bests[s] = bests[s].max(e.score);
-            evaluation.push(Some(counters[s]));
-            best_so_far.push(bests[s].is_finite().then(|| self.shown(bests[s])));
-        }
+        let mut counters = [0i64; SEARCHES.len()];
+        let mut bests = [f64::NEG_INFINITY; SEARCHES.len()];
+        let mut out: Vec<TrialRow> = rows
+            .iter()
+            .map(|e| {
+                let s = search_index(e.search);
+                counters[s] += 1;
+                bests[s] = bests[s].max(e.score);
+                TrialRow {
+                    trial: e,
+                    search_index: s,
+                    evaluation: counters[s],
+                    best_so_far: bests[s].is_finite().then(|| self.shown(bests[s])),
+                    quantile: None,
+                }
+            })
+            .collect();
         // Robustness samples: each one's rank among its spread's samples, as a quantile, so
         // that E_tr against `quantile` draws the distribution.
-        let objective: Vec<f64> = rows.iter().map(|e| e.score).collect();
-        let mut quantile: Vec<Option<f64>> = vec![None; rows.len()];
-        for search in searches.iter().filter(|s| s.starts_with("robustness")) {
+        for search in SEARCHES.iter().filter(|s| s.starts_with("robustness")) {
             let mut members: Vec<usize> = (0..rows.len())
                 .filter(|&i| rows[i].search == *search)
                 .collect();
-            members.sort_by(|&a, &b| objective[a].total_cmp(&objective[b]).then(a.cmp(&b)));
+            members.sort_by(|&a, &b| rows[a].score.total_cmp(&rows[b].score).then(a.cmp(&b)));
             let n = members.len();
             for (rank, &i) in members.iter().enumerate() {
-                quantile[i] = Some(if n > 1 {
+                out[i].quantile = Some(if n > 1 {
                     rank as f64 / (n - 1) as f64
                 } else {
                     0.5
                 });
             }
         }
-        let fraction = |pick: fn(&crate::points::PointData) -> &Vec<f64>| -> Vec<Option<f64>> {
-            rows.iter()
-                .map(|e| e.result.as_ref().ok().and_then(|p| pick(p).last().copied()))
-                .collect()
-        };
-        let mut c = Columns::new();
-        c.str(
-            "search",
-            rows.iter().map(|e| Some(e.search.to_string())).collect(),
-        )
-        .i64(
-            "search_index",
-            rows.iter()
-                .map(|e| {
-                    searches
-                        .iter()
-                        .position(|s| *s == e.search)
-                        .map(|i| i as i64)
-                })
-                .collect(),
-        )
-        .i64("evaluation", evaluation)
-        .i64(
-            "resonators",
-            rows.iter()
-                .map(|e| Some(e.layout.resonators.len() as i64))
-                .collect(),
-        )
-        .str(
-            "sites",
-            rows.iter().map(|e| Some(e.layout.list(|r| r.0))).collect(),
-        )
-        .str(
-            "eps",
-            rows.iter().map(|e| Some(e.layout.list(|r| r.1))).collect(),
-        )
-        .str(
-            "kappa",
-            rows.iter().map(|e| Some(e.layout.list(|r| r.2))).collect(),
-        )
-        .str(
-            "p",
-            rows.iter().map(|e| Some(e.layout.list(|r| r.3))).collect(),
-        )
-        .f64(
-            "total_eps",
-            rows.iter().map(|e| Some(e.layout.total_eps())).collect(),
-        )
-        .f64("R", fraction(|p| &p.reflected))
-        .f64("T", fraction(|p| &p.transmitted))
-        .f64("E_tr", fraction(|p| &p.trapped))
-        .f64(
-            "error_estimate",
-            rows.iter()
-                .map(|e| e.result.as_ref().ok().and_then(|p| p.error_estimate))
-                .collect(),
-        )
-        .f64("best_so_far", best_so_far)
-        .f64("quantile", quantile)
-        .str(
-            "failure",
-            rows.iter()
-                .map(|e| e.result.as_ref().err().cloned())
-                .collect(),
-        )
-        .str(
-            "scene_key",
-            rows.iter()
-                .map(|e| (!e.key.is_empty()).then(|| e.key.clone()))
-                .collect(),
-        );
-        c.into_frame()
+        rows_frame(&out)
+    }
+}
+
+/// The searches a design table holds, in `search_index` order.
+const SEARCHES: [&str; 7] = [
+    "differential evolution",
+    "random",
+    "refinement",
+    "verification",
+    "robustness ±1%",
+    "robustness ±5%",
+    "robustness",
+];
+
+fn search_index(search: &str) -> usize {
+    SEARCHES
+        .iter()
+        .position(|s| *s == search)
+        .unwrap_or(SEARCHES.len() - 1)
+}
+
+/// One row of the design table: an evaluated design and where it stands in its search.
+struct TrialRow<'a> {
+    trial: &'a Evaluated,
+    search_index: usize,
+    evaluation: i64,
+    best_so_far: Option<f64>,
+    quantile: Option<f64>,
+}
+
+impl Row for TrialRow<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let e = self.trial;
+        let ok = e.result.as_ref().ok();
+        let last = |pick: fn(&PointData) -> &Vec<f64>| ok.and_then(|p| pick(p).last().copied());
+        vec![
+            ("search", e.search.into()),
+            ("search_index", Cell::from(self.search_index as i64)),
+            ("evaluation", Cell::from(self.evaluation)),
+            ("resonators", Cell::from(e.layout.resonators.len() as i64)),
+            ("sites", e.layout.list(|r| r.0).into()),
+            ("eps", e.layout.list(|r| r.1).into()),
+            ("kappa", e.layout.list(|r| r.2).into()),
+            ("p", e.layout.list(|r| r.3).into()),
+            ("total_eps", Cell::from(e.layout.total_eps())),
+            ("R", last(|p| &p.reflected).into()),
+            ("T", last(|p| &p.transmitted).into()),
+            ("E_tr", last(|p| &p.trapped).into()),
+            ("error_estimate", ok.and_then(|p| p.error_estimate).into()),
+            ("best_so_far", self.best_so_far.into()),
+            ("quantile", self.quantile.into()),
+            ("failure", e.result.as_ref().err().cloned().into()),
+            (
+                "scene_key",
+                (!e.key.is_empty()).then(|| e.key.clone()).into(),
+            ),
+        ]
     }
 }
 
