@@ -27,15 +27,24 @@ const DIVERGING: [(u8, u8, u8); 7] = [
     (103, 0, 31),
 ];
 
-/// Colours for categories, in order: green, orange, red, then tab10's others. Three classes
-/// such as "meets", "misses", "unstable" read as go, caution, stop.
-pub const CATEGORIES: [RGBColor; 6] = [
+/// Line colours (matplotlib's tab10, which prints and projects well). Its grey is left out:
+/// it is too close to the grey of missing values.
+pub const PALETTE: [RGBColor; 9] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(255, 127, 14),
-    RGBColor(214, 39, 40),
-    RGBColor(31, 119, 180),
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// Colours for categories, the palette's in the order green, orange, red, blue, purple, brown:
+/// three classes such as "meets", "misses", "unstable" read as go, caution, stop.
+pub const CATEGORIES: [RGBColor; 6] = [
+    PALETTE[2], PALETTE[3], PALETTE[1], PALETTE[0], PALETTE[4], PALETTE[5],
 ];
 
 /// The viridis colour at `t` in [0, 1] (clamped).

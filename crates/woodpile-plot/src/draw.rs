@@ -4,25 +4,12 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::colour::{diverging, viridis, CATEGORIES};
+use crate::colour::{diverging, viridis, CATEGORIES, PALETTE};
 use crate::{Colours, Figure, HeatPanel, LinePanel, Mark, MarkAt, Panel};
 
 /// Height of the figure title strip in pixels.
 pub(crate) const TITLE_HEIGHT: u32 = 36;
 const FONT: &str = "sans-serif";
-/// Line colours (matplotlib's tab10, which prints and projects well).
-/// Its grey is left out: it is too close to [`MISSING`].
-const PALETTE: [RGBColor; 9] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-];
 const MISSING: RGBColor = RGBColor(190, 190, 190);
 
 fn text<E: std::fmt::Debug>(e: E) -> String {
