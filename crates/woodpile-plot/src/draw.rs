@@ -226,13 +226,7 @@ struct Scale<'a> {
 impl Scale<'_> {
     fn of(h: &HeatPanel) -> Scale<'_> {
         let (lo, hi) = h.z_range.unwrap_or_else(|| {
-            let (lo, hi) =
-                h.z.iter()
-                    .flatten()
-                    .filter(|v| v.is_finite())
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), &v| {
-                        (l.min(v), u.max(v))
-                    });
+            let (lo, hi) = h.value_range();
             match (&h.colours, lo.is_finite()) {
                 (_, false) => (0.0, 1.0),
                 (Colours::Diverging, true) => {

@@ -84,6 +84,19 @@ pub struct HeatPanel {
     pub view: View,
 }
 
+impl HeatPanel {
+    /// The smallest and largest finite value, or (inf, -inf) when there is none.
+    pub fn value_range(&self) -> (f64, f64) {
+        self.z
+            .iter()
+            .flatten()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), &v| {
+                (l.min(v), u.max(v))
+            })
+    }
+}
+
 /// How a heat map colours its values.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Colours {

@@ -453,14 +453,7 @@ fn share_colour_scale(panels: &mut [Panel]) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for panel in panels.iter() {
         if let Panel::Heat(h) = panel {
-            let (l, u) = h.z_range.unwrap_or_else(|| {
-                h.z.iter()
-                    .flatten()
-                    .filter(|v| v.is_finite())
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, u), &v| {
-                        (l.min(v), u.max(v))
-                    })
-            });
+            let (l, u) = h.z_range.unwrap_or_else(|| h.value_range());
             (lo, hi) = (lo.min(l), hi.max(u));
         }
     }
