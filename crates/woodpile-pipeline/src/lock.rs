@@ -28,7 +28,7 @@ pub struct ResultsLock {
 /// process holds it. A tree that cannot be written at all (a read-only copy) is not locked:
 /// a run there can only find its stages fresh or fail at its first write.
 pub fn lock_results(results: &Path, events: &dyn Events) -> Result<ResultsLock> {
-    let path = results.join(LOCK_FILE);
+    let path = lock_path(results);
     let opened = fs::create_dir_all(results).and_then(|()| {
         OpenOptions::new()
             .create(true)
