@@ -117,7 +117,7 @@ fn profile_start(form: Form, x: &[f64], y: &[f64]) -> Option<[f64; 3]> {
                 g.iter().zip(y).map(|(a, b)| a * b).sum::<f64>(),
             );
             let det = n * sgg - sg * sg;
-            if !(det.abs() > 1e-300) {
+            if det.is_nan() || det.abs() <= 1e-300 {
                 return None;
             }
             let a = (n * sgy - sg * sy) / det;

@@ -264,7 +264,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
                 "is physical.velocity in a [physical] scene",
             ));
         }
-        (Some(v), None) if v == 0.0 => {
+        (Some(0.0), None) => {
             return Err(invalid(
                 "impulse.velocity",
                 "is 0: no wave enters the chain, so there is no energy to split and the fractions are undefined",

@@ -65,7 +65,7 @@ impl StepSetBy {
 /// settings and tolerance must already be valid (a [`SimError`] otherwise).
 pub fn check(scenario: &Scenario) -> Result<(), SimError> {
     let samples = (scenario.t_end / scenario.sample_every).ceil();
-    if !(samples <= MAX_SAMPLES as f64) {
+    if samples.is_nan() || samples > MAX_SAMPLES as f64 {
         return Err(OverBudget::Samples { samples }.into());
     }
     let model = &scenario.model;

@@ -133,7 +133,7 @@ impl SpaceTimeField {
 
 impl Observer for SpaceTimeField {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
-        let keep = self.seen % self.time_stride == 0;
+        let keep = self.seen.is_multiple_of(self.time_stride);
         self.seen += 1;
         if !keep {
             return;

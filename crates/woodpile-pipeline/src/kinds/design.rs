@@ -105,7 +105,7 @@ pub struct Range {
 impl Range {
     fn at(&self, u: f64) -> f64 {
         // The ends exactly: exp(ln 0.1) is not 0.1.
-        if !(u > 0.0) {
+        if u.is_nan() || u <= 0.0 {
             return self.min;
         }
         if u >= 1.0 {
@@ -608,8 +608,8 @@ impl Design {
                     })
                     .collect();
                 let label: &'static str = match spread {
-                    s if s == 0.01 => "robustness ±1%",
-                    s if s == 0.05 => "robustness ±5%",
+                    0.01 => "robustness ±1%",
+                    0.05 => "robustness ±5%",
                     _ => "robustness",
                 };
                 // In order of E_tr: the table then reads as the distribution's quantiles.
@@ -789,7 +789,7 @@ fn parse_space(mut f: Fields<'_>) -> Result<Space> {
         }
     };
     let (lo, hi) = pair(&mut f, "resonators")?;
-    if lo < 0 || hi < 1 || hi > 64 {
+    if lo < 0 || !(1..=64).contains(&hi) {
         return Err(f.error(
             "resonators",
             "expected counts from 0 to 64, at least one resonator possible",

@@ -480,8 +480,10 @@ struct PlottedColumns {
 /// index and the curve's (or the colour bar's) label, each number under the name of the column
 /// it was drawn from, so a diff can give a column (a wall time, say) its own tolerance.
 fn plotted(panels: &[Panel], names: &[PlottedColumns]) -> Columns {
+    /// A drawn point: its panel, its curve's label, and its numbers by source column.
+    type Plotted = (usize, String, Vec<(String, Option<f64>)>);
     let mut order: Vec<String> = Vec::new();
-    let mut rows: Vec<(usize, String, Vec<(String, Option<f64>)>)> = Vec::new();
+    let mut rows: Vec<Plotted> = Vec::new();
     let mut push = |p: usize, label: &str, cells: Vec<(String, Option<f64>)>| {
         for (name, _) in &cells {
             if !order.contains(name) {
