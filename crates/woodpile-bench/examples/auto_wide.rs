@@ -96,6 +96,16 @@ fn main() {
     let mut rng = Lcg(777);
     let indexed: Vec<(usize, Scenario)> =
         (0..n).map(|k| (k, random_scene(&mut rng, tol))).collect();
+    if let Ok(k) = std::env::var("WIDE_SCENE") {
+        let scene = &indexed[k.parse::<usize>().unwrap()].1;
+        for (name, dt) in [("rk4-contact", 0.001), ("rk4-contact", 0.0005), ("rk4-contact", 0.00025), ("rkn6-contact", 0.1), ("rkn6-contact", 0.05), ("rkn6-contact", 0.025), ("rkn6-contact", 0.0125), ("rkn6-contact", 0.001), ("rkn4-contact", 0.001), ("dop853", 0.0)] {
+            let method = woodpile_sim::integrate::Method::from_name(name).unwrap();
+            let accuracy = if dt > 0.0 { woodpile_sim::testing::fixed_dt(dt) } else { tolerance(1e-10) };
+            let o = simulate(&Scenario { method: MethodChoice::Named(method), accuracy, ..scene.clone() }, &mut ()).unwrap();
+            println!("{name} {dt}: {:?}", o.fractions);
+        }
+        return;
+    }
     let results: Vec<(String, bool, u64)> =
         on_two_cores(&indexed, |(k, scene)| check(*k, scene, tol));
     for (line, _, _) in &results {

@@ -128,6 +128,21 @@ impl Cubic {
     }
 }
 
+/// The first moment, as a fraction of the step in (`after`, 1), at which the bond's Hermite path
+/// crosses zero (a contact opens or closes), if any.
+pub(crate) fn first_crossing(path: &BondPath, h: f64, after: f64) -> Option<f64> {
+    let cubic = Cubic::hermite(path, h);
+    let (critical, n_critical) = cubic.critical_points();
+    let mut knots = [0.0; 4];
+    knots[1..=n_critical].copy_from_slice(&critical[..n_critical]);
+    knots[n_critical + 1] = 1.0;
+    knots[..n_critical + 2].windows(2).find_map(|piece| {
+        let (a, b) = (piece[0].max(after), piece[1]);
+        let crosses = a < b && (cubic.at(a) > 0.0) != (cubic.at(b) > 0.0);
+        crosses.then(|| cubic.root_between(a, b))
+    })
+}
+
 /// `(∫_0^h F(d(s)) ds, ∫_0^h (h - s) F(d(s)) ds)` along the Hermite path, F = [d]_+^{3/2}.
 pub(crate) fn path_integrals(path: &BondPath, h: f64) -> (f64, f64) {
     let cubic = Cubic::hermite(path, h);

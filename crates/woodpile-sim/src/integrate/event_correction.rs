@@ -6,7 +6,7 @@
 //! A method supplies only its quadrature: what its stage weights make of a bond's `S` stage
 //! forces, as an impulse `h Σ b_i F_i` and a position change `h² Σ b̄_i F_i`.
 
-use super::contact_event::{path_integrals, BondPath};
+use super::contact_event::{first_crossing, path_integrals, BondPath};
 use crate::model::{Boundary, Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
@@ -45,8 +45,8 @@ pub(crate) struct ContactEvents<const S: usize> {
     pending: Vec<(Option<usize>, Option<usize>, f64, f64)>,
     /// Bonds corrected so far.
     events: u64,
-    /// Scratch: window offsets of the bonds that changed contact in this step.
-    changed: Vec<usize>,
+    /// Scratch: the bonds that changed contact in this step, as (bond, left site, right site).
+    changed: Vec<(usize, Option<usize>, Option<usize>)>,
 }
 
 impl<const S: usize> ContactEvents<S> {
@@ -67,6 +67,19 @@ impl<const S: usize> ContactEvents<S> {
         self.events
     }
 
+    /// Whether the last [`finish_step`] corrected any bond (then the end state is not the one
+    /// the method's last stage saw).
+    pub fn corrected_last_step(&self) -> bool {
+        !self.pending.is_empty()
+    }
+
+    /// Makes stage `to`'s recorded bond forces those of stage `from` (the stage vectors are
+    /// swapped; `from`'s are overwritten before they are read again): for a method whose first
+    /// stage reuses its previous step's last.
+    pub fn reuse_stage(&mut self, from: usize, to: usize) {
+        self.stage_force.swap(from, to);
+    }
+
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
     /// contact opened or closed during the step of size `h` from `start` to `end` (states
     /// `[q, q']`, the end not yet corrected).
@@ -78,81 +91,21 @@ impl<const S: usize> ContactEvents<S> {
         window: Window,
     ) {
         let n = model.n_dof();
-        let n_sites = model.n_sites();
+        self.scan(model, &end[..n], window);
         let (q, v) = start.split_at(n);
         let (new_q, new_v) = end.split_at_mut(n);
-        let forces = &self.stage_force;
         let quadrature = self.quadrature;
-        let stage_forces = |bond: usize| -> [f64; S] { std::array::from_fn(|s| forces[s][bond]) };
-        // Overlap and rate of a bond from (positions, velocities): left minus right member.
-        let member = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
         let mut pending = std::mem::take(&mut self.pending);
         pending.clear();
-        let mut correct = |bond: usize, left: Option<usize>, right: Option<usize>| {
-            let stage = stage_forces(bond);
-            let d_end = member(new_q, left) - member(new_q, right);
-            if !changes_contact(stage, d_end) || negligible(stage, d_end) {
-                return;
+        for &(bond, left, right) in &self.changed {
+            let stage = self.stage_forces(bond);
+            let path = bond_path((q, v), (new_q, new_v), left, right);
+            if negligible(stage, path.d1) {
+                continue;
             }
-            let path = BondPath {
-                d0: member(q, left) - member(q, right),
-                rate0: member(v, left) - member(v, right),
-                d1: d_end,
-                rate1: member(new_v, left) - member(new_v, right),
-            };
             let (impulse, moment) = path_integrals(&path, h);
             let (q0, q1) = quadrature(stage, h);
             pending.push((left, right, impulse - q0, moment - q1));
-        };
-        // The scan over the window's bonds is the only per-bond cost; it touches the stage
-        // forces and end positions in order and calls out only for the rare bond that changed.
-        let (lo, hi) = (window.lo, window.hi);
-        let stage_slices: [&[f64]; S] = std::array::from_fn(|s| &forces[s][lo + 1..hi + 1]);
-        let (left_q, right_q) = (&new_q[lo..hi], &new_q[lo + 1..hi + 1]);
-        // A bond changed contact when between one and S of its S + 1 values say "touching"
-        // (`changes_contact`): when the largest of them is positive and the smallest is not.
-        // Written as compare-and-select minima and maxima over fixed blocks of four bonds (one
-        // AVX2 register), the test has no bounds checks and no branch per bond; each block
-        // yields a bit mask of its changed bonds, and only set bits are visited. This scan
-        // took a third of a step as a per-bond count of "touching" values; now it is a tenth
-        // (standard scene, `rkn4-contact` at dt = 0.1: 2.10 -> 1.65 ms, best of 400).
-        let changed = &mut self.changed;
-        changed.clear();
-        let n_bonds = hi - lo;
-        const BLOCK: usize = 4;
-        let mut start = 0;
-        while start + BLOCK <= n_bonds {
-            let block = start..start + BLOCK;
-            let forces: [&[f64; BLOCK]; S] =
-                std::array::from_fn(|s| block_of(&stage_slices[s][block.clone()]));
-            let mut mask = block_changes(
-                block_of(&left_q[block.clone()]),
-                block_of(&right_q[block]),
-                forces,
-            );
-            while mask != 0 {
-                changed.push(start + mask.trailing_zeros() as usize);
-                mask &= mask - 1;
-            }
-            start += BLOCK;
-        }
-        // The last bonds, fewer than a block: the scalar test.
-        changed.extend((start..n_bonds).filter(|&i| {
-            changes_contact::<S>(
-                std::array::from_fn(|s| stage_slices[s][i]),
-                left_q[i] - right_q[i],
-            )
-        }));
-        for &i in changed.iter() {
-            correct(lo + i + 1, Some(lo + i), Some(lo + i + 1));
-        }
-        if model.boundary() == Boundary::Fixed {
-            if lo == 0 {
-                correct(0, None, Some(0));
-            }
-            if hi == n_sites - 1 {
-                correct(n_sites, Some(n_sites - 1), None);
-            }
         }
         // The bond pushes its left member back and its right member on.
         let inv_mass = model.inv_mass();
@@ -168,6 +121,118 @@ impl<const S: usize> ContactEvents<S> {
         }
         self.events += pending.len() as u64;
         self.pending = pending;
+    }
+
+    /// The earliest moment, as a fraction of the step in (`after`, 1), at which a contact of
+    /// `window` that is not [`negligible`] opens or closes along its path over the step of size
+    /// `h` from `start` to `end` (states `[q, q']`): where an event-located method ends its step.
+    pub(crate) fn first_event(
+        &mut self,
+        model: &Model,
+        (start, end): (&[f64], &[f64]),
+        h: f64,
+        window: Window,
+        after: f64,
+    ) -> Option<f64> {
+        let n = model.n_dof();
+        self.scan(model, &end[..n], window);
+        let (q, v) = start.split_at(n);
+        let (new_q, new_v) = end.split_at(n);
+        let mut first: Option<f64> = None;
+        for &(bond, left, right) in &self.changed {
+            let path = bond_path((q, v), (new_q, new_v), left, right);
+            if negligible(self.stage_forces(bond), path.d1) {
+                continue;
+            }
+            if let Some(x) = first_crossing(&path, h, after) {
+                first = Some(first.map_or(x, |f| f.min(x)));
+            }
+        }
+        first
+    }
+
+    fn stage_forces(&self, bond: usize) -> [f64; S] {
+        std::array::from_fn(|s| self.stage_force[s][bond])
+    }
+
+    /// Lists in `self.changed` every bond of `window` whose contact opened or closed during the
+    /// step, as (bond, left site, right site) with `None` for a wall; `new_q` are the end
+    /// positions.
+    fn scan(&mut self, model: &Model, new_q: &[f64], window: Window) {
+        let n_sites = model.n_sites();
+        let forces = &self.stage_force;
+        // The scan over the window's bonds is the only per-bond cost; it touches the stage
+        // forces and end positions in order and calls out only for the rare bond that changed.
+        let (lo, hi) = (window.lo, window.hi);
+        let stage_slices: [&[f64]; S] = std::array::from_fn(|s| &forces[s][lo + 1..hi + 1]);
+        let (left_q, right_q) = (&new_q[lo..hi], &new_q[lo + 1..hi + 1]);
+        // A bond changed contact when between one and S of its S + 1 values say "touching"
+        // (`changes_contact`): when the largest of them is positive and the smallest is not.
+        // Written as compare-and-select minima and maxima over fixed blocks of four bonds (one
+        // AVX2 register), the test has no bounds checks and no branch per bond; each block
+        // yields a bit mask of its changed bonds, and only set bits are visited. This scan
+        // took a third of a step as a per-bond count of "touching" values; now it is a tenth
+        // (standard scene, `rkn4-contact` at dt = 0.1: 2.10 -> 1.65 ms, best of 400).
+        let changed = &mut self.changed;
+        changed.clear();
+        let inner = |i: usize| (lo + i + 1, Some(lo + i), Some(lo + i + 1));
+        let n_bonds = hi - lo;
+        const BLOCK: usize = 4;
+        let mut start = 0;
+        while start + BLOCK <= n_bonds {
+            let block = start..start + BLOCK;
+            let forces: [&[f64; BLOCK]; S] =
+                std::array::from_fn(|s| block_of(&stage_slices[s][block.clone()]));
+            let mut mask = block_changes(
+                block_of(&left_q[block.clone()]),
+                block_of(&right_q[block]),
+                forces,
+            );
+            while mask != 0 {
+                changed.push(inner(start + mask.trailing_zeros() as usize));
+                mask &= mask - 1;
+            }
+            start += BLOCK;
+        }
+        // The last bonds, fewer than a block: the scalar test.
+        changed.extend(
+            (start..n_bonds)
+                .filter(|&i| {
+                    changes_contact::<S>(
+                        std::array::from_fn(|s| stage_slices[s][i]),
+                        left_q[i] - right_q[i],
+                    )
+                })
+                .map(inner),
+        );
+        if model.boundary() == Boundary::Fixed {
+            let wall_changed = |bond: usize, d_end: f64| {
+                changes_contact::<S>(std::array::from_fn(|s| forces[s][bond]), d_end)
+            };
+            if lo == 0 && wall_changed(0, -new_q[0]) {
+                changed.push((0, None, Some(0)));
+            }
+            if hi == n_sites - 1 && wall_changed(n_sites, new_q[n_sites - 1]) {
+                changed.push((n_sites, Some(n_sites - 1), None));
+            }
+        }
+    }
+}
+
+/// A bond's overlap and rate at both ends of a step, from the states (positions, velocities) at
+/// its start and end: left member minus right member, a wall counting as at rest.
+fn bond_path(
+    (q, v): (&[f64], &[f64]),
+    (new_q, new_v): (&[f64], &[f64]),
+    left: Option<usize>,
+    right: Option<usize>,
+) -> BondPath {
+    let member = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
+    BondPath {
+        d0: member(q, left) - member(q, right),
+        rate0: member(v, left) - member(v, right),
+        d1: member(new_q, left) - member(new_q, right),
+        rate1: member(new_v, left) - member(new_v, right),
     }
 }
 

@@ -19,6 +19,7 @@ mod event_correction;
 mod method;
 mod rk;
 mod rk4_fused;
+mod rkn;
 mod rkn4;
 mod symplectic;
 
@@ -26,6 +27,7 @@ pub use dop853::Dop853;
 pub use method::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD, BLOW_UP_DRIFT, DRIFT_PER_TOL};
 pub use rk::{ExplicitRk, Rk4, Tableau};
 pub use rk4_fused::Rk4Fused;
+pub use rkn::{ContactMode, Rkn, RknTableau, DPRKN6, NYSTROM4};
 pub use rkn4::Rkn4;
 pub use symplectic::{Composition, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6};
 
