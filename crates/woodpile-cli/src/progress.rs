@@ -118,8 +118,9 @@ impl Events for Progress {
     }
 
     fn stage_finished(&self, stage: &str, summary: &str) {
+        // Only the stage that owns the progress bar clears it: stages run side by side.
         if let Ok(mut guard) = self.sweep.lock() {
-            if let Some(s) = guard.take() {
+            if let Some(s) = guard.take_if(|s| s.stage == stage) {
                 if let Some(bar) = s.bar {
                     bar.finish_and_clear();
                 }

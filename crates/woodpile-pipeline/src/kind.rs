@@ -33,6 +33,24 @@ pub trait Kind: std::fmt::Debug + Send + Sync + Any {
     fn files(&self, _stage: &str, _results: &Path, _figures: &Path) -> Vec<PathBuf> {
         Vec::new()
     }
+
+    /// How the stage shares the machine with the other stages of a run ([`Sharing`]).
+    fn sharing(&self) -> Sharing {
+        Sharing::Shared
+    }
+}
+
+/// How a stage shares the machine with the other stages a run has ready at the same time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Sharing {
+    /// Mostly one thread: runs beside anything (reductions, fits, figures, single scenes).
+    Shared,
+    /// Keeps every core busy by itself (a sweep's scenes, the design search): one such stage
+    /// at a time, in pipeline order, so that a sweep whose scenes an earlier one shares (F5
+    /// and F4) finds them cached instead of simulating them again alongside it.
+    Parallel,
+    /// Times itself: runs with nothing else, so that its timings are one quiet core's.
+    Alone,
 }
 
 /// The outcome of [`Kind::check_inputs`]: `Err((key, reason))`.

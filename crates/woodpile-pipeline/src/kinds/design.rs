@@ -843,6 +843,10 @@ fn parse_space(mut f: Fields<'_>) -> Result<Space> {
 }
 
 impl Kind for Design {
+    fn sharing(&self) -> crate::kind::Sharing {
+        crate::kind::Sharing::Parallel
+    }
+
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
         no_inputs(stage)
     }

@@ -80,12 +80,18 @@ impl Stability {
             match Method::from_name(&name) {
                 Some(m) if !m.is_adaptive() => methods.push(m),
                 _ => {
+                    let fixed: Vec<&str> = Method::ALL
+                        .iter()
+                        .filter(|m| !m.is_adaptive())
+                        .map(|m| m.name())
+                        .collect();
                     return Err(fields.error(
                         "methods",
                         format!(
-                            "`{name}` is not a fixed-step method (rk4, rk4-contact, verlet, yoshida4, yoshida6)"
+                            "`{name}` is not a fixed-step method ({})",
+                            fixed.join(", ")
                         ),
-                    ))
+                    ));
                 }
             }
         }
@@ -359,6 +365,10 @@ struct Run {
 }
 
 impl Kind for Stability {
+    fn sharing(&self) -> crate::kind::Sharing {
+        crate::kind::Sharing::Parallel
+    }
+
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
         no_inputs(stage)
     }

@@ -424,6 +424,10 @@ pub fn points_dir(results: &Path) -> PathBuf {
 }
 
 impl Kind for Sweep {
+    fn sharing(&self) -> crate::kind::Sharing {
+        crate::kind::Sharing::Parallel
+    }
+
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
         no_inputs(stage)
     }

@@ -304,6 +304,10 @@ impl Row for Run<'_> {
 }
 
 impl Kind for WorkPrecision {
+    fn sharing(&self) -> crate::kind::Sharing {
+        crate::kind::Sharing::Alone
+    }
+
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
         no_inputs(stage)
     }
