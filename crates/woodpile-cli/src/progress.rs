@@ -2,6 +2,7 @@
 //! scenes/s, ETA), and a plain line every few seconds otherwise (CI logs, `make` in a pipe),
 //! where a bar would be invisible or garble the log.
 
+use std::collections::HashMap;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -18,6 +19,8 @@ pub(crate) struct Progress {
     terminal: bool,
     sweep: Mutex<Option<Sweep>>,
     done: AtomicUsize,
+    /// When each running stage started, for its `done` line (stages run side by side).
+    started: Mutex<HashMap<String, Instant>>,
 }
 
 struct Sweep {
@@ -34,6 +37,7 @@ impl Progress {
             terminal: std::io::stderr().is_terminal(),
             sweep: Mutex::new(None),
             done: AtomicUsize::new(0),
+            started: Mutex::new(HashMap::new()),
         }
     }
 
@@ -68,6 +72,9 @@ fn plain_line(s: &Sweep, done: usize) -> String {
 
 impl Events for Progress {
     fn stage_started(&self, stage: &str, why: &str) {
+        if let Ok(mut started) = self.started.lock() {
+            started.insert(stage.to_string(), Instant::now());
+        }
         self.line(&format!("run {stage}: {why}"));
     }
 
@@ -134,7 +141,16 @@ impl Events for Progress {
                 }
             }
         }
-        eprintln!("done {stage}: {summary}");
+        let secs = self
+            .started
+            .lock()
+            .ok()
+            .and_then(|mut started| started.remove(stage))
+            .map(|t| t.elapsed().as_secs_f64());
+        match secs {
+            Some(secs) => eprintln!("done {stage}: {summary} ({secs:.1} s)"),
+            None => eprintln!("done {stage}: {summary}"),
+        }
     }
 
     fn stage_skipped(&self, stage: &str) {

@@ -136,7 +136,7 @@ impl PointStore {
 
     /// Stores `result` under `key`, atomically.
     pub fn save(&self, key: &Key, result: &PointResult) -> Result<()> {
-        atomic::write(&self.path(key), &encode(key, result))
+        atomic::write_checksummed(&self.path(key), &encode(key, result))
     }
 
     /// Removes leftovers of killed writers from the fan-out directory of `key`.
