@@ -1542,3 +1542,66 @@ fn errors_keep_their_sources() {
     let e = table::read(&p.results.join("absent.parquet")).unwrap_err();
     assert!(e.source().is_some_and(|s| s.is::<std::io::Error>()), "{e}");
 }
+
+/// Records which stages run at the same time.
+#[derive(Default)]
+struct Overlaps {
+    running: Mutex<Vec<String>>,
+    /// Every pair seen running together, and the most seen at once.
+    together: Mutex<Vec<(String, String)>>,
+}
+
+impl Events for Overlaps {
+    fn stage_started(&self, stage: &str, _: &str) {
+        let mut running = self.running.lock().unwrap();
+        let mut together = self.together.lock().unwrap();
+        for other in running.iter() {
+            together.push((other.clone(), stage.to_string()));
+        }
+        running.push(stage.to_string());
+    }
+    fn stage_finished(&self, stage: &str, _: &str) {
+        self.running.lock().unwrap().retain(|s| s != stage);
+    }
+}
+
+/// Independent stages run side by side, within what their kinds allow: a stage that times
+/// itself (work precision) runs with nothing else, and two sweeps never run together (the
+/// second may need the first's points). The results are those of a run one stage at a time.
+#[test]
+fn stages_run_side_by_side_within_their_kinds_limits() {
+    let other_sweep = SWEEP.replace("L = [0, 1]", "L = [2, 3]");
+    let stages = [
+        ("sweep", SWEEP),
+        ("sweep_b", other_sweep.as_str()),
+        ("reduce", REDUCE),
+        ("best", BEST),
+        ("wp", WORK_PRECISION),
+        ("chart", WORK_PRECISION_CHART),
+    ];
+    let p = Project::new(&stages);
+    let events = Overlaps::default();
+    let pipeline = Pipeline::load(&p.pipeline).unwrap();
+    let options = RunOptions {
+        results: p.results.clone(),
+        figures: p.results.join("figures"),
+        ..RunOptions::default()
+    };
+    run(&pipeline, &options, &events).unwrap();
+    let together = events.together.lock().unwrap().clone();
+    for (a, b) in &together {
+        assert!(a != "wp" && b != "wp", "work precision ran beside {a} {b}");
+        assert!(
+            !(a.starts_with("sweep") && b.starts_with("sweep")),
+            "two sweeps ran together"
+        );
+    }
+    // The same tables as a run that starts again from nothing: the order changed no bit.
+    let again = Project::new(&stages);
+    again.run(&[]);
+    for name in ["sweep", "sweep_b", "reduce", "best"] {
+        let a = table::read(&p.output(name)).unwrap();
+        let b = table::read(&again.output(name)).unwrap();
+        assert!(a.equals_missing(&b), "{name} differs");
+    }
+}
