@@ -17,7 +17,7 @@ build: ## Build the woodpile binary (release)
 install: ## Put `woodpile` on the PATH (cargo install into ~/.cargo/bin, reusing this build)
 	$(CARGO) install --locked --path crates/woodpile-cli --target-dir $(or $(CARGO_TARGET_DIR),target)
 
-docs: ## Regenerate docs/stage-kinds.md from the stage kinds' module documentation
+docs: ## Regenerate docs/stage-kinds.md and the README's accuracy captions
 	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-pipeline --test docs
 
 test: ## Run the whole test suite (what CI runs; release profile, shared with `figures`)
@@ -48,7 +48,7 @@ bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, then
 	mkdir -p $(BASELINE)
 	gcc -O3 -march=x86-64-v3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
-	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py
+	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py
 	$(CARGO) bench -p woodpile-bench
 
 work-precision: ## Error in E_tr against wall time for every method and step (README table)

@@ -3,6 +3,8 @@
 //! with one linear defect eps = 10, kappa = 1 at site 0, the scene of the C and numba
 //! timings (`baseline/`).
 
+pub mod paper;
+
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
 use woodpile_sim::run::{simulate, Outcome, Scenario};
 use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};

@@ -2,8 +2,13 @@
 //! run as the C and numba RK4 baselines of `baseline/`, with the ratios. Prints a Markdown table
 //! (the README's) and one JSON line per row on stderr.
 //!
+//! Then the paper-level comparison ([`woodpile_bench::paper`]): a seeded sample of the F4, F7
+//! coarse and F7 fine sweeps' scenes, woodpile at the pipeline's settings against the numba
+//! script at RK4 dt = 0.01, one thread each.
+//!
 //! ```text
-//! woodpile-bench [--c PATH_TO_C_BINARY] [--numba PATH_TO_SCRIPT] [--repeats N]
+//! woodpile-bench [--c PATH_TO_C_BINARY] [--numba PATH_TO_SCRIPT] [--numba-scenes PATH]
+//!                [--repeats N] [--paper SCENES_PER_SWEEP] [--seed SEED]
 //! ```
 //!
 //! Accuracy is |ΔE_tr| against a reference (Yoshida-6 at dt = 2.5e-4, whose own error is about
@@ -14,10 +19,10 @@ use std::process::Command;
 use std::time::Instant;
 
 use serde_json::Value;
-use woodpile_bench::{fixed, run};
+use woodpile_bench::{fixed, paper, run, standard_scene};
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
 use woodpile_sim::run::{run_with_plan, Scenario};
-use woodpile_sim::testing::fixed_dt;
+use woodpile_sim::testing::{fixed_dt, tolerance};
 
 struct Row {
     implementation: String,
@@ -124,6 +129,16 @@ fn main() {
             best_ms(repeats, || trapped(&scene)),
         );
     }
+    let scene = fixed(Method::Rkn6Contact, 0.1);
+    ours(
+        "rkn6-contact dt = 0.1",
+        best_ms(repeats, || trapped(&scene)),
+    );
+    let auto = standard_scene(MethodChoice::Auto, tolerance(1e-7));
+    ours(
+        "auto, tolerance 1e-7",
+        best_ms(repeats, || trapped(&auto)),
+    );
     let scene = fixed(Method::Rk4, 0.01);
     ours(
         "rk4 dt = 0.01, full chain (no active window)",
@@ -175,5 +190,45 @@ fn main() {
             serde_json::json!({"implementation": r.implementation, "setting": r.setting,
                 "abs_error_E_tr": r.error, "ms": r.ms})
         );
+    }
+
+    let per_sweep: usize = option("--paper").and_then(|n| n.parse().ok()).unwrap_or(8);
+    let seed: u64 = option("--seed").and_then(|n| n.parse().ok()).unwrap_or(2026);
+    if per_sweep > 0 {
+        paper_level(per_sweep, seed, option("--numba-scenes").as_deref());
+    }
+}
+
+/// The paper-level comparison, printed as a table.
+fn paper_level(per_sweep: usize, seed: u64, numba_script: Option<&str>) {
+    let scenes = match paper::paper_sample("pipeline", per_sweep, seed) {
+        Ok(scenes) => scenes,
+        Err(e) => {
+            eprintln!("paper-level comparison skipped: {e}");
+            return;
+        }
+    };
+    let c = paper::compare(&scenes, numba_script);
+    println!(
+        "\npaper-level sample: {} scenes ({per_sweep} each of F4, F7 coarse, F7 fine; seed {seed}), \
+         one thread each, errors = largest of R, T, E_tr against rk4-contact at dt = 0.001\n",
+        c.scenes
+    );
+    println!("| implementation | worst error | wall ms (sum) | time / numba |");
+    println!("|---|---|---|---|");
+    let numba_ms = c.numba.as_ref().map(|n| n.ms).ok();
+    let mut sides: Vec<&paper::Side> = c.woodpile.iter().collect();
+    if let Ok(n) = &c.numba {
+        sides.push(n);
+    }
+    for side in sides {
+        let ratio = numba_ms.map_or("–".to_string(), |n| format!("{:.3}", side.ms / n));
+        println!(
+            "| {} | {:.1e} | {:.1} | {ratio} |",
+            side.name, side.worst_error, side.ms
+        );
+    }
+    if let Err(e) = &c.numba {
+        eprintln!("numba side skipped: {e}");
     }
 }

@@ -25,10 +25,20 @@ pub fn sampled_sweep_scenes(
     pipeline: &Pipeline,
     per_sweep: usize,
 ) -> Result<Vec<(String, Scenario)>> {
-    let mut rng = Lcg(20_261_123);
-    let mut scenes = Vec::with_capacity(per_sweep * SURVEY_SWEEPS.len());
+    sampled_scenes(pipeline, SURVEY_SWEEPS, per_sweep, 20_261_123)
+}
+
+/// [`sampled_sweep_scenes`] from the given `(stage, label)` sweeps with the given `seed`.
+pub fn sampled_scenes(
+    pipeline: &Pipeline,
+    sweeps: &[(&str, &str)],
+    per_sweep: usize,
+    seed: u64,
+) -> Result<Vec<(String, Scenario)>> {
+    let mut rng = Lcg(seed);
+    let mut scenes = Vec::with_capacity(per_sweep * sweeps.len());
     for _ in 0..per_sweep {
-        for &(stage, label) in SURVEY_SWEEPS {
+        for &(stage, label) in sweeps {
             let sweep = pipeline.sweep(stage).ok_or_else(|| {
                 PipelineError::stage(stage, "a survey draws from this sweep, which is missing")
             })?;

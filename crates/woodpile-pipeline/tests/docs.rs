@@ -51,3 +51,79 @@ fn the_stage_kind_reference_is_generated_from_the_code() {
         "docs/stage-kinds.md is out of date: run `make docs`"
     );
 }
+
+/// The accuracy each README figure was computed to: for every stage upstream of the figure that
+/// simulates (sweeps, space-time maps, the design search), the tolerance and the largest error
+/// estimate its manifest in `results/` records. `None` for a figure with no such stage.
+fn accuracy_caption(
+    pipeline: &woodpile_pipeline::Pipeline,
+    results: &Path,
+    figure: &str,
+) -> Option<String> {
+    use woodpile_pipeline::table;
+    let mut seen = std::collections::BTreeSet::new();
+    let mut stack = vec![figure.to_string()];
+    while let Some(name) = stack.pop() {
+        if seen.insert(name.clone()) {
+            stack.extend(pipeline.stage(&name).unwrap().inputs.iter().cloned());
+        }
+    }
+    let parts: Vec<String> = seen
+        .iter()
+        .filter_map(|name| {
+            let manifest = table::read_manifest(&results.join(format!("{name}.parquet")))
+                .unwrap()
+                .unwrap_or_else(|| panic!("results/{name}.parquet has no manifest"));
+            let number = |key: &str| manifest.summary.get(key).and_then(|v| v.as_f64());
+            match manifest.kind.as_str() {
+                "sweep" | "spacetime" => Some(format!(
+                    "`{name}` at tolerance {:e}, largest error estimate {:.1e}",
+                    number("tolerance")?,
+                    number("max_error_estimate")?
+                )),
+                "design" => Some(format!(
+                    "`{name}` best design verified at tolerance {:e}, error estimate {:.1e}",
+                    number("verify_tolerance")?,
+                    number("best_error_estimate")?
+                )),
+                _ => None,
+            }
+        })
+        .collect();
+    (!parts.is_empty()).then(|| format!("*Accuracy: {}.*", parts.join("; ")))
+}
+
+/// The README's figure captions end with the accuracy of what they draw, read from the
+/// manifests of `results/` (so a caption cannot keep a number the results no longer have).
+/// `UPDATE_DOCS=1` (`make docs`) rewrites them.
+#[test]
+fn readme_captions_state_the_accuracy_of_the_committed_results() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let pipeline = woodpile_pipeline::Pipeline::load(&root.join("pipeline")).unwrap();
+    let readme_path = root.join("README.md");
+    let readme = std::fs::read_to_string(&readme_path).unwrap();
+    let mut expected = String::new();
+    for line in readme.lines() {
+        let figure = line
+            .strip_prefix("| ![")
+            .and_then(|rest| rest.split("(figures/").nth(1))
+            .and_then(|rest| rest.split(".png)").next());
+        let rewritten = match figure.and_then(|f| accuracy_caption(&pipeline, &root.join("results"), f)) {
+            Some(caption) => {
+                let body = line.trim_end().strip_suffix('|').unwrap().trim_end();
+                let body = body.split(" *Accuracy:").next().unwrap();
+                format!("{body} {caption} |")
+            }
+            None => line.to_string(),
+        };
+        expected.push_str(&rewritten);
+        expected.push('\n');
+    }
+    if std::env::var_os("UPDATE_DOCS").is_some() {
+        std::fs::write(&readme_path, &expected).unwrap();
+    }
+    assert!(
+        readme == expected,
+        "README.md's figure captions do not state the accuracy of results/: run `make docs`"
+    );
+}

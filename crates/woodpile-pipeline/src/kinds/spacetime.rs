@@ -114,18 +114,29 @@ impl SpaceTime {
                 (vec![(Vec::new(), scene)], &[])
             }
         };
-        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> = scenes
+        // The accuracy asked for (a scene's tolerance, or its fixed step's) and the largest
+        // error estimate `auto` reported, for the manifest.
+        let tolerance = scenes
+            .first()
+            .map(|(_, scene)| scene.scenario.accuracy.tolerance);
+        let simulated: Vec<(Vec<AxisValue>, SpaceTimeField, i64, Option<f64>)> = scenes
             .into_par_iter()
             .enumerate()
             .map(|(i, (values, scene))| {
                 let model = &scene.scenario.model;
                 let mut field = SpaceTimeField::new(model, 1, 1);
-                simulate(&scene.scenario, &mut field).map_err(|e| {
+                let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;
-                Ok((values, field, scene.first_site))
+                Ok((values, field, scene.first_site, outcome.error_estimate))
             })
             .collect::<Result<_>>()?;
+        let max_error_estimate = simulated
+            .iter()
+            .filter_map(|f| f.3)
+            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> =
+            simulated.into_iter().map(|(v, f, s, _)| (v, f, s)).collect();
         let mut point = Vec::new();
         let points = fields.len();
         let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::new(); axes.len()];
@@ -170,7 +181,12 @@ impl SpaceTime {
         Ok(Output {
             failures: Vec::new(),
             frame: columns.into_frame()?,
-            summary: json!({"points": points, "sites": self.sites}),
+            summary: json!({
+                "points": points,
+                "sites": self.sites,
+                "tolerance": tolerance,
+                "max_error_estimate": max_error_estimate,
+            }),
         })
     }
 }

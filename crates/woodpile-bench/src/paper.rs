@@ -1,0 +1,180 @@
+//! The paper-level comparison of `make bench`: a seeded sample of the sweeps' own scenes (F4,
+//! F7 coarse, F7 fine), woodpile at the pipeline's settings (each sweep's `auto` tolerance and
+//! sample interval) against `baseline/rk4_numba_scenes.py` at RK4 dt = 0.01 on the full chain,
+//! one thread each, in the same run, and both sides' worst error against a tight reference
+//! (`rk4-contact` at dt = 0.001).
+
+use std::io::Write;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use woodpile_pipeline::sampling::sampled_scenes;
+use woodpile_pipeline::Pipeline;
+use woodpile_sim::energy::Fractions;
+use woodpile_sim::model::{Boundary, Coupling};
+use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance};
+
+/// The sweeps the sample is drawn from, with their labels.
+pub const PAPER_SWEEPS: &[(&str, &str)] = &[
+    ("f4_sweep", "F4"),
+    ("f7_coarse_sweep", "F7 coarse"),
+    ("f7_fine_sweep", "F7 fine"),
+];
+
+/// One side of the comparison over the whole sample.
+#[derive(Debug, Clone)]
+pub struct Side {
+    /// Who ran it, and how.
+    pub name: String,
+    /// Summed wall time over the sample, ms.
+    pub ms: f64,
+    /// Largest error of R, T or E_tr over the sample against the reference.
+    pub worst_error: f64,
+}
+
+/// The comparison's result.
+#[derive(Debug, Clone)]
+pub struct Comparison {
+    /// Scenes in the sample.
+    pub scenes: usize,
+    /// woodpile at the pipeline's settings, then at tolerance 1e-6 for every scene.
+    pub woodpile: [Side; 2],
+    /// The numba script, if it ran.
+    pub numba: Result<Side, String>,
+}
+
+/// `per_sweep` scenes of each of [`PAPER_SWEEPS`] drawn with `seed` from the stage files under
+/// `pipeline_dir`, as the pipeline runs them.
+pub fn paper_sample(
+    pipeline_dir: &str,
+    per_sweep: usize,
+    seed: u64,
+) -> Result<Vec<(String, Scenario)>, String> {
+    let pipeline = Pipeline::load(pipeline_dir.as_ref()).map_err(|e| e.to_string())?;
+    sampled_scenes(&pipeline, PAPER_SWEEPS, per_sweep, seed).map_err(|e| e.to_string())
+}
+
+/// Runs both sides over `scenes` (numba through `python3 script` when given).
+pub fn compare(scenes: &[(String, Scenario)], numba_script: Option<&str>) -> Comparison {
+    let references: Vec<Fractions> = scenes
+        .iter()
+        .map(|(name, s)| {
+            reference_fractions(s, reference_dt(&s.model))
+                .unwrap_or_else(|e| panic!("reference for {name}: {e}"))
+        })
+        .collect();
+    let at_1e6: Vec<(String, Scenario)> = scenes
+        .iter()
+        .map(|(name, s)| {
+            let scene = Scenario {
+                accuracy: tolerance(1e-6),
+                ..s.clone()
+            };
+            (name.clone(), scene)
+        })
+        .collect();
+    let woodpile = [
+        woodpile_side("woodpile, each sweep's own settings", scenes, &references),
+        woodpile_side("woodpile, tolerance 1e-6 for every scene", &at_1e6, &references),
+    ];
+    let numba = numba_script
+        .ok_or_else(|| "no --numba script".to_string())
+        .and_then(|script| numba_side(script, scenes, &references));
+    Comparison {
+        scenes: scenes.len(),
+        woodpile,
+        numba,
+    }
+}
+
+/// woodpile over the sample on this thread: summed wall time and worst error.
+fn woodpile_side(label: &str, scenes: &[(String, Scenario)], references: &[Fractions]) -> Side {
+    let mut ms = 0.0;
+    let mut worst = 0.0f64;
+    for ((name, scene), reference) in scenes.iter().zip(references) {
+        let t0 = Instant::now();
+        let out = simulate(scene, &mut ()).unwrap_or_else(|e| panic!("{name}: {e}"));
+        ms += t0.elapsed().as_secs_f64() * 1e3;
+        worst = worst.max(out.fractions.largest_difference(reference));
+    }
+    Side {
+        name: label.into(),
+        ms,
+        worst_error: worst,
+    }
+}
+
+/// The scene as the numba script reads it (linear resonators with constant couplings).
+fn numba_scene(scene: &Scenario, dt: f64) -> Result<Value, String> {
+    let model = &scene.model;
+    let res = model
+        .resonators()
+        .iter()
+        .map(|r| match (r.coupling, r.p) {
+            (Coupling::Constant(k), 1) => Ok(json!([r.site, r.eps, k])),
+            _ => Err("the numba baseline takes linear, constant couplings only".to_string()),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(json!({
+        "n": model.n_sites(),
+        "fixed": model.boundary() == Boundary::Fixed,
+        "striker": scene.impulse_site,
+        "velocity": scene.impulse_velocity,
+        "t_end": scene.t_end,
+        "dt": dt,
+        "lo": scene.region.lo(),
+        "hi": scene.region.hi(),
+        "res": res,
+    }))
+}
+
+fn numba_side(
+    script: &str,
+    scenes: &[(String, Scenario)],
+    references: &[Fractions],
+) -> Result<Side, String> {
+    let input = scenes
+        .iter()
+        .map(|(_, s)| numba_scene(s, 0.01))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut child = Command::new("python3")
+        .arg(script)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("python3 {script}: {e}"))?;
+    child
+        .stdin
+        .take()
+        .ok_or("no stdin")?
+        .write_all(Value::Array(input).to_string().as_bytes())
+        .map_err(|e| e.to_string())?;
+    let out = child.wait_with_output().map_err(|e| e.to_string())?;
+    if !out.status.success() {
+        return Err(format!(
+            "{script} failed: {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        ));
+    }
+    let v: Value = serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))?;
+    let fractions = v["fractions"].as_array().ok_or("no fractions")?;
+    let mut worst = 0.0f64;
+    for (f, reference) in fractions.iter().zip(references) {
+        let get = |k: &str| f[k].as_f64().unwrap_or(f64::NAN);
+        let numba = Fractions {
+            reflected: get("R"),
+            transmitted: get("T"),
+            trapped: get("E_tr"),
+            total: reference.total,
+        };
+        worst = worst.max(numba.largest_difference(reference));
+    }
+    Ok(Side {
+        name: "numba RK4 dt = 0.01, full chain".into(),
+        ms: v["ms"].as_f64().ok_or("no ms")?,
+        worst_error: worst,
+    })
+}
