@@ -122,6 +122,7 @@ fn readme_captions_state_the_accuracy_of_the_committed_results() {
     if std::env::var_os("UPDATE_DOCS").is_some() {
         std::fs::write(&readme_path, &expected).unwrap();
     }
+    let readme = std::fs::read_to_string(&readme_path).unwrap();
     assert!(
         readme == expected,
         "README.md's figure captions do not state the accuracy of results/: run `make docs`"

@@ -239,14 +239,22 @@ impl<const S: usize> Rkn<S> {
             let nq = &mut new_q[r.clone()];
             let nv = &mut new_v[r.clone()][..nq.len()];
             let (q0, v0) = (&q[r.clone()][..nq.len()], &v[r.clone()][..nq.len()]);
+            // An FSAL tableau's last stage position is the new position, computed by the same
+            // operations in the same order: copy it.
+            let new_q_known = self.fsal;
+            if new_q_known {
+                nq.copy_from_slice(&self.q_stage[r.clone()]);
+            }
             for k in 0..nq.len() {
-                nq[k] = q0[k] + h * v0[k];
+                if !new_q_known {
+                    nq[k] = q0[k] + h * v0[k];
+                }
                 nv[k] = v0[k];
             }
             for i in 0..S {
                 let ai = &self.a[i][r.clone()][..nq.len()];
                 let (wq, wv) = (h * h * tab.b[i], h * tab.b_prime[i]);
-                if wq != 0.0 {
+                if wq != 0.0 && !new_q_known {
                     for k in 0..nq.len() {
                         nq[k] += wq * ai[k];
                     }
