@@ -8,6 +8,9 @@
 //! ```text
 //! cargo run --release -p woodpile-bench --example auto_wide [-- SCENES [TOLERANCE]]
 //! ```
+//!
+//! With `WIDE_SCENE=K` in the environment it instead prints scene K's fractions by
+//! `rk4-contact`, `rkn6-contact` and DOP853 at several settings: how a miss is examined.
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_bench::on_two_cores;
@@ -98,10 +101,33 @@ fn main() {
         (0..n).map(|k| (k, random_scene(&mut rng, tol))).collect();
     if let Ok(k) = std::env::var("WIDE_SCENE") {
         let scene = &indexed[k.parse::<usize>().unwrap()].1;
-        for (name, dt) in [("rk4-contact", 0.001), ("rk4-contact", 0.0005), ("rk4-contact", 0.00025), ("rkn6-contact", 0.1), ("rkn6-contact", 0.05), ("rkn6-contact", 0.025), ("rkn6-contact", 0.0125), ("rkn6-contact", 0.001), ("rkn4-contact", 0.001), ("dop853", 0.0)] {
+        for (name, dt) in [
+            ("rk4-contact", 0.001),
+            ("rk4-contact", 0.0005),
+            ("rk4-contact", 0.00025),
+            ("rkn6-contact", 0.1),
+            ("rkn6-contact", 0.05),
+            ("rkn6-contact", 0.025),
+            ("rkn6-contact", 0.0125),
+            ("rkn6-contact", 0.001),
+            ("rkn4-contact", 0.001),
+            ("dop853", 0.0),
+        ] {
             let method = woodpile_sim::integrate::Method::from_name(name).unwrap();
-            let accuracy = if dt > 0.0 { woodpile_sim::testing::fixed_dt(dt) } else { tolerance(1e-10) };
-            let o = simulate(&Scenario { method: MethodChoice::Named(method), accuracy, ..scene.clone() }, &mut ()).unwrap();
+            let accuracy = if dt > 0.0 {
+                woodpile_sim::testing::fixed_dt(dt)
+            } else {
+                tolerance(1e-10)
+            };
+            let o = simulate(
+                &Scenario {
+                    method: MethodChoice::Named(method),
+                    accuracy,
+                    ..scene.clone()
+                },
+                &mut (),
+            )
+            .unwrap();
             println!("{name} {dt}: {:?}", o.fractions);
         }
         return;

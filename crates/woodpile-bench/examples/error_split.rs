@@ -155,7 +155,10 @@ fn report(group: &str, per_scene: &[&Errors]) {
         for (j, dt) in STEPS.iter().enumerate() {
             let cells: Vec<_> = per_scene.iter().map(|e| e[k][j]).collect();
             if cells.iter().any(Option::is_none) {
-                println!("| {} | {dt} | failed (drift or blow-up) | | | | |", v.label());
+                println!(
+                    "| {} | {dt} | failed (drift or blow-up) | | | | |",
+                    v.label()
+                );
                 continue;
             }
             let cells: Vec<_> = cells.into_iter().flatten().collect();
@@ -176,13 +179,14 @@ fn report(group: &str, per_scene: &[&Errors]) {
             orders.push(format!("{} {:.2}", v.label(), fitted_order(&dts, &errs)));
         }
     }
-    println!("\nOrders fitted to the worst state error: {}", orders.join(", "));
+    println!(
+        "\nOrders fitted to the worst state error: {}",
+        orders.join(", ")
+    );
 }
 
 fn main() {
-    let per_sweep: usize = std::env::args()
-        .nth(1)
-        .map_or(4, |a| a.parse().unwrap());
+    let per_sweep: usize = std::env::args().nth(1).map_or(4, |a| a.parse().unwrap());
     let mut scenes: Vec<(String, Scenario)> = vec![(
         "standard".into(),
         standard_scene(MethodChoice::Auto, tolerance(1e-6)),

@@ -135,10 +135,7 @@ fn main() {
         best_ms(repeats, || trapped(&scene)),
     );
     let auto = standard_scene(MethodChoice::Auto, tolerance(1e-7));
-    ours(
-        "auto, tolerance 1e-7",
-        best_ms(repeats, || trapped(&auto)),
-    );
+    ours("auto, tolerance 1e-7", best_ms(repeats, || trapped(&auto)));
     let scene = fixed(Method::Rk4, 0.01);
     ours(
         "rk4 dt = 0.01, full chain (no active window)",
@@ -193,7 +190,9 @@ fn main() {
     }
 
     let per_sweep: usize = option("--paper").and_then(|n| n.parse().ok()).unwrap_or(8);
-    let seed: u64 = option("--seed").and_then(|n| n.parse().ok()).unwrap_or(2026);
+    let seed: u64 = option("--seed")
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(2026);
     if per_sweep > 0 {
         paper_level(per_sweep, seed, option("--numba-scenes").as_deref());
     }

@@ -77,7 +77,11 @@ pub fn compare(scenes: &[(String, Scenario)], numba_script: Option<&str>) -> Com
         .collect();
     let woodpile = [
         woodpile_side("woodpile, each sweep's own settings", scenes, &references),
-        woodpile_side("woodpile, tolerance 1e-6 for every scene", &at_1e6, &references),
+        woodpile_side(
+            "woodpile, tolerance 1e-6 for every scene",
+            &at_1e6,
+            &references,
+        ),
     ];
     let numba = numba_script
         .ok_or_else(|| "no --numba script".to_string())

@@ -108,14 +108,15 @@ fn readme_captions_state_the_accuracy_of_the_committed_results() {
             .strip_prefix("| ![")
             .and_then(|rest| rest.split("(figures/").nth(1))
             .and_then(|rest| rest.split(".png)").next());
-        let rewritten = match figure.and_then(|f| accuracy_caption(&pipeline, &root.join("results"), f)) {
-            Some(caption) => {
-                let body = line.trim_end().strip_suffix('|').unwrap().trim_end();
-                let body = body.split(" *Accuracy:").next().unwrap();
-                format!("{body} {caption} |")
-            }
-            None => line.to_string(),
-        };
+        let rewritten =
+            match figure.and_then(|f| accuracy_caption(&pipeline, &root.join("results"), f)) {
+                Some(caption) => {
+                    let body = line.trim_end().strip_suffix('|').unwrap().trim_end();
+                    let body = body.split(" *Accuracy:").next().unwrap();
+                    format!("{body} {caption} |")
+                }
+                None => line.to_string(),
+            };
         expected.push_str(&rewritten);
         expected.push('\n');
     }

@@ -8,8 +8,8 @@
 
 use woodpile_sim::energy::{energy_density, Fractions, Region};
 use woodpile_sim::integrate::{
-    drive, Accuracy, Dop853, DriveConfig, ExplicitRk, Method, MethodChoice, Plan, Rk4, Rk4Fused,
-    ContactMode, Rkn, Rkn4, StepControl, Stepper, SymplecticStepper, DPRKN6, VERLET, YOSHIDA4,
+    drive, Accuracy, ContactMode, Dop853, DriveConfig, ExplicitRk, Method, MethodChoice, Plan, Rk4,
+    Rk4Fused, Rkn, Rkn4, StepControl, Stepper, SymplecticStepper, DPRKN6, VERLET, YOSHIDA4,
     YOSHIDA6,
 };
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
@@ -157,7 +157,10 @@ fn contact_events_beat_plain_rk4_at_every_step() {
 fn rkn6_contact_beats_rk4_contact_at_every_step() {
     let error = state_error_against_tight_run();
     for dt in [0.08, 0.04, 0.02, 0.01] {
-        let (rk4, rkn6) = (error(Method::Rk4Contact, dt), error(Method::Rkn6Contact, dt));
+        let (rk4, rkn6) = (
+            error(Method::Rk4Contact, dt),
+            error(Method::Rkn6Contact, dt),
+        );
         assert!(
             rkn6 * 10.0 < rk4,
             "dt = {dt}: rkn6-contact {rkn6:.2e}, rk4-contact {rk4:.2e}"
@@ -490,7 +493,11 @@ fn the_tableau_stepper_reproduces_rkn4_contact() {
     let (model, ..) = short_scene();
     let control = StepControl::Fixed { dt: 0.05 };
     let hand = run_state(&mut Rkn4::with_contact_events(&model), control).2;
-    let tableau = run_state(&mut Rkn::new(&model, NYSTROM4, ContactMode::Corrected), control).2;
+    let tableau = run_state(
+        &mut Rkn::new(&model, NYSTROM4, ContactMode::Corrected),
+        control,
+    )
+    .2;
     let largest = hand
         .iter()
         .zip(&tableau)
@@ -516,6 +523,10 @@ fn located_steps_cut_at_contact_events_and_converge() {
         .zip(&reference)
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
-    assert!(located.contact_events() > 100, "{} cuts", located.contact_events());
+    assert!(
+        located.contact_events() > 100,
+        "{} cuts",
+        located.contact_events()
+    );
     assert!(largest < 1e-6, "{largest:e}");
 }

@@ -135,8 +135,10 @@ impl SpaceTime {
             .iter()
             .filter_map(|f| f.3)
             .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
-        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> =
-            simulated.into_iter().map(|(v, f, s, _)| (v, f, s)).collect();
+        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> = simulated
+            .into_iter()
+            .map(|(v, f, s, _)| (v, f, s))
+            .collect();
         let mut point = Vec::new();
         let points = fields.len();
         let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::new(); axes.len()];

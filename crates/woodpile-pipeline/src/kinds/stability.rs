@@ -87,10 +87,7 @@ impl Stability {
                         .collect();
                     return Err(fields.error(
                         "methods",
-                        format!(
-                            "`{name}` is not a fixed-step method ({})",
-                            fixed.join(", ")
-                        ),
+                        format!("`{name}` is not a fixed-step method ({})", fixed.join(", ")),
                     ));
                 }
             }

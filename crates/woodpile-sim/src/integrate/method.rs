@@ -2,8 +2,8 @@
 //! and step control for one model. `method = "auto"` lives here.
 
 use super::{
-    drive, ContactMode, Dop853, Rkn, DPRKN6, DriveConfig, Observer, Rk4Fused, Rkn4, Stats, StepControl, SymplecticStepper,
-    VERLET, YOSHIDA4, YOSHIDA6,
+    drive, ContactMode, Dop853, DriveConfig, Observer, Rk4Fused, Rkn, Rkn4, Stats, StepControl,
+    SymplecticStepper, DPRKN6, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use crate::error::SimError;
 use crate::model::Model;
