@@ -229,7 +229,7 @@ pub const DRIFT_PER_TOL: f64 = 100.0;
 /// The method `auto` verifies by step halving: the sixth-order Nyström method with exact
 /// contact events. On the sweeps' own scenes its errors at dt = 0.1 are 10 to 2000 times
 /// smaller than `rk4-contact`'s (docs/performance.md, "Where the error comes from"), and over
-/// the `auto_accuracy` survey it needs 2.4 to 2.8 times fewer force evaluations than
+/// the `auto_accuracy` survey it needs 2.6 to 2.8 times fewer force evaluations than
 /// `rk4-contact` did at tolerances 1e-5 to 1e-7, with no scene missing its tolerance.
 pub const AUTO_METHOD: Method = Method::Rkn6Contact;
 
