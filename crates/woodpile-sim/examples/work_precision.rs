@@ -68,6 +68,7 @@ fn main() {
         Method::Rk4,
         Method::Rk4Contact,
         Method::Rkn4Contact,
+        Method::Rkn6Contact,
         Method::Verlet,
         Method::Yoshida4,
         Method::Yoshida6,
