@@ -3,7 +3,7 @@
 //!
 //! `method = "auto"` is verified, not trusted: it runs the calibrated step `dt` and its double
 //! `2 dt`, estimates the finer run's error by Richardson's rule for the method's observed order q
-//! (3 for `rk4-contact`, auto's method; 2.5 for the others), |F(dt) - F(2 dt)| / (2^q - 1), and
+//! (3 for `rkn6-contact`, auto's method), |F(dt) - F(2 dt)| / (2^q - 1), and
 //! accepts when that estimate is at most half the tolerance;
 //! otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
 //! without a stiffness model having to foresee them.

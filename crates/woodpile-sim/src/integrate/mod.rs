@@ -7,7 +7,8 @@
 //!
 //! Methods (see [`Method`]): RK4 (the paper's), RK4 with exact contact events (`rk4-contact`,
 //! [`contact_event`]), Nyström's three-stage order-4 method with the same events
-//! (`rkn4-contact`), Störmer–Verlet and its symplectic compositions
+//! (`rkn4-contact`), the sixth-order Nyström method RKN6 with them (`rkn6-contact`, `auto`'s;
+//! [`Rkn`] steps any Nyström tableau), Störmer–Verlet and its symplectic compositions
 //! of order 4 and 6, and the adaptive Dormand–Prince 8(5,3).
 //!
 //! Comparisons are written `!(x <= limit)` on purpose: a NaN must fail them.

@@ -384,8 +384,8 @@ mod tests {
                 let mut acc = [0.0; 6];
                 for i in 0..6 {
                     let mut qi = q + DPRKN6.c[i] * h * v;
-                    for j in 0..i {
-                        qi += h * h * DPRKN6.a[i][j] * acc[j];
+                    for (a_ij, acc_j) in DPRKN6.a[i][..i].iter().zip(&acc) {
+                        qi += h * h * a_ij * acc_j;
                     }
                     acc[i] = -qi;
                 }
