@@ -89,7 +89,7 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
             scope.spawn(|| {
                 while let Some(i) = next_job(&board, &changed, events) {
                     let stage = selection[i];
-                    let (step, outcome) = match decide(pipeline, stage, options, &store, events) {
+                    let work = || match decide(pipeline, stage, options, &store, events) {
                         Ok((step, true)) => {
                             let partial =
                                 run_stage(pipeline, stage, &step.why, options, &store, events);
@@ -98,6 +98,20 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
                         Ok((step, false)) => (Some(step), Ok(Vec::new())),
                         Err(e) => (None, Err(e)),
                     };
+                    // A stage that panics fails like any other: the worker must still report
+                    // it, or the workers waiting for it would wait forever.
+                    let (step, outcome) =
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(work))
+                            .unwrap_or_else(|panic| {
+                                let what = panic
+                                    .downcast_ref::<&str>()
+                                    .map(|s| s.to_string())
+                                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                                    .unwrap_or_default();
+                                let e =
+                                    PipelineError::stage(&stage.name, format!("panicked: {what}"));
+                                (None, Err(e))
+                            });
                     lock(&board).finish(i, step, outcome, events);
                     changed.notify_all();
                 }
