@@ -5,8 +5,8 @@
 
 use woodpile_sim::energy::{total_energy, total_momentum};
 use woodpile_sim::integrate::{
-    drive, Dop853, DriveConfig, ExplicitRk, Rk4, Rkn4, StepControl, Stepper, SymplecticStepper,
-    VERLET, YOSHIDA4, YOSHIDA6,
+    drive, ContactMode, Dop853, DriveConfig, ExplicitRk, Rk4, Rkn, Rkn4, StepControl, Stepper,
+    SymplecticStepper, DPRKN6, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Model, Window};
 use woodpile_sim::testing::{fitted_order, linear_oscillator, two_bead_collision};
@@ -26,6 +26,11 @@ fn fixed_steppers(model: &Model) -> Vec<(Box<dyn Stepper>, f64)> {
     vec![
         (Box::new(ExplicitRk::<Rk4>::new(model)), 4.0),
         (Box::new(Rkn4::new(model)), 4.0),
+        (Box::new(Rkn::new(model, DPRKN6, ContactMode::Plain)), 6.0),
+        (
+            Box::new(Rkn::new(model, DPRKN6, ContactMode::Corrected)),
+            6.0,
+        ),
         (Box::new(SymplecticStepper::new(model, VERLET)), 2.0),
         (Box::new(SymplecticStepper::new(model, YOSHIDA4)), 4.0),
         (Box::new(SymplecticStepper::new(model, YOSHIDA6)), 6.0),

@@ -25,8 +25,9 @@ use crate::model::{Model, Window};
 /// An explicit Nyström tableau of `S` stages. `a` is strictly lower triangular.
 #[derive(Debug, Clone, Copy)]
 pub struct RknTableau<const S: usize> {
-    /// Name of the plain method (the contact modes append a suffix).
-    pub name: &'static str,
+    /// The method's names, plain, with contact events corrected, and with them located (the
+    /// order of [`ContactMode`]).
+    pub names: [&'static str; 3],
     /// Stage times.
     pub c: [f64; S],
     /// Position coefficients of the stages (times h²).
@@ -44,7 +45,7 @@ pub struct RknTableau<const S: usize> {
 /// reuses it spends five evaluations a step). The coefficients involve √8581; these are their
 /// values rounded to double precision (the order conditions hold to 1e-16, tested).
 pub const DPRKN6: RknTableau<6> = RknTableau {
-    name: "rkn6",
+    names: ["rkn6", "rkn6-contact", "rkn6-located"],
     c: [
         0.0,
         0.129_295_903_136_704_42,
@@ -113,7 +114,7 @@ fn dprkn6_quadrature(f: [f64; 6], h: f64) -> (f64, f64) {
 /// Nyström's three-stage order-4 method (the one [`super::Rkn4`] hand-codes), as a tableau: the
 /// located variant of `rkn4-contact` for the comparison of contact treatments.
 pub const NYSTROM4: RknTableau<3> = RknTableau {
-    name: "rkn4",
+    names: ["rkn4", "rkn4-contact", "rkn4-located"],
     c: [0.0, 0.5, 1.0],
     a: [[0.0; 3], [0.125, 0.0, 0.0], [0.0, 0.5, 0.0]],
     b: [1.0 / 6.0, 1.0 / 3.0, 0.0],
@@ -312,7 +313,7 @@ impl<const S: usize> Rkn<S> {
 
 impl<const S: usize> Stepper for Rkn<S> {
     fn name(&self) -> &'static str {
-        self.tableau.name
+        self.tableau.names[self.mode as usize]
     }
 
     fn step(
