@@ -210,8 +210,10 @@ fn paper_level(per_sweep: usize, seed: u64, numba_script: Option<&str>) {
     let c = paper::compare(&scenes, numba_script);
     println!(
         "\npaper-level sample: {} scenes ({per_sweep} each of F4, F7 coarse, F7 fine; seed {seed}), \
-         one thread each, errors = largest of R, T, E_tr against rk4-contact at dt = 0.001\n",
-        c.scenes
+         one thread each, best of {} passes; errors = largest of R, T, E_tr against rk4-contact \
+         at dt = 0.001\n",
+        c.scenes,
+        paper::REPEATS
     );
     println!("| implementation | worst error | wall ms (sum) | time / numba |");
     println!("|---|---|---|---|");
