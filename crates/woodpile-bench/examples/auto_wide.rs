@@ -15,10 +15,10 @@
 
 use woodpile_bench::on_two_cores;
 use woodpile_sim::energy::Region;
-use woodpile_sim::integrate::MethodChoice;
+use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::run::{simulate, Scenario};
-use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance, Lcg};
+use woodpile_sim::testing::{fixed_dt, reference_dt, reference_fractions, tolerance, Lcg};
 
 fn random_scene(rng: &mut Lcg, tol: f64) -> Scenario {
     let half = 40 + (rng.uniform() * 80.0) as usize;
@@ -93,6 +93,37 @@ fn check(k: usize, scene: &Scenario, tol: f64) -> (String, bool, u64) {
     (line, error > tol, out.total_rhs_evals)
 }
 
+/// Scene `scene`'s fractions by the reference method at finer steps, by `auto`'s method over
+/// its ladder's steps, and by DOP853: whether a miss is `auto`'s or its reference's.
+fn examine(scene: &Scenario) {
+    let settings = [
+        ("rk4-contact", Some(0.001)),
+        ("rk4-contact", Some(0.0005)),
+        ("rk4-contact", Some(0.00025)),
+        ("rkn6-contact", Some(0.1)),
+        ("rkn6-contact", Some(0.05)),
+        ("rkn6-contact", Some(0.025)),
+        ("rkn6-contact", Some(0.0125)),
+        ("rkn6-contact", Some(0.001)),
+        ("rkn4-contact", Some(0.001)),
+        ("dop853", None),
+    ];
+    for (name, dt) in settings {
+        let accuracy = dt.map_or(tolerance(1e-10), fixed_dt);
+        let method = MethodChoice::Named(Method::from_name(name).unwrap());
+        let o = simulate(
+            &Scenario {
+                method,
+                accuracy,
+                ..scene.clone()
+            },
+            &mut (),
+        )
+        .unwrap();
+        println!("{name} {dt:?}: {:?}", o.fractions);
+    }
+}
+
 fn main() {
     let n: usize = std::env::args().nth(1).map_or(60, |s| s.parse().unwrap());
     let tol: f64 = std::env::args().nth(2).map_or(1e-6, |s| s.parse().unwrap());
@@ -100,36 +131,7 @@ fn main() {
     let indexed: Vec<(usize, Scenario)> =
         (0..n).map(|k| (k, random_scene(&mut rng, tol))).collect();
     if let Ok(k) = std::env::var("WIDE_SCENE") {
-        let scene = &indexed[k.parse::<usize>().unwrap()].1;
-        for (name, dt) in [
-            ("rk4-contact", 0.001),
-            ("rk4-contact", 0.0005),
-            ("rk4-contact", 0.00025),
-            ("rkn6-contact", 0.1),
-            ("rkn6-contact", 0.05),
-            ("rkn6-contact", 0.025),
-            ("rkn6-contact", 0.0125),
-            ("rkn6-contact", 0.001),
-            ("rkn4-contact", 0.001),
-            ("dop853", 0.0),
-        ] {
-            let method = woodpile_sim::integrate::Method::from_name(name).unwrap();
-            let accuracy = if dt > 0.0 {
-                woodpile_sim::testing::fixed_dt(dt)
-            } else {
-                tolerance(1e-10)
-            };
-            let o = simulate(
-                &Scenario {
-                    method: MethodChoice::Named(method),
-                    accuracy,
-                    ..scene.clone()
-                },
-                &mut (),
-            )
-            .unwrap();
-            println!("{name} {dt}: {:?}", o.fractions);
-        }
+        examine(&indexed[k.parse::<usize>().unwrap()].1);
         return;
     }
     let results: Vec<(String, bool, u64)> =
