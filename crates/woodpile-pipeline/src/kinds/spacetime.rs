@@ -28,6 +28,7 @@ use std::path::Path;
 use rayon::prelude::*;
 use serde_json::json;
 use woodpile_scene::Scene;
+use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::observe::SpaceTimeField;
 use woodpile_sim::run::simulate;
 
@@ -116,9 +117,11 @@ impl SpaceTime {
         };
         // The accuracy asked for (a scene's tolerance, or its fixed step's) and the largest
         // error estimate `auto` reported, for the manifest.
-        let tolerance = scenes
-            .first()
-            .map(|(_, scene)| scene.scenario.accuracy.tolerance);
+        let tolerance = scenes.first().and_then(|(_, scene)| {
+            let s = &scene.scenario;
+            let asked = s.method == MethodChoice::Auto || s.accuracy.tolerance_explicit;
+            asked.then_some(s.accuracy.tolerance)
+        });
         let simulated: Vec<(Vec<AxisValue>, SpaceTimeField, i64, Option<f64>)> = scenes
             .into_par_iter()
             .enumerate()
