@@ -96,6 +96,16 @@ impl Cubic {
         (out, n)
     }
 
+    /// 0, the critical points inside (0, 1) and 1: the ends of the pieces on which the cubic is
+    /// monotone (each holds at most one root), and how many there are.
+    fn monotone_knots(&self) -> ([f64; 4], usize) {
+        let (critical, n_critical) = self.critical_points();
+        let mut knots = [0.0; 4];
+        knots[1..=n_critical].copy_from_slice(&critical[..n_critical]);
+        knots[n_critical + 1] = 1.0;
+        (knots, n_critical + 2)
+    }
+
     /// The root in [a, b] of a cubic monotone there with a sign change: Newton from the
     /// secant point, kept inside a shrinking bracket (bisection when Newton leaves it).
     fn root_between(&self, mut a: f64, mut b: f64) -> f64 {
@@ -132,11 +142,8 @@ impl Cubic {
 /// crosses zero (a contact opens or closes), if any.
 pub(crate) fn first_crossing(path: &BondPath, h: f64, after: f64) -> Option<f64> {
     let cubic = Cubic::hermite(path, h);
-    let (critical, n_critical) = cubic.critical_points();
-    let mut knots = [0.0; 4];
-    knots[1..=n_critical].copy_from_slice(&critical[..n_critical]);
-    knots[n_critical + 1] = 1.0;
-    knots[..n_critical + 2].windows(2).find_map(|piece| {
+    let (knots, n_knots) = cubic.monotone_knots();
+    knots[..n_knots].windows(2).find_map(|piece| {
         let (a, b) = (piece[0].max(after), piece[1]);
         let crosses = a < b && (cubic.at(a) > 0.0) != (cubic.at(b) > 0.0);
         crosses.then(|| cubic.root_between(a, b))
@@ -147,13 +154,10 @@ pub(crate) fn first_crossing(path: &BondPath, h: f64, after: f64) -> Option<f64>
 pub(crate) fn path_integrals(path: &BondPath, h: f64) -> (f64, f64) {
     let cubic = Cubic::hermite(path, h);
     // Break points: 0, the critical points, 1; then the roots inside each monotone piece.
-    let (critical, n_critical) = cubic.critical_points();
-    let mut knots = [0.0; 4];
-    knots[1..=n_critical].copy_from_slice(&critical[..n_critical]);
-    knots[n_critical + 1] = 1.0;
+    let (knots, n_knots) = cubic.monotone_knots();
     let mut points = [0.0; 8];
     let mut n_points = 0;
-    for piece in knots[..n_critical + 2].windows(2) {
+    for piece in knots[..n_knots].windows(2) {
         let (a, b) = (piece[0], piece[1]);
         points[n_points] = a;
         n_points += 1;

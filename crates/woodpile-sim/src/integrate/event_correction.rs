@@ -298,6 +298,11 @@ pub(crate) fn finish_step<const S: usize>(
     if let Some(contact) = contact {
         contact.correct(model, (y, y_new), h, window);
     }
+    copy_window(model, (y, y_new), window);
+}
+
+/// Copies the new state `y_new` into `y` over `window` (states `[q, q']`).
+pub(crate) fn copy_window(model: &Model, (y, y_new): (&mut [f64], &[f64]), window: Window) {
     let n = model.n_dof();
     let (new_q, new_v) = y_new.split_at(n);
     let (q, v) = y.split_at_mut(n);

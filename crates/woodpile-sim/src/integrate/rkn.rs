@@ -18,7 +18,9 @@
 //! *located*: the step is cut short at the first moment any contact of the window opens or
 //! closes, so that no step contains a kink, and the next step starts there.
 
-use super::event_correction::{finish_step, stage_accelerations, ContactEvents, Quadrature};
+use super::event_correction::{
+    copy_window, finish_step, stage_accelerations, ContactEvents, Quadrature,
+};
 use super::{StepOutcome, Stepper};
 use crate::model::{Model, Window};
 
@@ -269,16 +271,6 @@ impl<const S: usize> Rkn<S> {
         }
     }
 
-    fn copy_new_state(&self, model: &Model, y: &mut [f64], window: Window) {
-        let n = model.n_dof();
-        let (new_q, new_v) = self.y_new.split_at(n);
-        let (q, v) = y.split_at_mut(n);
-        for r in window.dof_ranges(model) {
-            q[r.clone()].copy_from_slice(&new_q[r.clone()]);
-            v[r.clone()].copy_from_slice(&new_v[r]);
-        }
-    }
-
     /// The located step: sub-steps that each end at the next contact event, or at `t + h`.
     fn located_step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64, window: Window) {
         self.last_stage_current = false;
@@ -297,12 +289,12 @@ impl<const S: usize> Rkn<S> {
                 Some(x) if x < 1.0 - SAME_EVENT => {
                     let short = x * rest;
                     self.raw_step(model, t + done, y, short, window);
-                    self.copy_new_state(model, y, window);
+                    copy_window(model, (y, &self.y_new), window);
                     done += short;
                     cuts += 1;
                 }
                 _ => {
-                    self.copy_new_state(model, y, window);
+                    copy_window(model, (y, &self.y_new), window);
                     done = h;
                 }
             }
