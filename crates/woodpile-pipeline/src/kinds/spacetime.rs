@@ -122,7 +122,7 @@ impl SpaceTime {
             let asked = s.method == MethodChoice::Auto || s.accuracy.tolerance_explicit;
             asked.then_some(s.accuracy.tolerance)
         });
-        let simulated: Vec<(Vec<AxisValue>, SpaceTimeField, i64, Option<f64>)> = scenes
+        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64, Option<f64>)> = scenes
             .into_par_iter()
             .enumerate()
             .map(|(i, (values, scene))| {
@@ -134,19 +134,15 @@ impl SpaceTime {
                 Ok((values, field, scene.first_site, outcome.error_estimate))
             })
             .collect::<Result<_>>()?;
-        let max_error_estimate = simulated
+        let max_error_estimate = fields
             .iter()
             .filter_map(|f| f.3)
             .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
-        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64)> = simulated
-            .into_iter()
-            .map(|(v, f, s, _)| (v, f, s))
-            .collect();
         let mut point = Vec::new();
         let points = fields.len();
         let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::new(); axes.len()];
         let (mut t, mut site, mut velocity) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, (values, field, first)) in fields.iter().enumerate() {
+        for (i, (values, field, first, _)) in fields.iter().enumerate() {
             let n_sites = field.sites.len();
             for (k, &time) in field.t.iter().enumerate() {
                 for (j, &s) in field.sites.iter().enumerate() {
