@@ -21,7 +21,7 @@ docs: ## Regenerate docs/stage-kinds.md and the README's accuracy captions
 	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-pipeline --test docs
 
 test: ## Run the whole test suite (what CI runs; release profile, shared with `figures`)
-	$(CARGO) test --workspace --release --exclude woodpile-bench
+	$(CARGO) test --workspace --release --exclude woodpile-bench --exclude woodpile-py
 
 figures: build ## Bring every stale stage up to date (nothing runs when all are fresh)
 	$(WOODPILE) run

@@ -43,6 +43,11 @@ pub(crate) struct RunArgs {
     /// a SLURM array job the shard comes from SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT.
     #[arg(long, value_name = "I/N")]
     shard: Option<String>,
+    /// Print what ran (or would run) as one JSON object on stdout: `stages` (each with
+    /// `stage`, `runs`, `why`, `points`, `cached`), `ran`, `fresh`, `scenes_simulated`,
+    /// `seconds`. Progress still goes to stderr.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     at: Locations,
 }
@@ -86,6 +91,9 @@ pub(crate) struct StatusArgs {
     /// Exit 1 unless every stage is fresh (CI: committed results must match the stage files).
     #[arg(long)]
     check: bool,
+    /// Print the table as a JSON array of objects (`stage`, `kind`, `state`, `why`).
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     at: Locations,
 }
@@ -175,20 +183,36 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let progress = Progress::new();
     let started = std::time::Instant::now();
     let steps = run(&pipeline, &options, &progress).map_err(stage_failure)?;
-    if !args.dry_run {
-        let ran = steps.iter().filter(|s| s.runs).count();
-        let scenes: usize = steps
+    let ran = steps.iter().filter(|s| s.runs).count();
+    let scenes: usize = steps
+        .iter()
+        .filter_map(|s| s.points)
+        .map(|(n, cached)| n - cached)
+        .sum();
+    let seconds = started.elapsed().as_secs_f64();
+    if args.json {
+        let stages: Vec<serde_json::Value> = steps
             .iter()
-            .filter_map(|s| s.points)
-            .map(|(n, cached)| n - cached)
-            .sum();
-        eprintln!(
-            "woodpile run: {ran} stage(s) run, {} fresh, {scenes} scene(s) simulated, {:.1} s",
-            steps.len() - ran,
-            started.elapsed().as_secs_f64()
-        );
-    }
-    if args.dry_run {
+            .map(|s| {
+                serde_json::json!({
+                    "stage": s.stage,
+                    "runs": s.runs,
+                    "why": s.why,
+                    "points": s.points.map(|(n, _)| n),
+                    "cached": s.points.map(|(_, c)| c),
+                })
+            })
+            .collect();
+        let summary = serde_json::json!({
+            "dry_run": args.dry_run,
+            "stages": stages,
+            "ran": ran,
+            "fresh": steps.len() - ran,
+            "scenes_simulated": if args.dry_run { 0 } else { scenes },
+            "seconds": seconds,
+        });
+        say!("{summary}");
+    } else if args.dry_run {
         for step in &steps {
             let points = step
                 .points
@@ -202,6 +226,12 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
                 say!("fresh     {}", step.stage);
             }
         }
+    }
+    if !args.dry_run {
+        eprintln!(
+            "woodpile run: {ran} stage(s) run, {} fresh, {scenes} scene(s) simulated, {seconds:.1} s",
+            steps.len() - ran,
+        );
     }
     Ok(())
 }
@@ -278,18 +308,36 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
         .map(|s| s.name.len())
         .max()
         .unwrap_or(5);
-    say!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
-    let mut not_fresh = 0;
-    for stage in pipeline.stages() {
-        let st = state(&pipeline, &args.at.results, &args.at.figures, stage);
-        not_fresh += usize::from(st != State::Fresh);
-        say!(
-            "{:width$}  {:11}  {:7}  {}",
-            stage.name,
-            stage.kind,
-            st.label(),
-            st.why()
-        );
+    let states: Vec<(&woodpile_pipeline::stage::Stage, State)> = pipeline
+        .stages()
+        .iter()
+        .map(|stage| (stage, state(&pipeline, &args.at.results, &args.at.figures, stage)))
+        .collect();
+    let not_fresh = states.iter().filter(|(_, st)| *st != State::Fresh).count();
+    if args.json {
+        let rows: Vec<serde_json::Value> = states
+            .iter()
+            .map(|(stage, st)| {
+                serde_json::json!({
+                    "stage": stage.name,
+                    "kind": stage.kind,
+                    "state": st.label(),
+                    "why": st.why(),
+                })
+            })
+            .collect();
+        say!("{}", serde_json::Value::Array(rows));
+    } else {
+        say!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
+        for (stage, st) in &states {
+            say!(
+                "{:width$}  {:11}  {:7}  {}",
+                stage.name,
+                stage.kind,
+                st.label(),
+                st.why()
+            );
+        }
     }
     if args.check && not_fresh > 0 {
         return Err(Failure::new(

@@ -1,12 +1,18 @@
 //! `woodpile simulate SCENE.toml`: the contract of docs/scene.md. One JSON object on stdout, or one error
-//! on stderr and a non-zero exit.
+//! on stderr and a non-zero exit. `--series` and `--field` also write the scene's time series
+//! and its space-time field as parquet tables, sealed as pipeline tables are.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use anyhow::Context;
+use anyhow::{anyhow, Context};
 use serde_json::{json, Value};
+use woodpile_pipeline::canonical::{code_version, scene_json, Key};
+use woodpile_pipeline::manifest::Manifest;
+use woodpile_pipeline::table::{self, Columns};
+use woodpile_scene::report::simulate_report;
 use woodpile_scene::Scene;
+use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::run::{simulate, Outcome};
 
 use crate::Failure;
@@ -14,21 +20,53 @@ use crate::Failure;
 /// Arguments of `woodpile simulate`.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Args {
-    /// The scene file (TOML; see README "Scene files").
+    /// The scene file (TOML; the format is in docs/scene.md).
     scene: PathBuf,
     /// Indent the JSON for reading.
     #[arg(long)]
     pretty: bool,
+    /// Also write R, T, E_tr and E at every `run.sample_every` to this parquet file
+    /// (columns t, R, T, E_tr, E).
+    #[arg(long, value_name = "OUT.parquet")]
+    series: Option<PathBuf>,
+    /// Also write every site's displacement and velocity at every sample to this parquet file
+    /// (columns t, site, velocity, displacement; one row per sample and site).
+    #[arg(long, value_name = "OUT.parquet")]
+    field: Option<PathBuf>,
+    /// The paper sites the field keeps, inclusive (default: the whole chain).
+    #[arg(long, value_name = "LO,HI", requires = "field", allow_hyphen_values = true)]
+    sites: Option<String>,
 }
 
 pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     let scene = woodpile_scene::load(&args.scene).map_err(Failure::input)?;
+    let s = &scene.scenario;
+    let sites = field_sites(&scene, args.sites.as_deref()).map_err(Failure::input)?;
+    if args.field.is_some() {
+        SiteField::check_size(s, sites.1 - sites.0 + 1)
+            .map_err(|reason| Failure::input(anyhow!("--field: {reason}")))?;
+    }
+    let mut observers = (
+        FractionSeries::new(&s.model, s.region),
+        SiteField::new(&s.model, sites.0, sites.1),
+    );
     let started = Instant::now();
-    let outcome = simulate(&scene.scenario, &mut ())
-        .with_context(|| format!("{}: simulation failed", args.scene.display()))
-        .map_err(Failure::simulation)?;
+    let outcome = if args.series.is_some() || args.field.is_some() {
+        simulate(s, &mut observers)
+    } else {
+        simulate(s, &mut ())
+    }
+    .with_context(|| format!("{}: simulation failed", args.scene.display()))
+    .map_err(Failure::simulation)?;
     let wall_s = started.elapsed().as_secs_f64();
-    let report = report(&scene, &outcome, wall_s);
+    let report = simulate_report(&scene, &outcome, wall_s);
+    let (series, field) = observers;
+    if let Some(path) = &args.series {
+        write_series(path, &args.scene, &scene, &outcome, &series)?;
+    }
+    if let Some(path) = &args.field {
+        write_field(path, &args.scene, &scene, &outcome, &field)?;
+    }
     let text = if args.pretty {
         serde_json::to_string_pretty(&report)
     } else {
@@ -38,46 +76,96 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The JSON object: the contract's keys first, then what makes the number trustworthy and traceable.
-fn report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
-    let f = out.fractions;
-    let accuracy = scene.scenario.accuracy;
-    let mut report = json!({
-        "R": f.reflected,
-        "T": f.transmitted,
-        "E_tr": f.trapped,
-        "E_initial": out.e_initial,
-        "E_final": out.e_final,
-        "method": out.plan.method.name(),
-        "steps": out.stats.steps,
-        "wall_s": wall_s,
-        "requested_method": match scene.scenario.method {
-            woodpile_sim::integrate::MethodChoice::Auto => "auto",
-            woodpile_sim::integrate::MethodChoice::Named(m) => m.name(),
-        },
-        "dt": out.plan.dt(),
-        "tolerance": accuracy.tolerance,
-        "error_estimate": out.error_estimate,
-        "rejected_steps": out.stats.rejected,
-        "rhs_evals": out.stats.rhs_evals,
-        "site_steps": out.stats.site_steps,
-        "site_steps_full_chain": scene.scenario.model.n_sites() as u64 * (out.stats.steps + out.stats.rejected),
-        "total_rhs_evals": out.total_rhs_evals,
-        "energy_drift": if scene.scenario.model.is_time_dependent() { Value::Null } else { json!(out.stats.max_energy_drift) },
-        "energy_conserved": !scene.scenario.model.is_time_dependent(),
-        "normalisation": "E(t_end)",
-        "region": scene.region_paper,
-        "t_end": scene.scenario.t_end,
-        "version": env!("CARGO_PKG_VERSION"),
-    });
-    if let Some(p) = &scene.physical {
-        report["physical"] = json!({
-            "length_scale_m": p.scales.length_m(),
-            "time_scale_s": p.scales.time_s(),
-            "velocity_scale_m_per_s": p.scales.velocity,
-            "t_end_s": scene.scenario.t_end * p.scales.time_s(),
-            "defects": p.defects,
-        });
+/// The internal site range of `--sites LO,HI` (paper numbering), or the whole chain.
+fn field_sites(scene: &Scene, spec: Option<&str>) -> anyhow::Result<(usize, usize)> {
+    let (first, last) = (scene.first_site, scene.last_site);
+    let Some(spec) = spec else {
+        return Ok((0, (last - first) as usize));
+    };
+    let parsed = spec
+        .split_once(',')
+        .and_then(|(a, b)| Some((a.trim().parse::<i64>().ok()?, b.trim().parse::<i64>().ok()?)));
+    let Some((lo, hi)) = parsed else {
+        return Err(anyhow!("--sites `{spec}`: expected LO,HI (two paper site numbers)"));
+    };
+    if lo > hi || lo < first || hi > last {
+        return Err(anyhow!(
+            "--sites {lo},{hi}: need {first} <= LO <= HI <= {last} (the chain's paper sites)"
+        ));
     }
-    report
+    Ok(((lo - first) as usize, (hi - first) as usize))
+}
+
+/// A table's manifest: what was simulated (the resolved scene, which the key hashes) and what
+/// came of it (the JSON report, without its wall time, so the same scene writes the same bytes).
+fn manifest(what: &str, file: &Path, scene: &Scene, out: &Outcome, extra: Value) -> Manifest {
+    let params = json!({"scene": scene_json(scene), "table": what, "extra": extra});
+    let mut summary = simulate_report(scene, out, 0.0);
+    if let Value::Object(map) = &mut summary {
+        map.remove("wall_s");
+    }
+    Manifest {
+        stage: file
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned()),
+        kind: format!("simulate {what}"),
+        key: Key::of(&json!({"code": code_version(), "params": params}))
+            .as_str()
+            .to_string(),
+        code_version: code_version(),
+        params,
+        inputs: Default::default(),
+        summary,
+        checksum: None,
+    }
+}
+
+fn write_series(
+    path: &Path,
+    file: &Path,
+    scene: &Scene,
+    out: &Outcome,
+    series: &FractionSeries,
+) -> Result<(), Failure> {
+    let some = |v: &[f64]| v.iter().map(|x| Some(*x)).collect::<Vec<_>>();
+    let mut columns = Columns::new();
+    columns
+        .f64("t", some(&series.t))
+        .f64("R", some(&series.reflected))
+        .f64("T", some(&series.transmitted))
+        .f64("E_tr", some(&series.trapped))
+        .f64("E", some(&series.energy));
+    let frame = columns.into_frame().map_err(Failure::simulation)?;
+    table::write(path, frame, &manifest("series", file, scene, out, Value::Null))
+        .map_err(Failure::input)
+}
+
+fn write_field(
+    path: &Path,
+    file: &Path,
+    scene: &Scene,
+    out: &Outcome,
+    field: &SiteField,
+) -> Result<(), Failure> {
+    let width = field.width();
+    let rows = field.t.len() * width;
+    let first = scene.first_site + *field.sites().start() as i64;
+    let mut columns = Columns::new();
+    columns
+        .f64(
+            "t",
+            field.t.iter().flat_map(|t| std::iter::repeat_n(Some(*t), width)).collect(),
+        )
+        .i64(
+            "site",
+            (0..rows).map(|i| Some(first + (i % width) as i64)).collect(),
+        )
+        .f64("velocity", field.velocity.iter().map(|v| Some(*v)).collect())
+        .f64(
+            "displacement",
+            field.displacement.iter().map(|u| Some(*u)).collect(),
+        );
+    let frame = columns.into_frame().map_err(Failure::simulation)?;
+    let sites = json!([first, first + width as i64 - 1]);
+    table::write(path, frame, &manifest("field", file, scene, out, sites)).map_err(Failure::input)
 }

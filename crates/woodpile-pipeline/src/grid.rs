@@ -1,212 +1,27 @@
-//! A sweep's parameter grid: named axes, each a list or a `{ from, to, step }` range, and the
-//! Cartesian product of their values in a fixed order (axes sorted by name, the last varying
-//! fastest). Range values are computed as `from + i * step` and rounded to 12 significant
-//! digits, so `0.1 + 2 * 0.1` is the `0.3` a user typed elsewhere and two sweeps that share a
-//! value share its cached point.
+//! A sweep's parameter grid, as `woodpile_scene::grid` defines it (axes, ranges rounded to 12
+//! significant digits, the product's order), read from a stage file's `[axes]` table so that
+//! every error names the stage file and the dotted key.
+
+pub use woodpile_scene::grid::{point, point_count, Axis, AxisValue, MAX_POINTS, RESERVED};
 
 use crate::error::PipelineError;
 use crate::fields::Fields;
 
-/// One value of an axis: integers stay integers (p, L), the rest are floats.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum AxisValue {
-    /// An integer value.
-    Int(i64),
-    /// A float value.
-    Float(f64),
-}
-
-impl AxisValue {
-    /// The value as TOML, for substitution into a scene.
-    pub fn to_toml(self) -> toml::Value {
-        match self {
-            AxisValue::Int(i) => toml::Value::Integer(i),
-            AxisValue::Float(x) => toml::Value::Float(x),
-        }
-    }
-
-    /// The value as a float.
-    pub fn as_f64(self) -> f64 {
-        match self {
-            AxisValue::Int(i) => i as f64,
-            AxisValue::Float(x) => x,
-        }
-    }
-}
-
-impl std::fmt::Display for AxisValue {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            AxisValue::Int(i) => write!(f, "{i}"),
-            AxisValue::Float(x) => write!(f, "{x}"),
-        }
-    }
-}
-
-/// A named axis and its values.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Axis {
-    /// The name, used as `$name` in the scene template and as the output column.
-    pub name: String,
-    /// Integer axes hold only `Int`s, float axes only `Float`s.
-    pub values: Vec<AxisValue>,
-}
-
-impl Axis {
-    /// Whether the axis holds integers.
-    pub fn is_integer(&self) -> bool {
-        matches!(self.values.first(), Some(AxisValue::Int(_)))
-    }
-}
-
-/// Most points a single sweep may have: a hundred times the paper's largest grid (10^4). A
-/// run plans every point (about 1.4 KB each) and keeps its series, so beyond this a grid
-/// needs gigabytes before its first simulation: split it into several sweeps (or fix a typo
-/// in `step`). [`crate::sweep`] also bounds the memory of the series themselves.
-pub const MAX_POINTS: usize = 1_000_000;
-
-/// Column names an axis may not take (the sweep's own output columns).
-pub const RESERVED: &[&str] = &[
-    "point",
-    "t",
-    "R",
-    "T",
-    "E_tr",
-    "E",
-    "method",
-    "dt",
-    "steps",
-    "rhs_evals",
-    "error_estimate",
-    "energy_drift",
-    "E_initial",
-    "E_final",
-    "failure",
-    "scene_key",
-];
-
 /// Parses the `[axes]` table.
 pub(crate) fn parse_axes(mut fields: Fields<'_>) -> Result<Vec<Axis>, PipelineError> {
-    let mut axes = Vec::new();
-    for name in fields.keys() {
-        if !is_identifier(&name) || RESERVED.contains(&name.as_str()) {
-            return Err(fields.error(
-                &name,
-                format!("an axis name must be an identifier and not one of {RESERVED:?}"),
-            ));
+    let mut table = toml::Table::new();
+    for key in fields.keys() {
+        if let Some(value) = fields.take(&key) {
+            table.insert(key, value);
         }
-        let value = fields.take(&name).unwrap_or(toml::Value::Boolean(false));
-        let values = match value {
-            toml::Value::Array(items) => list(&fields, &name, items)?,
-            toml::Value::Table(table) => range(fields.nested(&name, table))?,
-            _ => {
-                return Err(fields.error(
-                    &name,
-                    "expected an array of numbers or a table { from, to, step }",
-                ))
-            }
-        };
-        axes.push(Axis { name, values });
     }
-    let total = axes
-        .iter()
-        .try_fold(1usize, |n, a| n.checked_mul(a.values.len()));
-    if !matches!(total, Some(n) if n <= MAX_POINTS) {
-        return Err(fields.error_here(format!(
-            "{} points, more than the {MAX_POINTS} a sweep may have (about 1.4 KB each to plan, plus the series); split the grid",
-            total.map_or("over 2^64".to_string(), |n| n.to_string())
-        )));
-    }
-    fields.finish()?;
-    Ok(axes)
-}
-
-fn list(
-    fields: &Fields<'_>,
-    name: &str,
-    items: Vec<toml::Value>,
-) -> Result<Vec<AxisValue>, PipelineError> {
-    if items.is_empty() {
-        return Err(fields.error(name, "an axis needs at least one value"));
-    }
-    let all_int = items.iter().all(|v| v.is_integer());
-    items
-        .into_iter()
-        .map(|v| match v {
-            toml::Value::Integer(i) if all_int => Ok(AxisValue::Int(i)),
-            toml::Value::Integer(i) => Ok(AxisValue::Float(i as f64)),
-            toml::Value::Float(x) if x.is_finite() => Ok(AxisValue::Float(x)),
-            _ => Err(fields.error(name, "expected finite numbers")),
-        })
-        .collect()
-}
-
-fn range(mut fields: Fields<'_>) -> Result<Vec<AxisValue>, PipelineError> {
-    let raw: Vec<toml::Value> = ["from", "to", "step"]
-        .iter()
-        .map(|k| fields.required::<toml::Value>(k))
-        .collect::<Result<_, _>>()?;
-    let all_int = raw.iter().all(|v| v.is_integer());
-    let num = |i: usize, key: &str| -> Result<f64, PipelineError> {
-        match raw[i] {
-            toml::Value::Integer(v) => Ok(v as f64),
-            toml::Value::Float(v) if v.is_finite() => Ok(v),
-            _ => Err(fields.error(key, "expected a number")),
+    woodpile_scene::grid::parse_axes(table).map_err(|(key, reason)| {
+        if key.is_empty() {
+            fields.error_here(reason)
+        } else {
+            fields.error(&key, reason)
         }
-    };
-    let (from, to, step) = (num(0, "from")?, num(1, "to")?, num(2, "step")?);
-    if step <= 0.0 || to < from {
-        return Err(fields.error("step", "need step > 0 and to >= from"));
-    }
-    let n = ((to - from) / step).round();
-    if n >= MAX_POINTS as f64 {
-        return Err(fields.error("step", format!("more than {MAX_POINTS} values")));
-    }
-    if (from + n * step - to).abs() > 1e-9 * step.max(to.abs()) {
-        return Err(fields.error(
-            "to",
-            format!("{to} is not from + k * step ({from} + k * {step})"),
-        ));
-    }
-    let values = (0..=n as i64)
-        .map(|i| {
-            if all_int {
-                AxisValue::Int(from as i64 + i * step as i64)
-            } else {
-                AxisValue::Float(round_sig(from + i as f64 * step))
-            }
-        })
-        .collect();
-    fields.finish()?;
-    Ok(values)
-}
-
-/// `x` rounded to 12 significant digits (through its decimal form, so it is the nearest double
-/// to what a user would type).
-fn round_sig(x: f64) -> f64 {
-    format!("{x:.11e}").parse().unwrap_or(x)
-}
-
-fn is_identifier(name: &str) -> bool {
-    let mut chars = name.chars();
-    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
-        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
-}
-
-/// The `index`-th point of the product of `axes` (last axis fastest).
-pub fn point(axes: &[Axis], mut index: usize) -> Vec<AxisValue> {
-    let mut values = vec![AxisValue::Int(0); axes.len()];
-    for (slot, axis) in values.iter_mut().zip(axes).rev() {
-        let n = axis.values.len();
-        *slot = axis.values[index % n];
-        index /= n;
-    }
-    values
-}
-
-/// Number of points in the product of `axes` (1 for no axes: a single scene).
-pub fn point_count(axes: &[Axis]) -> usize {
-    axes.iter().map(|a| a.values.len()).product()
+    })
 }
 
 #[cfg(test)]
@@ -220,31 +35,12 @@ mod tests {
     }
 
     #[test]
-    fn ranges_hit_the_decimal_values_a_user_would_type() {
-        let a = axes("eps = { from = 0.1, to = 60.0, step = 0.1 }").unwrap();
-        assert_eq!(a[0].values.len(), 600);
-        assert_eq!(a[0].values[2], AxisValue::Float(0.3));
-        assert_eq!(a[0].values[599], AxisValue::Float(60.0));
-    }
-
-    #[test]
-    fn integer_lists_and_ranges_stay_integer() {
-        let a = axes("L = [0, 2]\np = { from = 3, to = 19, step = 2 }").unwrap();
-        assert!(a[0].is_integer() && a[1].is_integer());
-        assert_eq!(a[1].values.len(), 9);
-        assert_eq!(point(&a, 0), vec![AxisValue::Int(0), AxisValue::Int(3)]);
-        assert_eq!(point(&a, 10), vec![AxisValue::Int(2), AxisValue::Int(5)]);
-        assert_eq!(point_count(&a), 18);
-    }
-
-    #[test]
-    fn bad_axes_name_their_key() {
+    fn errors_name_the_file_and_the_dotted_key() {
         let msg = |t: &str| axes(t).unwrap_err().to_string();
-        assert!(msg("eps = { from = 0.1, to = 1.05, step = 0.1 }").contains("axes.eps.to"));
-        assert!(msg("eps = { from = 0.1, to = 1.0 }").contains("axes.eps.step"));
+        assert!(msg("eps = { from = 0.1, to = 1.05, step = 0.1 }").contains("s.toml: key `axes.eps.to`"));
         assert!(msg("eps = { from = 1, to = 2, step = 1, by = 3 }").contains("axes.eps.by"));
         assert!(msg("t = [1.0]").contains("axes.t"));
-        assert!(msg("eps = []").contains("at least one"));
-        assert!(msg("eps = \"x\"").contains("axes.eps"));
+        assert!(msg("a = [1, 2]\nb = { from = 1, to = 1000000, step = 1 }").contains("key `axes`"));
+        assert_eq!(axes("eps = [0.5, 1]").unwrap()[0].values.len(), 2);
     }
 }

@@ -42,9 +42,9 @@ pub mod slurm;
 pub mod stage;
 pub mod status;
 pub mod table;
-pub mod template;
 
 pub use error::{PipelineError, Result};
+pub use woodpile_scene::template;
 pub use kinds::{
     approximate, design, fit, optimize, reduce, render, report, spacetime, stability, sweep,
     workprecision,

@@ -6,8 +6,11 @@
 //! reason.
 #![warn(missing_docs)]
 
+pub mod grid;
 mod raw;
+pub mod report;
 mod resolve;
+pub mod template;
 
 pub use resolve::{DerivedDefect, Physical, Scene};
 

@@ -122,6 +122,12 @@ pub enum SimError {
         /// Last (finest) step tried.
         dt: f64,
     },
+    /// The observer asked for the run to stop (see `Observer::cancelled`).
+    #[error("cancelled at t = {t:.6}")]
+    Cancelled {
+        /// Time of the sample at which the run stopped.
+        t: f64,
+    },
     /// A run setting (t_end, dt, tolerance, sample interval) is invalid.
     #[error("invalid run setting: {0}")]
     BadRun(String),

@@ -5,9 +5,12 @@
 //! - [`FractionSeries::kinetic`]: kinetic-energy fractions normalised by the impact energy, as
 //!   the woodpile experiment measures them (paper Fig. 2 c, f).
 //! - [`SpaceTimeField`]: a decimated site-by-time velocity map (paper Figs. 3, 8, 10).
+//! - [`SiteField`]: displacements and velocities of a range of sites at every sample, in full
+//!   precision (one scene's field for analysis, `woodpile simulate --field`, Python's `fields`).
 
 use crate::energy::{energy_density, kinetic_density, Fractions, Region};
-use crate::integrate::Observer;
+use crate::integrate::{intervals, Observer};
+use crate::run::Scenario;
 use crate::model::Model;
 
 /// Which energy a [`FractionSeries`] splits.
@@ -151,6 +154,79 @@ impl Observer for SpaceTimeField {
     }
 }
 
+/// Displacements u_n(t) and velocities u_n'(t) of the sites `first..=last` (internal
+/// indices) at every sample, as f64, row-major (time × site): what a user analyses, where
+/// [`SpaceTimeField`] is what a figure draws. Each sample appends one row to two flat
+/// vectors, so the arrays can be handed on whole, without a copy per sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SiteField {
+    first: usize,
+    last: usize,
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// Displacements: `displacement[i * width + k]` is site `first + k` at `t[i]`.
+    pub displacement: Vec<f64>,
+    /// Velocities, laid out as `displacement`.
+    pub velocity: Vec<f64>,
+}
+
+impl SiteField {
+    /// A field of the sites `first..=last` of `model`, clamped to the chain.
+    pub fn new(model: &Model, first: usize, last: usize) -> Self {
+        let top = model.n_sites().saturating_sub(1);
+        let last = last.min(top);
+        Self {
+            first: first.min(last),
+            last,
+            t: Vec::new(),
+            displacement: Vec::new(),
+            velocity: Vec::new(),
+        }
+    }
+
+    /// The internal indices of the sites kept.
+    pub fn sites(&self) -> std::ops::RangeInclusive<usize> {
+        self.first..=self.last
+    }
+
+    /// Number of sites kept per sample.
+    pub fn width(&self) -> usize {
+        self.last - self.first + 1
+    }
+
+    /// Refuses, before the run, a field of more than [`MAX_FIELD_VALUES`] values per array:
+    /// `width` sites at every sample of `scenario`. The reason names the sizes.
+    pub fn check_size(scenario: &Scenario, width: usize) -> Result<(), String> {
+        let samples = intervals(scenario.t_end, scenario.sample_every) + 1;
+        let values = samples.saturating_mul(width as u64);
+        if values > MAX_FIELD_VALUES {
+            return Err(format!(
+                "a field of {width} sites at {samples} samples is {values} values per array, more than the {MAX_FIELD_VALUES} it may have; keep fewer sites or sample less often"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Most values a [`SiteField`] array may hold (160 MB of f64 each for displacement and
+/// velocity): a thousand times the paper's largest map.
+pub const MAX_FIELD_VALUES: u64 = 20_000_000;
+
+impl Observer for SiteField {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        let (q, v) = y.split_at(model.n_dof());
+        self.t.push(t);
+        self.displacement.extend_from_slice(&q[self.sites()]);
+        self.velocity.extend_from_slice(&v[self.sites()]);
+    }
+
+    fn reset(&mut self) {
+        self.t.clear();
+        self.displacement.clear();
+        self.velocity.clear();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,5 +299,53 @@ mod tests {
         assert_eq!(moving, usize::from(75 % 4 == 0));
         field.reset();
         assert!(field.t.is_empty() && field.velocity.is_empty());
+    }
+
+    /// The site field keeps every sample of its sites in full precision: the same velocities
+    /// as the decimated f32 map, the displacements of the final state at t_end.
+    #[test]
+    fn site_field_keeps_its_sites_at_every_sample() {
+        let s = scene();
+        let mut both = (SiteField::new(&s.model, 70, 80), SpaceTimeField::new(&s.model, 1, 1));
+        let out = simulate(&s, &mut both).unwrap();
+        let (field, map) = both;
+        assert_eq!(field.width(), 11);
+        assert_eq!(field.t, map.t);
+        assert_eq!(field.velocity.len(), 61 * 11);
+        for (i, row) in field.velocity.chunks(11).enumerate() {
+            for (k, v) in row.iter().enumerate() {
+                assert_eq!(*v as f32, map.velocity[i * 201 + 70 + k]);
+            }
+        }
+        let last_row = &field.displacement[60 * 11..];
+        assert_eq!(last_row, &out.final_state[70..=80]);
+        // Only the impulse site (index 75) moves at t = 0.
+        assert_eq!(field.velocity[5], 1.0);
+        assert_eq!(field.velocity[..11].iter().filter(|v| **v != 0.0).count(), 1);
+    }
+
+    /// An observer that asks to stop ends the run at the next sample, `auto`'s verification
+    /// runs included, with `Cancelled` rather than numbers.
+    #[test]
+    fn a_cancelled_run_stops_at_the_next_sample() {
+        struct StopAfter(usize, usize);
+        impl Observer for StopAfter {
+            fn observe(&mut self, _: &Model, _: f64, _: &[f64]) {
+                self.0 += 1;
+            }
+            fn reset(&mut self) {}
+            fn cancelled(&self) -> bool {
+                self.0 >= self.1
+            }
+        }
+        let mut s = scene();
+        let mut stop = StopAfter(0, 5);
+        let err = simulate(&s, &mut stop).unwrap_err();
+        assert!(matches!(err, crate::SimError::Cancelled { t } if t == 4.0), "{err:?}");
+        s.method = MethodChoice::Auto;
+        let mut stop = StopAfter(0, 0);
+        let err = simulate(&s, &mut stop).unwrap_err();
+        // The coarse verification run is the first to see the request, at its first sample.
+        assert!(matches!(err, crate::SimError::Cancelled { t } if t == 1.0), "{err:?}");
     }
 }

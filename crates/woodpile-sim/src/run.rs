@@ -11,7 +11,7 @@
 use crate::energy::{energy_density, Fractions, Region};
 use crate::error::SimError;
 use crate::integrate::{
-    Accuracy, MethodChoice, Observer, Plan, Stats, BLOW_UP_DRIFT, DRIFT_PER_TOL,
+    Accuracy, CancelOnly, MethodChoice, Observer, Plan, Stats, BLOW_UP_DRIFT, DRIFT_PER_TOL,
 };
 use crate::model::Model;
 
@@ -97,7 +97,7 @@ fn verified<O: Observer + ?Sized>(
     };
     let mut dt = auto_first_step(scenario, &plan);
     let mut spent = 0;
-    let mut coarse = match run_plan(scenario, &guarded.with_dt(2.0 * dt), &mut ()) {
+    let mut coarse = match run_plan(scenario, &guarded.with_dt(2.0 * dt), &mut CancelOnly(&*observer)) {
         Ok(out) => {
             spent += out.stats.rhs_evals;
             Some(out)

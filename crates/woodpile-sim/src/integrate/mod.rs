@@ -82,6 +82,13 @@ pub trait Observer {
 
     /// Forgets everything recorded: a run is being repeated (the `auto` verification ladder).
     fn reset(&mut self);
+
+    /// Whether whoever asked for the run no longer wants it (Ctrl-C in a Python session, a
+    /// sweep being stopped). Asked at every sample, so a run stops within one sample
+    /// interval with [`SimError::Cancelled`] instead of running to `t_end`.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 impl Observer for () {
@@ -97,6 +104,21 @@ impl<A: Observer, B: Observer> Observer for (A, B) {
     fn reset(&mut self) {
         self.0.reset();
         self.1.reset();
+    }
+    fn cancelled(&self) -> bool {
+        self.0.cancelled() || self.1.cancelled()
+    }
+}
+
+/// Records nothing but passes on whether `O` wants the run stopped: the observer of runs
+/// whose samples nobody keeps (`auto`'s verification runs), which must stop all the same.
+pub struct CancelOnly<'a, O: ?Sized>(pub &'a O);
+
+impl<O: Observer + ?Sized> Observer for CancelOnly<'_, O> {
+    fn observe(&mut self, _: &Model, _: f64, _: &[f64]) {}
+    fn reset(&mut self) {}
+    fn cancelled(&self) -> bool {
+        self.0.cancelled()
     }
 }
 
@@ -328,6 +350,9 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
             }
         }
         observer.observe(model, t, y);
+        if observer.cancelled() {
+            return Err(SimError::Cancelled { t });
+        }
     }
     stats.rhs_evals = stepper.rhs_evals();
     Ok(stats)

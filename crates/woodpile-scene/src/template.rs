@@ -1,4 +1,4 @@
-//! A sweep's scene template: a scene in the `woodpile simulate` format (README "Scene files")
+//! A sweep's scene template: a scene in the `woodpile simulate` format (docs/scene.md)
 //! where any value may be a placeholder `"$name"` for an axis, plus one pipeline-only key,
 //! `defect[i].through`, which repeats a defect on every site from `site` to `through`
 //! (the paper's block of adjacent defects 0..L is `site = 0, through = "$L"`).

@@ -1,0 +1,254 @@
+//! A sweep's parameter grid: named axes, each a list or a `{ from, to, step }` range, and the
+//! Cartesian product of their values in a fixed order (axes sorted by name, the last varying
+//! fastest). Range values are computed as `from + i * step` and rounded to 12 significant
+//! digits, so `0.1 + 2 * 0.1` is the `0.3` a user typed elsewhere and two sweeps that share a
+//! value share its cached point.
+
+/// One value of an axis: integers stay integers (p, L), the rest are floats.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AxisValue {
+    /// An integer value.
+    Int(i64),
+    /// A float value.
+    Float(f64),
+}
+
+impl AxisValue {
+    /// The value as TOML, for substitution into a scene.
+    pub fn to_toml(self) -> toml::Value {
+        match self {
+            AxisValue::Int(i) => toml::Value::Integer(i),
+            AxisValue::Float(x) => toml::Value::Float(x),
+        }
+    }
+
+    /// The value as a float.
+    pub fn as_f64(self) -> f64 {
+        match self {
+            AxisValue::Int(i) => i as f64,
+            AxisValue::Float(x) => x,
+        }
+    }
+}
+
+impl std::fmt::Display for AxisValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AxisValue::Int(i) => write!(f, "{i}"),
+            AxisValue::Float(x) => write!(f, "{x}"),
+        }
+    }
+}
+
+/// A named axis and its values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// The name, used as `$name` in the scene template and as the output column.
+    pub name: String,
+    /// Integer axes hold only `Int`s, float axes only `Float`s.
+    pub values: Vec<AxisValue>,
+}
+
+impl Axis {
+    /// Whether the axis holds integers.
+    pub fn is_integer(&self) -> bool {
+        matches!(self.values.first(), Some(AxisValue::Int(_)))
+    }
+}
+
+/// Most points a single sweep may have: a hundred times the paper's largest grid (10^4). A
+/// run plans every point (about 1.4 KB each) and keeps its series, so beyond this a grid
+/// needs gigabytes before its first simulation: split it into several sweeps (or fix a typo
+/// in `step`). The pipeline's sweep also bounds the memory of the series themselves.
+pub const MAX_POINTS: usize = 1_000_000;
+
+/// Column names an axis may not take (the sweep's own output columns).
+pub const RESERVED: &[&str] = &[
+    "point",
+    "t",
+    "R",
+    "T",
+    "E_tr",
+    "E",
+    "method",
+    "dt",
+    "steps",
+    "rhs_evals",
+    "error_estimate",
+    "energy_drift",
+    "E_initial",
+    "E_final",
+    "failure",
+    "scene_key",
+];
+
+/// `(dotted key relative to the axes table, reason)`; an empty key is the table as a whole.
+/// The caller knows the file and where the table sits.
+pub type AxisError = (String, String);
+
+/// Parses an `[axes]` table: each key an axis name, each value a list of numbers or a range
+/// `{ from, to, step }`; the product may have at most [`MAX_POINTS`] points.
+pub fn parse_axes(table: toml::Table) -> Result<Vec<Axis>, AxisError> {
+    let mut axes = Vec::new();
+    for (name, value) in table {
+        if !is_identifier(&name) || RESERVED.contains(&name.as_str()) {
+            return Err((
+                name,
+                format!("an axis name must be an identifier and not one of {RESERVED:?}"),
+            ));
+        }
+        let values = match value {
+            toml::Value::Array(items) => list(&name, items)?,
+            toml::Value::Table(table) => range(table)
+                .map_err(|(key, reason)| (format!("{name}.{key}"), reason))?,
+            _ => {
+                return Err((
+                    name,
+                    "expected an array of numbers or a table { from, to, step }".into(),
+                ))
+            }
+        };
+        axes.push(Axis { name, values });
+    }
+    let total = axes
+        .iter()
+        .try_fold(1usize, |n, a| n.checked_mul(a.values.len()));
+    if !matches!(total, Some(n) if n <= MAX_POINTS) {
+        return Err((String::new(), format!(
+            "{} points, more than the {MAX_POINTS} a sweep may have (about 1.4 KB each to plan, plus the series); split the grid",
+            total.map_or("over 2^64".to_string(), |n| n.to_string())
+        )));
+    }
+    Ok(axes)
+}
+
+fn list(name: &str, items: Vec<toml::Value>) -> Result<Vec<AxisValue>, AxisError> {
+    let error = |reason: &str| (name.to_string(), reason.to_string());
+    if items.is_empty() {
+        return Err(error("an axis needs at least one value"));
+    }
+    let all_int = items.iter().all(|v| v.is_integer());
+    items
+        .into_iter()
+        .map(|v| match v {
+            toml::Value::Integer(i) if all_int => Ok(AxisValue::Int(i)),
+            toml::Value::Integer(i) => Ok(AxisValue::Float(i as f64)),
+            toml::Value::Float(x) if x.is_finite() => Ok(AxisValue::Float(x)),
+            _ => Err(error("expected finite numbers")),
+        })
+        .collect()
+}
+
+/// A `{ from, to, step }` table; error keys are relative to it.
+fn range(mut table: toml::Table) -> Result<Vec<AxisValue>, AxisError> {
+    let error = |key: &str, reason: String| (key.to_string(), reason);
+    let raw: Vec<toml::Value> = ["from", "to", "step"]
+        .iter()
+        .map(|k| {
+            table
+                .remove(*k)
+                .ok_or_else(|| error(k, "missing (expected a value)".into()))
+        })
+        .collect::<Result<_, _>>()?;
+    if let Some(key) = table.keys().next() {
+        return Err(error(key, "unknown key".into()));
+    }
+    let all_int = raw.iter().all(|v| v.is_integer());
+    let num = |i: usize, key: &str| -> Result<f64, AxisError> {
+        match raw[i] {
+            toml::Value::Integer(v) => Ok(v as f64),
+            toml::Value::Float(v) if v.is_finite() => Ok(v),
+            _ => Err(error(key, "expected a number".into())),
+        }
+    };
+    let (from, to, step) = (num(0, "from")?, num(1, "to")?, num(2, "step")?);
+    if step <= 0.0 || to < from {
+        return Err(error("step", "need step > 0 and to >= from".into()));
+    }
+    let n = ((to - from) / step).round();
+    if n >= MAX_POINTS as f64 {
+        return Err(error("step", format!("more than {MAX_POINTS} values")));
+    }
+    if (from + n * step - to).abs() > 1e-9 * step.max(to.abs()) {
+        return Err(error(
+            "to",
+            format!("{to} is not from + k * step ({from} + k * {step})"),
+        ));
+    }
+    let values = (0..=n as i64)
+        .map(|i| {
+            if all_int {
+                AxisValue::Int(from as i64 + i * step as i64)
+            } else {
+                AxisValue::Float(round_sig(from + i as f64 * step))
+            }
+        })
+        .collect();
+    Ok(values)
+}
+
+/// `x` rounded to 12 significant digits (through its decimal form, so it is the nearest double
+/// to what a user would type).
+fn round_sig(x: f64) -> f64 {
+    format!("{x:.11e}").parse().unwrap_or(x)
+}
+
+fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// The `index`-th point of the product of `axes` (last axis fastest).
+pub fn point(axes: &[Axis], mut index: usize) -> Vec<AxisValue> {
+    let mut values = vec![AxisValue::Int(0); axes.len()];
+    for (slot, axis) in values.iter_mut().zip(axes).rev() {
+        let n = axis.values.len();
+        *slot = axis.values[index % n];
+        index /= n;
+    }
+    values
+}
+
+/// Number of points in the product of `axes` (1 for no axes: a single scene).
+pub fn point_count(axes: &[Axis]) -> usize {
+    axes.iter().map(|a| a.values.len()).product()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn axes(text: &str) -> Result<Vec<Axis>, AxisError> {
+        parse_axes(toml::from_str(text).unwrap())
+    }
+
+    #[test]
+    fn ranges_hit_the_decimal_values_a_user_would_type() {
+        let a = axes("eps = { from = 0.1, to = 60.0, step = 0.1 }").unwrap();
+        assert_eq!(a[0].values.len(), 600);
+        assert_eq!(a[0].values[2], AxisValue::Float(0.3));
+        assert_eq!(a[0].values[599], AxisValue::Float(60.0));
+    }
+
+    #[test]
+    fn integer_lists_and_ranges_stay_integer() {
+        let a = axes("L = [0, 2]\np = { from = 3, to = 19, step = 2 }").unwrap();
+        assert!(a[0].is_integer() && a[1].is_integer());
+        assert_eq!(a[1].values.len(), 9);
+        assert_eq!(point(&a, 0), vec![AxisValue::Int(0), AxisValue::Int(3)]);
+        assert_eq!(point(&a, 10), vec![AxisValue::Int(2), AxisValue::Int(5)]);
+        assert_eq!(point_count(&a), 18);
+    }
+
+    #[test]
+    fn bad_axes_name_their_key() {
+        let key = |t: &str| axes(t).unwrap_err().0;
+        assert_eq!(key("eps = { from = 0.1, to = 1.05, step = 0.1 }"), "eps.to");
+        assert_eq!(key("eps = { from = 0.1, to = 1.0 }"), "eps.step");
+        assert_eq!(key("eps = { from = 1, to = 2, step = 1, by = 3 }"), "eps.by");
+        assert_eq!(key("t = [1.0]"), "t");
+        assert!(axes("eps = []").unwrap_err().1.contains("at least one"));
+        assert_eq!(key("eps = \"x\""), "eps");
+    }
+}

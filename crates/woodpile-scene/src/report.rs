@@ -1,0 +1,53 @@
+//! The JSON object of `woodpile simulate` (docs/scene.md): one scene's outcome, the contract's
+//! keys first, then what makes the numbers trustworthy and traceable. The CLI prints it and
+//! the Python package's `as_dict()` returns it, so the two can never disagree.
+
+use serde_json::{json, Value};
+use woodpile_sim::integrate::MethodChoice;
+use woodpile_sim::run::Outcome;
+
+use crate::Scene;
+
+/// The report of `scene`'s `outcome`, which took `wall_s` seconds.
+pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
+    let f = out.fractions;
+    let scenario = &scene.scenario;
+    let mut report = json!({
+        "R": f.reflected,
+        "T": f.transmitted,
+        "E_tr": f.trapped,
+        "E_initial": out.e_initial,
+        "E_final": out.e_final,
+        "method": out.plan.method.name(),
+        "steps": out.stats.steps,
+        "wall_s": wall_s,
+        "requested_method": match scenario.method {
+            MethodChoice::Auto => "auto",
+            MethodChoice::Named(m) => m.name(),
+        },
+        "dt": out.plan.dt(),
+        "tolerance": scenario.accuracy.tolerance,
+        "error_estimate": out.error_estimate,
+        "rejected_steps": out.stats.rejected,
+        "rhs_evals": out.stats.rhs_evals,
+        "site_steps": out.stats.site_steps,
+        "site_steps_full_chain": scenario.model.n_sites() as u64 * (out.stats.steps + out.stats.rejected),
+        "total_rhs_evals": out.total_rhs_evals,
+        "energy_drift": if scenario.model.is_time_dependent() { Value::Null } else { json!(out.stats.max_energy_drift) },
+        "energy_conserved": !scenario.model.is_time_dependent(),
+        "normalisation": "E(t_end)",
+        "region": scene.region_paper,
+        "t_end": scenario.t_end,
+        "version": env!("CARGO_PKG_VERSION"),
+    });
+    if let Some(p) = &scene.physical {
+        report["physical"] = json!({
+            "length_scale_m": p.scales.length_m(),
+            "time_scale_s": p.scales.time_s(),
+            "velocity_scale_m_per_s": p.scales.velocity,
+            "t_end_s": scenario.t_end * p.scales.time_s(),
+            "defects": p.defects,
+        });
+    }
+    report
+}

@@ -1,0 +1,40 @@
+//! `woodpile._core`: the native half of the Python package. It turns Python values into scenes
+//! (`scene_input`), simulates one scene with its series and field (`simulate`) or a grid of them
+//! on every core (`sweep`), always on a worker thread that Ctrl-C can stop (`interrupt`), and
+//! hands results back as NumPy arrays without a copy per sample. The typed, documented API is
+//! the pure-Python `woodpile` package around it.
+
+mod interrupt;
+mod scene_input;
+mod simulate;
+mod sweep;
+
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    woodpile,
+    SceneError,
+    pyo3::exceptions::PyValueError,
+    "A scene (or sweep axes) that cannot be used: the message names the source (file, <dict> or <string>), the key and the reason, as `woodpile simulate` does."
+);
+pyo3::create_exception!(
+    woodpile,
+    SimulationError,
+    pyo3::exceptions::PyRuntimeError,
+    "A simulation that failed (blow-up, energy drift, tolerance out of reach, over budget): never numbers."
+);
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The clone this module was built from: where `Pipeline` finds (or builds) the `woodpile`
+    // command that runs stages, so that `pip install ./python` alone is enough.
+    m.add("SOURCE_DIR", concat!(env!("CARGO_MANIFEST_DIR"), "/.."))?;
+    Ok(())
+}

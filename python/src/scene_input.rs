@@ -1,0 +1,179 @@
+//! A scene as Python users hold it: a dict with the scene file's keys, a TOML string, or a path
+//! (`str` or `os.PathLike`). Dicts are turned into TOML tables value by value, so a dict and
+//! the file it mirrors give the same scene and the same errors (named `<dict>` instead of the
+//! file).
+
+use std::path::{Path, PathBuf};
+
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use woodpile_scene::Scene;
+
+use crate::SceneError;
+
+/// Where a scene comes from.
+pub(crate) enum Source {
+    /// A scene file.
+    File(PathBuf),
+    /// TOML text.
+    Text(String),
+    /// A dict, already a TOML table.
+    Table(toml::Table),
+}
+
+/// How errors name a source that is not a file.
+const DICT: &str = "<dict>";
+const STRING: &str = "<string>";
+
+impl Source {
+    /// Reads `obj`: a dict, an `os.PathLike`, or a `str` that is TOML text when it holds a
+    /// newline or an `=` and a path otherwise.
+    pub(crate) fn of(obj: &Bound<'_, PyAny>) -> PyResult<Source> {
+        if let Ok(dict) = obj.cast::<PyDict>() {
+            return Ok(Source::Table(table(dict, "")?));
+        }
+        if let Ok(text) = obj.cast::<PyString>() {
+            let text: String = text.extract()?;
+            return Ok(if text.contains('\n') || text.contains('=') {
+                Source::Text(text)
+            } else {
+                Source::File(PathBuf::from(text))
+            });
+        }
+        if obj.hasattr("__fspath__")? {
+            return Ok(Source::File(obj.call_method0("__fspath__")?.extract()?));
+        }
+        Err(SceneError::new_err(format!(
+            "a scene is a dict, a TOML string or a path, not {}",
+            obj.get_type().name()?
+        )))
+    }
+
+    /// The name errors give this source.
+    pub(crate) fn label(&self) -> PathBuf {
+        match self {
+            Source::File(path) => path.clone(),
+            Source::Text(_) => PathBuf::from(STRING),
+            Source::Table(_) => PathBuf::from(DICT),
+        }
+    }
+
+    /// The validated scene, with the CLI's error messages.
+    pub(crate) fn scene(self) -> PyResult<Scene> {
+        let label = self.label();
+        match self {
+            Source::File(path) => woodpile_scene::load(&path),
+            Source::Text(text) => woodpile_scene::parse(&text, &label),
+            Source::Table(table) => woodpile_scene::from_table(table, &label),
+        }
+        .map_err(|e| SceneError::new_err(e.to_string()))
+    }
+
+    /// The source as a TOML table, not yet validated (a sweep's template).
+    pub(crate) fn table(self) -> PyResult<toml::Table> {
+        let label = self.label();
+        let text = match self {
+            Source::Table(table) => return Ok(table),
+            Source::Text(text) => text,
+            Source::File(path) => woodpile_scene::read_input(&path).map_err(|reason| {
+                SceneError::new_err(format!("{}: cannot read: {reason}", path.display()))
+            })?,
+        };
+        toml::from_str(&text).map_err(|e| {
+            SceneError::new_err(format!("{}: {}", label.display(), e.to_string().trim_end()))
+        })
+    }
+}
+
+/// An error about `key` of a dict, in the scene errors' form.
+fn key_error(key: &str, reason: &str) -> PyErr {
+    SceneError::new_err(format!("{DICT}: key `{key}`: {reason}"))
+}
+
+fn join(prefix: &str, key: &str) -> String {
+    if prefix.is_empty() {
+        key.to_string()
+    } else {
+        format!("{prefix}.{key}")
+    }
+}
+
+/// A dict as a TOML table; `prefix` is its dotted key, for errors.
+pub(crate) fn table(dict: &Bound<'_, PyDict>, prefix: &str) -> PyResult<toml::Table> {
+    let mut out = toml::Table::new();
+    for (key, value) in dict.iter() {
+        let Ok(key) = key.extract::<String>() else {
+            return Err(key_error(prefix, "keys must be strings"));
+        };
+        let path = join(prefix, &key);
+        out.insert(key, value_of(&value, &path)?);
+    }
+    Ok(out)
+}
+
+/// A Python value as a TOML value: bool, int, float, str, dict, list or tuple, and anything
+/// with `tolist()` (NumPy arrays) or `__index__`/`__float__` (NumPy scalars).
+fn value_of(value: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
+    if value.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(value.extract()?));
+    }
+    if value.is_instance_of::<PyInt>() {
+        return value
+            .extract::<i64>()
+            .map(toml::Value::Integer)
+            .map_err(|_| key_error(path, "integer out of range"));
+    }
+    if value.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(value.extract()?));
+    }
+    if let Ok(s) = value.cast::<PyString>() {
+        return Ok(toml::Value::String(s.extract()?));
+    }
+    if let Ok(dict) = value.cast::<PyDict>() {
+        return Ok(toml::Value::Table(table(dict, path)?));
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items = value
+            .try_iter()?
+            .enumerate()
+            .map(|(i, item)| value_of(&item?, &format!("{path}[{i}]")))
+            .collect::<PyResult<Vec<_>>>()?;
+        return Ok(toml::Value::Array(items));
+    }
+    if value.hasattr("tolist")? {
+        let list = value.call_method0("tolist")?;
+        if !list.is(value) {
+            return value_of(&list, path);
+        }
+    }
+    if value.hasattr("__index__")? {
+        if let Ok(i) = value.extract::<i64>() {
+            return Ok(toml::Value::Integer(i));
+        }
+    }
+    if value.hasattr("__float__")? {
+        if let Ok(x) = value.extract::<f64>() {
+            return Ok(toml::Value::Float(x));
+        }
+    }
+    let type_name = value.get_type().name()?;
+    Err(key_error(
+        path,
+        &format!("a {type_name} has no TOML form (expected a number, string, bool, list or dict)"),
+    ))
+}
+
+/// scene_toml(scene) -> str
+/// --
+///
+/// The scene (a dict, TOML string or path) as the text of a scene file.
+#[pyfunction]
+pub(crate) fn scene_toml(scene: &Bound<'_, PyAny>) -> PyResult<String> {
+    let table = Source::of(scene)?.table()?;
+    toml::to_string(&table).map_err(|e| SceneError::new_err(e.to_string()))
+}
+
+/// The label's display form, for messages built outside this module.
+pub(crate) fn shown(label: &Path) -> String {
+    label.display().to_string()
+}

@@ -1,0 +1,118 @@
+//! `simulate`: one scene, its JSON report (the CLI's), its fraction series and optionally its
+//! field, as NumPy arrays that take over the simulator's vectors (no copy per sample).
+
+use std::time::Instant;
+
+use numpy::ndarray::Array2;
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use woodpile_scene::report::simulate_report;
+use woodpile_scene::Scene;
+use woodpile_sim::observe::{FractionSeries, SiteField};
+use woodpile_sim::run::simulate as run;
+
+use crate::interrupt::{interruptible, Watch};
+use crate::scene_input::{shown, Source};
+use crate::{SceneError, SimulationError};
+
+/// _simulate(scene, fields=False, field_sites=None) -> dict
+/// --
+///
+/// The native call behind `woodpile.simulate`: a dict with `report` (the CLI's JSON text),
+/// `series` (t, R, T, E_tr, E arrays) and, when a field is asked for, `t`, `sites`,
+/// `velocity` and `displacement`.
+#[pyfunction]
+#[pyo3(signature = (scene, fields = false, field_sites = None))]
+pub(crate) fn simulate<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyAny>,
+    fields: bool,
+    field_sites: Option<(i64, i64)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let source = Source::of(scene)?;
+    let label = shown(&source.label());
+    let scene = source.scene()?;
+    let sites = match field_sites {
+        Some(range) => Some(internal_sites(&scene, range)?),
+        None if fields => Some((0, scene.scenario.model.n_sites() - 1)),
+        None => None,
+    };
+    let s = &scene.scenario;
+    if let Some((first, last)) = sites {
+        SiteField::check_size(s, last - first + 1)
+            .map_err(|reason| SceneError::new_err(format!("{label}: field: {reason}")))?;
+    }
+    let (outcome, wall_s, series, field) = interruptible(py, |cancel| {
+        let series = FractionSeries::new(&s.model, s.region);
+        let started = Instant::now();
+        match sites {
+            Some((first, last)) => {
+                let field = SiteField::new(&s.model, first, last);
+                let mut watched = Watch {
+                    inner: (series, field),
+                    cancel,
+                };
+                let outcome = run(s, &mut watched);
+                let (series, field) = watched.inner;
+                (outcome, started.elapsed(), series, Some(field))
+            }
+            None => {
+                let mut watched = Watch {
+                    inner: series,
+                    cancel,
+                };
+                let outcome = run(s, &mut watched);
+                (outcome, started.elapsed(), watched.inner, None)
+            }
+        }
+    })?;
+    let outcome = outcome
+        .map_err(|e| SimulationError::new_err(format!("{label}: simulation failed: {e}")))?;
+    let report = simulate_report(&scene, &outcome, wall_s.as_secs_f64());
+    let out = PyDict::new(py);
+    out.set_item("report", report.to_string())?;
+    let columns = PyDict::new(py);
+    columns.set_item("t", series.t.into_pyarray(py))?;
+    columns.set_item("R", series.reflected.into_pyarray(py))?;
+    columns.set_item("T", series.transmitted.into_pyarray(py))?;
+    columns.set_item("E_tr", series.trapped.into_pyarray(py))?;
+    columns.set_item("E", series.energy.into_pyarray(py))?;
+    out.set_item("series", columns)?;
+    if let Some(field) = field {
+        add_field(py, &out, &scene, field)?;
+    }
+    Ok(out)
+}
+
+/// Paper sites `(lo, hi)` as internal indices, or a `SceneError` naming the chain's range.
+fn internal_sites(scene: &Scene, (lo, hi): (i64, i64)) -> PyResult<(usize, usize)> {
+    let (first, last) = (scene.first_site, scene.last_site);
+    if lo > hi || lo < first || hi > last {
+        return Err(SceneError::new_err(format!(
+            "field_sites ({lo}, {hi}): need {first} <= lo <= hi <= {last} (the chain's paper sites)"
+        )));
+    }
+    Ok(((lo - first) as usize, (hi - first) as usize))
+}
+
+fn add_field(
+    py: Python<'_>,
+    out: &Bound<'_, PyDict>,
+    scene: &Scene,
+    field: SiteField,
+) -> PyResult<()> {
+    let width = field.width();
+    let first = scene.first_site + *field.sites().start() as i64;
+    let rows = field.t.len();
+    let grid = |values: Vec<f64>| {
+        Array2::from_shape_vec((rows, width), values)
+            .map_err(|e| SimulationError::new_err(format!("field shape: {e}")))
+    };
+    let sites: Vec<i64> = (first..first + width as i64).collect();
+    out.set_item("sites", sites.into_pyarray(py))?;
+    out.set_item("velocity", grid(field.velocity)?.into_pyarray(py))?;
+    out.set_item("displacement", grid(field.displacement)?.into_pyarray(py))?;
+    out.set_item("t", field.t.into_pyarray(py))?;
+    Ok(())
+}

@@ -1,0 +1,28 @@
+"""woodpile: granular chains with internal resonator defects, from Python.
+
+Simulate one scene (``simulate``) or a grid of them on every core (``sweep``), and drive the
+figure pipeline of a woodpile project (``Pipeline``). Scenes are dicts with the keys of a
+scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile repository.
+
+>>> import woodpile
+>>> r = woodpile.simulate({"defect": [{"site": 0, "eps": 10.0}], "run": {"t_end": 150.0}})
+>>> r.E_tr, r.error_estimate          # verified to run.tolerance (default 1e-8)
+>>> r.series.plot(x="t", y=["R", "T", "E_tr"])
+>>> woodpile.sweep({"defect": [{"site": 0, "eps": "$eps"}]}, {"eps": [0.5, 1, 2, 5]})
+"""
+
+from ._core import SceneError, SimulationError, __version__, scene_toml
+from ._pipeline import Pipeline
+from ._simulate import SimulationResult, simulate
+from ._sweep import sweep
+
+__all__ = [
+    "Pipeline",
+    "SceneError",
+    "SimulationError",
+    "SimulationResult",
+    "__version__",
+    "scene_toml",
+    "simulate",
+    "sweep",
+]

@@ -1,0 +1,18 @@
+"""Type stubs of the native module (``woodpile._core``); use the ``woodpile`` package's API."""
+
+import os
+from typing import Any, Dict, Mapping, Optional, Tuple, Union
+
+Scene = Union[Dict[str, Any], str, "os.PathLike[str]"]
+
+__version__: str
+SOURCE_DIR: str
+
+class SceneError(ValueError): ...
+class SimulationError(RuntimeError): ...
+
+def simulate(
+    scene: Scene, fields: bool = False, field_sites: Optional[Tuple[int, int]] = None
+) -> Dict[str, Any]: ...
+def sweep(scene: Scene, axes: Mapping[str, Any], series: bool = False) -> Dict[str, Any]: ...
+def scene_toml(scene: Scene) -> str: ...

@@ -1,0 +1,135 @@
+"""One scene: ``simulate`` and the ``SimulationResult`` it returns."""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, Optional, Tuple, Union
+
+import numpy as np
+import pandas as pd
+
+from . import _core
+
+Scene = Union[Dict[str, Any], str, "os.PathLike[str]"]
+
+
+class SimulationResult:
+    """What one simulated scene gave: the fractions at ``t_end``, how far they can be
+    trusted, their time series and, when asked for, the space-time field.
+
+    Every key of ``woodpile simulate``'s JSON object is an attribute (``R``, ``T``,
+    ``E_tr``, ``error_estimate``, ``method``, ``dt``, ``steps``, ``tolerance``, ...), and
+    ``as_dict()`` returns that object exactly.
+
+    Attributes:
+        series: a DataFrame with columns ``t``, ``R``, ``T``, ``E_tr``, ``E`` at every
+            ``run.sample_every``. R, T and E_tr are the shares of the energy left of,
+            right of and inside the region at that time (R = 1 before the wave arrives).
+        t: the sample times (a float64 array).
+        sites: the paper site numbers of the field's columns (int64), or None.
+        velocity: site velocities, float64, shape (len(t), len(sites)), or None.
+        displacement: site displacements, laid out as ``velocity``, or None.
+    """
+
+    R: float
+    T: float
+    E_tr: float
+    E_initial: float
+    E_final: float
+    error_estimate: Optional[float]
+    method: str
+    requested_method: str
+    dt: Optional[float]
+    tolerance: float
+    steps: int
+    rejected_steps: int
+    rhs_evals: int
+    total_rhs_evals: int
+    site_steps: int
+    site_steps_full_chain: int
+    energy_drift: Optional[float]
+    energy_conserved: bool
+    normalisation: str
+    region: List[int]
+    t_end: float
+    wall_s: float
+    version: str
+    physical: Optional[Dict[str, Any]]
+
+    series: pd.DataFrame
+    t: np.ndarray
+    sites: Optional[np.ndarray]
+    velocity: Optional[np.ndarray]
+    displacement: Optional[np.ndarray]
+
+    def __init__(self, raw: Dict[str, Any]) -> None:
+        self._report: Dict[str, Any] = json.loads(raw["report"])
+        for key, value in self._report.items():
+            setattr(self, key, value)
+        self.physical = self._report.get("physical")
+        columns = raw["series"]
+        self.series = pd.DataFrame({name: columns[name] for name in ("t", "R", "T", "E_tr", "E")})
+        self.t = raw.get("t", columns["t"])
+        self.sites = raw.get("sites")
+        self.velocity = raw.get("velocity")
+        self.displacement = raw.get("displacement")
+
+    def as_dict(self) -> Dict[str, Any]:
+        """The JSON object ``woodpile simulate`` prints for this scene (a copy)."""
+        return json.loads(json.dumps(self._report))
+
+    def field_frame(self) -> pd.DataFrame:
+        """The field in long form (columns t, site, velocity, displacement), as
+        ``woodpile simulate --field`` writes it; needs ``fields=True`` or ``field_sites``."""
+        if self.velocity is None or self.sites is None or self.displacement is None:
+            raise ValueError("no field was recorded: call simulate(..., fields=True)")
+        n_t, n_s = self.velocity.shape
+        return pd.DataFrame(
+            {
+                "t": np.repeat(self.t, n_s),
+                "site": np.tile(self.sites, n_t),
+                "velocity": self.velocity.ravel(),
+                "displacement": self.displacement.ravel(),
+            }
+        )
+
+    def __repr__(self) -> str:
+        est = "none" if self.error_estimate is None else f"{self.error_estimate:.1e}"
+        return (
+            f"SimulationResult(R={self.R:.6g}, T={self.T:.6g}, E_tr={self.E_tr:.6g}, "
+            f"method={self.method!r}, error_estimate={est}, steps={self.steps})"
+        )
+
+
+def simulate(
+    scene: Scene,
+    *,
+    fields: bool = False,
+    field_sites: Optional[Tuple[int, int]] = None,
+) -> SimulationResult:
+    """Simulate one scene and return its fractions, series and (optionally) field.
+
+    Args:
+        scene: a dict with the keys of a scene file (``{"defect": [{"site": 0, "eps":
+            10.0}], "run": {"t_end": 150.0}}``), a TOML string, or the path of a scene
+            file (``str`` or ``os.PathLike``). Keys left out take the paper's defaults.
+        fields: also record every site's velocity and displacement at every sample.
+        field_sites: record only the paper sites ``lo..=hi`` (implies ``fields``).
+
+    Returns:
+        A ``SimulationResult``: ``R``, ``T``, ``E_tr`` (fractions at ``t_end``),
+        ``error_estimate`` (``auto``'s verified error bound estimate), ``method``, ``dt``
+        and every other key of ``woodpile simulate``'s JSON; ``series`` (a DataFrame of
+        t, R, T, E_tr, E); with a field, ``t``, ``sites``, ``velocity`` and
+        ``displacement`` (float64 arrays of shape (time, site)).
+
+    Raises:
+        SceneError: the scene is invalid (a ``ValueError``; the message names the file or
+            ``<dict>``/``<string>``, the key and the reason).
+        SimulationError: the run failed (blow-up, energy drift, tolerance out of reach).
+        KeyboardInterrupt: Ctrl-C; the run stops within a sample interval.
+
+    The GIL is released while the scene runs, so other Python threads go on.
+    """
+    return SimulationResult(_core.simulate(scene, fields, field_sites))

@@ -1,0 +1,53 @@
+"""A grid of scenes: ``sweep``."""
+
+from __future__ import annotations
+
+from typing import Any, Dict, Mapping, Sequence, Union
+
+import numpy as np
+import pandas as pd
+
+from . import _core
+from ._simulate import Scene
+
+Axis = Union[Sequence[float], Sequence[int], "np.ndarray", Mapping[str, float]]
+
+
+def sweep(scene: Scene, axes: Mapping[str, Axis], *, series: bool = False) -> pd.DataFrame:
+    """Simulate every point of a grid of scenes, on all cores, and return one table.
+
+    The grid is a sweep stage's: ``scene`` holds ``"$name"`` placeholders (and may repeat a
+    defect over sites with ``"through": "$L"``), and each axis is a list of numbers (or a
+    NumPy array) or a range ``{"from": 0.1, "to": 10.0, "step": 0.1}`` whose values are
+    rounded to 12 significant digits. Axes vary in name order, the last fastest.
+
+    Args:
+        scene: the scene template: a dict, a TOML string or a path.
+        axes: axis name -> values.
+        series: one row per point and sample (columns t, R, T, E_tr, E) instead of one row
+            per point with the fractions at ``t_end``.
+
+    Returns:
+        A DataFrame: ``point``, the axes, then ``R``, ``T``, ``E_tr`` (or, with
+        ``series``, ``t``, ``R``, ``T``, ``E_tr``, ``E``), ``error_estimate``, ``dt``,
+        ``steps``, ``rhs_evals``, ``method`` and ``failure``. A point that failed is a row
+        with NaN fractions and its reason in ``failure`` (None for the others).
+
+    Raises:
+        SceneError: the template or the axes are invalid (checked on the grid's first and
+            last points before anything runs).
+        KeyboardInterrupt: Ctrl-C stops the sweep within about a second.
+
+    The GIL is released while the sweep runs.
+    """
+    raw: Dict[str, Any] = _core.sweep(scene, dict(axes), series)
+    valid = np.asarray(raw["valid"], dtype=bool)
+    columns: Dict[str, Any] = {}
+    for name in raw["names"]:
+        values = raw[name]
+        if name in ("steps", "rhs_evals"):
+            values = pd.arrays.IntegerArray(np.asarray(values, dtype=np.int64), ~valid)
+        elif name in ("method", "failure"):
+            values = pd.array(values, dtype=object)
+        columns[name] = values
+    return pd.DataFrame(columns)
