@@ -62,6 +62,17 @@ where
     })
 }
 
+/// _panic_in_worker()
+/// --
+///
+/// Panics on the worker thread, as a bug in the core would: the test suite's check that a
+/// panic becomes a `SimulationError` and leaves the interpreter running.
+#[pyfunction]
+#[pyo3(name = "_panic_in_worker")]
+pub(crate) fn panic_in_worker(py: Python<'_>) -> PyResult<()> {
+    interruptible(py, |_| -> () { panic!("deliberate panic (woodpile._core._panic_in_worker)") })
+}
+
 /// The text of a panic's payload.
 pub(crate) fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
     panic

@@ -32,6 +32,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     // The clone this module was built from: where `Pipeline` finds (or builds) the `woodpile`
     // command that runs stages, so that `pip install ./python` alone is enough.

@@ -1,0 +1,127 @@
+"""`woodpile.simulate`: the same numbers as the CLI, every input form, series and fields."""
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import woodpile
+
+from conftest import REPO, SCENES
+
+STANDARD = {
+    "chain": {"n": 60, "boundary": "fixed"},
+    "impulse": {"site": -20, "velocity": 1.0},
+    "defect": [{"site": 0, "eps": 3.0, "kappa": 0.7}],
+    "run": {"t_end": 60.0, "tolerance": 1e-7},
+}
+
+
+@pytest.mark.parametrize("path", SCENES, ids=[p.stem for p in SCENES])
+def test_bit_identical_to_the_cli_on_the_reference_scenes(path, cli):
+    expected = cli(path)
+    result = woodpile.simulate(path)
+    for key in ("R", "T", "E_tr", "error_estimate", "E_final", "dt", "steps", "method"):
+        assert getattr(result, key) == expected[key], key
+    got = result.as_dict()
+    assert set(got) == set(expected)
+    assert {k: v for k, v in got.items() if k != "wall_s"} == {
+        k: v for k, v in expected.items() if k != "wall_s"
+    }
+
+
+def test_a_dict_a_toml_string_and_a_path_are_the_same_scene(tmp_path):
+    text = woodpile.scene_toml(STANDARD)
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    results = [
+        woodpile.simulate(STANDARD),
+        woodpile.simulate(text),
+        woodpile.simulate(str(path)),
+        woodpile.simulate(path),
+    ]
+    for r in results[1:]:
+        assert (r.R, r.T, r.E_tr, r.error_estimate) == (
+            results[0].R,
+            results[0].T,
+            results[0].E_tr,
+            results[0].error_estimate,
+        )
+
+
+def test_numpy_values_are_accepted_in_a_dict():
+    scene = dict(STANDARD, defect=[{"site": np.int64(0), "eps": np.float64(3.0), "kappa": 0.7}])
+    assert woodpile.simulate(scene).E_tr == woodpile.simulate(STANDARD).E_tr
+
+
+def test_series_has_every_sample_and_ends_at_the_result():
+    r = woodpile.simulate(STANDARD)
+    s = r.series
+    assert list(s.columns) == ["t", "R", "T", "E_tr", "E"]
+    assert all(s[c].dtype == np.float64 for c in s.columns)
+    assert len(s) == 61 and s.t.iloc[0] == 0.0 and s.t.iloc[-1] == 60.0
+    last = s.iloc[-1]
+    assert (last.R, last["T"], last.E_tr) == (r.R, r.T, r.E_tr)
+    np.testing.assert_allclose(s.R + s["T"] + s.E_tr, 1.0, rtol=0, atol=1e-12)
+    assert s.R.iloc[0] == 1.0  # before the wave arrives, all energy is left of the region
+    assert r.velocity is None and r.sites is None
+
+
+def test_fields_have_the_shapes_and_dtypes_stated():
+    r = woodpile.simulate(STANDARD, fields=True)
+    assert r.sites.dtype == np.int64 and r.sites[0] == -60 and r.sites[-1] == 60
+    assert r.velocity.shape == (61, 121) and r.velocity.dtype == np.float64
+    assert r.displacement.shape == r.velocity.shape and r.displacement.dtype == np.float64
+    assert r.velocity.flags["C_CONTIGUOUS"]
+    # At t = 0 only the struck site moves, with the impulse's velocity.
+    moving = np.nonzero(r.velocity[0])[0]
+    assert list(r.sites[moving]) == [-20] and r.velocity[0, moving[0]] == 1.0
+    assert not r.displacement[0].any()
+    # A field does not change the numbers.
+    assert r.E_tr == woodpile.simulate(STANDARD).E_tr
+
+    part = woodpile.simulate(STANDARD, field_sites=(-5, 5))
+    assert list(part.sites) == list(range(-5, 6))
+    np.testing.assert_array_equal(part.velocity, r.velocity[:, 55:66])
+    np.testing.assert_array_equal(part.displacement, r.displacement[:, 55:66])
+
+
+def test_fields_agree_with_the_cli_field_table(cli, tmp_path):
+    path = tmp_path / "scene.toml"
+    path.write_text(woodpile.scene_toml(STANDARD))
+    field_file, series_file = tmp_path / "field.parquet", tmp_path / "series.parquet"
+    cli(path, "--field", str(field_file), "--sites", "-3,7", "--series", str(series_file))
+    r = woodpile.simulate(path, field_sites=(-3, 7))
+    pd.testing.assert_frame_equal(pd.read_parquet(field_file), r.field_frame())
+    pd.testing.assert_frame_equal(pd.read_parquet(series_file), r.series)
+
+
+def test_series_agree_with_a_one_point_sweep_stage(small_pipeline):
+    p = woodpile.Pipeline(small_pipeline)
+    p.run("small_sweep")
+    table = p.read("small_sweep")
+    stage = p.manifest("small_sweep")["params"]["scene"]
+    for eps in (0.5, 4.0):
+        scene = dict(stage, defect=[{"site": 0, "eps": eps}])
+        r = woodpile.simulate(scene)
+        rows = table[table.eps == eps].reset_index(drop=True)
+        for column in ("t", "R", "T", "E_tr", "E"):
+            np.testing.assert_array_equal(rows[column].to_numpy(), r.series[column].to_numpy())
+        assert rows.error_estimate.iloc[-1] == r.error_estimate
+
+
+def test_field_sites_outside_the_chain_are_refused():
+    with pytest.raises(woodpile.SceneError, match="field_sites"):
+        woodpile.simulate(STANDARD, field_sites=(-61, 0))
+    with pytest.raises(woodpile.SceneError, match="field_sites"):
+        woodpile.simulate(STANDARD, field_sites=(3, 2))
+
+
+def test_help_reads_well():
+    doc = woodpile.simulate.__doc__
+    assert "SceneError" in doc and "field_sites" in doc and "Returns" in doc
+    assert woodpile.sweep.__doc__ and woodpile.Pipeline.__doc__
+    stub = Path(woodpile.__file__).with_name("_core.pyi")
+    assert stub.is_file() and Path(woodpile.__file__).with_name("py.typed").is_file()
