@@ -48,6 +48,6 @@ def sweep(scene: Scene, axes: Mapping[str, Axis], *, series: bool = False) -> pd
         if name in ("steps", "rhs_evals"):
             values = pd.arrays.IntegerArray(np.asarray(values, dtype=np.int64), ~valid)
         elif name in ("method", "failure"):
-            values = pd.array(values, dtype=object)
+            values = pd.Series(values, dtype=object)
         columns[name] = values
     return pd.DataFrame(columns)
