@@ -1,15 +1,22 @@
 //! Work that runs without the GIL and stops on Ctrl-C.
 //!
 //! Python handles SIGINT by setting a flag that only the main thread, holding the GIL, can act
-//! on. So the work runs on a worker thread while the calling thread waits with the GIL
-//! released, waking every [`POLL`] to ask Python whether a signal arrived. When one did, the
-//! work's cancel flag is raised (simulations read it at every sample through [`Watch`]), the
-//! worker is joined, and the signal's exception (`KeyboardInterrupt`) is raised. Other Python
-//! threads run meanwhile, since the GIL is free.
+//! on. Two ways to honour it:
+//! - [`on_this_thread`] (one scene): the work runs on the calling thread with the GIL
+//!   released, and its stop check re-takes the GIL at most every [`POLL`] to ask Python
+//!   whether a signal arrived. No thread is started, so a short scene pays nothing for it.
+//! - [`interruptible`] (a sweep, whose rayon workers are other threads): the work runs on a
+//!   worker thread while the calling thread waits with the GIL released, waking every
+//!   [`POLL`] to ask; on a signal it raises the work's cancel flag and joins the worker.
+//!
+//! Either way simulations read the stop check at every sample through [`Watch`], the
+//! signal's exception (`KeyboardInterrupt`) is raised, a panic becomes `SimulationError`,
+//! and other Python threads run meanwhile, since the GIL is free.
 
+use std::cell::{Cell, RefCell};
 use std::panic::AssertUnwindSafe;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
 use woodpile_sim::integrate::Observer;
@@ -20,6 +27,42 @@ use crate::SimulationError;
 /// How often the waiting thread checks for a signal: Ctrl-C stops work within about this
 /// plus one sample interval of the slowest running scene.
 const POLL: Duration = Duration::from_millis(50);
+
+/// Runs `work` on this thread with the GIL released. `work` gets a stop check to poll (at
+/// every sample): it is true once Python has a pending signal, whose exception is then raised.
+pub(crate) fn on_this_thread<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+where
+    T: Send,
+    F: FnOnce(&dyn Fn() -> bool) -> T + Send,
+{
+    let (result, signal) = py.detach(|| {
+        let next_check = Cell::new(Instant::now() + POLL);
+        let signal: RefCell<Option<PyErr>> = RefCell::new(None);
+        let stop = || {
+            if signal.borrow().is_some() {
+                return true;
+            }
+            let now = Instant::now();
+            if now < next_check.get() {
+                return false;
+            }
+            next_check.set(now + POLL);
+            match Python::attach(|py| py.check_signals()) {
+                Ok(()) => false,
+                Err(e) => {
+                    *signal.borrow_mut() = Some(e);
+                    true
+                }
+            }
+        };
+        let result = std::panic::catch_unwind(AssertUnwindSafe(|| work(&stop)));
+        (result, signal.into_inner())
+    });
+    if let Some(signal) = signal {
+        return Err(signal);
+    }
+    result.map_err(|panic| internal_error(&panic))
+}
 
 /// Runs `work` on a worker thread with the GIL released, raising the pending signal's
 /// exception (after stopping the work) if one arrives, and `SimulationError` if it panics.
@@ -54,12 +97,22 @@ where
         }
         match result {
             Ok(Ok(value)) => Ok(value),
-            Ok(Err(panic)) | Err(panic) => Err(SimulationError::new_err(format!(
-                "internal error (a bug in woodpile; please report it): {}",
-                panic_message(&panic)
-            ))),
+            Ok(Err(panic)) | Err(panic) => Err(internal_error(&panic)),
         }
     })
+}
+
+/// A panic as the exception Python sees.
+fn internal_error(panic: &Box<dyn std::any::Any + Send>) -> PyErr {
+    SimulationError::new_err(internal_message(panic))
+}
+
+/// What a panic's caller is told.
+pub(crate) fn internal_message(panic: &Box<dyn std::any::Any + Send>) -> String {
+    format!(
+        "internal error (a bug in woodpile; please report it): {}",
+        panic_message(panic)
+    )
 }
 
 /// _panic_in_worker()
@@ -70,11 +123,13 @@ where
 #[pyfunction]
 #[pyo3(name = "_panic_in_worker")]
 pub(crate) fn panic_in_worker(py: Python<'_>) -> PyResult<()> {
-    interruptible(py, |_| -> () { panic!("deliberate panic (woodpile._core._panic_in_worker)") })
+    let here = on_this_thread(py, |_| -> () { panic!("deliberate panic on the calling thread") });
+    let worker = interruptible(py, |_| -> () { panic!("deliberate panic on a worker thread") });
+    here.and(worker)
 }
 
 /// The text of a panic's payload.
-pub(crate) fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
+fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
     panic
         .downcast_ref::<&str>()
         .map(|s| s.to_string())
@@ -82,13 +137,13 @@ pub(crate) fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
         .unwrap_or_else(|| "panic".into())
 }
 
-/// An observer that also stops its run when `cancel` is raised.
-pub(crate) struct Watch<'a, O> {
+/// An observer that also stops its run when `stop()` says so.
+pub(crate) struct Watch<'a, O, C: Fn() -> bool + ?Sized> {
     pub(crate) inner: O,
-    pub(crate) cancel: &'a AtomicBool,
+    pub(crate) stop: &'a C,
 }
 
-impl<O: Observer> Observer for Watch<'_, O> {
+impl<O: Observer, C: Fn() -> bool + ?Sized> Observer for Watch<'_, O, C> {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
         self.inner.observe(model, t, y);
     }
@@ -96,6 +151,6 @@ impl<O: Observer> Observer for Watch<'_, O> {
         self.inner.reset();
     }
     fn cancelled(&self) -> bool {
-        self.cancel.load(Ordering::Relaxed) || self.inner.cancelled()
+        (self.stop)() || self.inner.cancelled()
     }
 }

@@ -12,7 +12,7 @@ use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::run::simulate as run;
 
-use crate::interrupt::{interruptible, Watch};
+use crate::interrupt::{on_this_thread, Watch};
 use crate::scene_input::{shown, Source};
 use crate::{SceneError, SimulationError};
 
@@ -43,7 +43,7 @@ pub(crate) fn simulate<'py>(
         SiteField::check_size(s, last - first + 1)
             .map_err(|reason| SceneError::new_err(format!("{label}: field: {reason}")))?;
     }
-    let (outcome, wall_s, series, field) = interruptible(py, |cancel| {
+    let (outcome, wall_s, series, field) = on_this_thread(py, |stop| {
         let series = FractionSeries::new(&s.model, s.region);
         let started = Instant::now();
         match sites {
@@ -51,7 +51,7 @@ pub(crate) fn simulate<'py>(
                 let field = SiteField::new(&s.model, first, last);
                 let mut watched = Watch {
                     inner: (series, field),
-                    cancel,
+                    stop,
                 };
                 let outcome = run(s, &mut watched);
                 let (series, field) = watched.inner;
@@ -60,7 +60,7 @@ pub(crate) fn simulate<'py>(
             None => {
                 let mut watched = Watch {
                     inner: series,
-                    cancel,
+                    stop,
                 };
                 let outcome = run(s, &mut watched);
                 (outcome, started.elapsed(), watched.inner, None)

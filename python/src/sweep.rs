@@ -16,7 +16,7 @@ use woodpile_sim::integrate::intervals;
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::run::{simulate, Outcome};
 
-use crate::interrupt::{interruptible, panic_message, Watch};
+use crate::interrupt::{internal_message, interruptible, Watch};
 use crate::scene_input::{self, shown, Source};
 use crate::SceneError;
 
@@ -120,11 +120,12 @@ impl Grid {
         }
         let scene = self.scene_at(index)?;
         let s = &scene.scenario;
+        let stop = || cancel.load(Ordering::Relaxed);
         let run = || -> Result<Point, String> {
             if series {
                 let mut watched = Watch {
                     inner: FractionSeries::new(&s.model, s.region),
-                    cancel,
+                    stop: &stop,
                 };
                 let outcome = simulate(s, &mut watched).map_err(|e| e.to_string())?;
                 Ok(Point {
@@ -132,19 +133,15 @@ impl Grid {
                     series: Some(watched.inner),
                 })
             } else {
-                let outcome = simulate(s, &mut Watch { inner: (), cancel }).map_err(|e| e.to_string())?;
+                let outcome = simulate(s, &mut Watch { inner: (), stop: &stop }).map_err(|e| e.to_string())?;
                 Ok(Point {
                     outcome,
                     series: None,
                 })
             }
         };
-        std::panic::catch_unwind(AssertUnwindSafe(run)).unwrap_or_else(|panic| {
-            Err(format!(
-                "internal error (a bug in woodpile; please report it): {}",
-                panic_message(&panic)
-            ))
-        })
+        std::panic::catch_unwind(AssertUnwindSafe(run))
+            .unwrap_or_else(|panic| Err(internal_message(&panic)))
     }
 
     /// The table, column by column: one row per point, or per point and sample.

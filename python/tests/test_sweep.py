@@ -92,3 +92,14 @@ def test_ctrl_c_raises_keyboard_interrupt_inside_a_sweep():
         timer.cancel()
     # Nothing is left running: a new call works at once.
     assert len(woodpile.sweep(TEMPLATE, {"L": [0], "eps": [1.0]})) == 1
+
+
+def test_ctrl_c_raises_keyboard_interrupt_inside_one_long_simulation():
+    scene = {"chain": {"n": 3000}, "impulse": {"site": -2900}, "run": {"t_end": 5000.0, "tolerance": 1e-10}}
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            woodpile.simulate(scene)
+    finally:
+        timer.cancel()

@@ -1,0 +1,89 @@
+"""Benchmarks of the Python package against the Rust core (not tests; numbers go to
+docs/performance.md). Run from the repository root after `pip install ./python`:
+
+    python python/benches/bench.py [--repeat 5] [--skip-sweep]
+
+1. `woodpile.simulate` on the standard scene (one defect, eps = 10, auto at 1e-7), with its
+   series returned, against the same call's own Rust time (the report's `wall_s`, measured
+   inside the core around the simulation): the Python overhead, as the median call's ratio.
+2. `woodpile.sweep` of the F7 coarse grid (pipeline/f7/f7_coarse_sweep.toml, series kept)
+   against `woodpile run f7_coarse_sweep` into an empty results folder.
+Each side is the best of `--repeat` runs.
+"""
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+try:
+    import tomllib
+except ImportError:  # Python < 3.11
+    import tomli as tomllib
+
+import woodpile
+from woodpile._pipeline import find_woodpile
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def best(repeat, work):
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = work()
+        times.append(time.perf_counter() - start)
+    return min(times), result
+
+
+def bench_simulate(repeat):
+    scene = tomllib.loads((REPO / "scenes" / "single_eps10.toml").read_text())
+    scene.setdefault("run", {})["tolerance"] = 1e-7
+    woodpile.simulate(scene)  # warm up
+    pairs = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = woodpile.simulate(scene)
+        pairs.append((result.wall_s, time.perf_counter() - start))
+        assert len(result.series) == 151
+    # Each call against its own Rust time, so the machine's drift between calls cancels.
+    pairs.sort(key=lambda p: p[1] / p[0])
+    return pairs[len(pairs) // 2]
+
+
+def bench_sweep(repeat):
+    stage = tomllib.loads((REPO / "pipeline" / "f7" / "f7_coarse_sweep.toml").read_text())
+    binary = find_woodpile()
+
+    def cli():
+        with tempfile.TemporaryDirectory() as tmp:
+            subprocess.run(
+                [binary, "run", "f7_coarse_sweep", "--results", tmp, "--figures", tmp],
+                cwd=REPO, check=True, capture_output=True,
+            )
+
+    rust, _ = best(repeat, cli)
+    python, table = best(repeat, lambda: woodpile.sweep(stage["scene"], stage["axes"], series=True))
+    assert table.failure.isna().all()
+    return rust, python
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--skip-sweep", action="store_true")
+    args = parser.parse_args()
+    print("| call | Rust | Python | Python / Rust |")
+    print("|---|---|---|---|")
+    rust, python = bench_simulate(args.repeat)
+    print(f"| `simulate`, standard scene, auto at 1e-7, series returned | {rust * 1e3:.2f} ms | {python * 1e3:.2f} ms | {python / rust:.3f} |")
+    if not args.skip_sweep:
+        rust, python = bench_sweep(max(1, args.repeat // 2))
+        print(f"| `sweep` of F7 coarse (10,000 scenes, series) vs `woodpile run` | {rust:.2f} s | {python:.2f} s | {python / rust:.3f} |")
+    sys.stdout.flush()
+
+
+if __name__ == "__main__":
+    main()
