@@ -6,7 +6,7 @@ SCRATCH := scratch/check
 # Wall times (work-precision stages) belong to the machine that measured them: not compared.
 CHECK_TOL := --abs 1e-9 --rel 1e-9 --tol wall_ms=inf --tol log10_wall_ms=inf
 
-.PHONY: help build install test docs figures stage status check read-check bench work-precision lint slurm-test
+.PHONY: help build install test rust-test python python-test python-bench docs figures stage status check read-check bench work-precision lint slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -17,10 +17,28 @@ build: ## Build the woodpile binary (release)
 install: ## Put `woodpile` on the PATH (cargo install into ~/.cargo/bin, reusing this build)
 	$(CARGO) install --locked --path crates/woodpile-cli --target-dir $(or $(CARGO_TARGET_DIR),target)
 
+# The Python package's own virtual environment (python-test builds it the README's way).
+VENV := .venv
+PY := $(VENV)/bin/python
+
+python: ## Install the Python package into .venv, as the README says (pip install ./python)
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check ./python
+
+python-test: python ## The Python package's tests and the quickstart notebook, in .venv
+	$(PY) -m pip install --quiet --disable-pip-version-check pytest matplotlib nbclient nbformat ipykernel
+	$(PY) -m pytest -q -p no:cacheprovider python/tests
+	$(PY) scripts/run_notebook.py examples/quickstart.ipynb
+
+python-bench: python ## woodpile.simulate and woodpile.sweep against the Rust calls (docs/performance.md)
+	$(PY) python/benches/bench.py
+
 docs: ## Regenerate docs/stage-kinds.md and the README's accuracy captions
 	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-pipeline --test docs
 
-test: ## Run the whole test suite (what CI runs; release profile, shared with `figures`)
+test: rust-test python-test ## Run the whole test suite: Rust, then Python (what CI runs)
+
+rust-test: ## The Rust tests (release profile, shared with `figures`)
 	$(CARGO) test --workspace --release --exclude woodpile-bench --exclude woodpile-py
 
 figures: build ## Bring every stale stage up to date (nothing runs when all are fresh)
