@@ -57,7 +57,6 @@ class SimulationResult:
     version: str
     physical: Optional[Dict[str, Any]]
 
-    series: pd.DataFrame
     t: np.ndarray
     sites: Optional[np.ndarray]
     velocity: Optional[np.ndarray]
@@ -68,12 +67,21 @@ class SimulationResult:
         for key, value in self._report.items():
             setattr(self, key, value)
         self.physical = self._report.get("physical")
-        columns = raw["series"]
-        self.series = pd.DataFrame({name: columns[name] for name in ("t", "R", "T", "E_tr", "E")})
-        self.t = raw.get("t", columns["t"])
+        self._series_columns: Dict[str, np.ndarray] = raw["series"]
+        self._series: Optional[pd.DataFrame] = None
+        self.t = raw.get("t", self._series_columns["t"])
         self.sites = raw.get("sites")
         self.velocity = raw.get("velocity")
         self.displacement = raw.get("displacement")
+
+    @property
+    def series(self) -> pd.DataFrame:
+        """R, T, E_tr and E at every ``run.sample_every`` (columns t, R, T, E_tr, E): the
+        arrays the simulation returned, made a DataFrame on first access."""
+        if self._series is None:
+            columns = self._series_columns
+            self._series = pd.DataFrame({name: columns[name] for name in ("t", "R", "T", "E_tr", "E")})
+        return self._series
 
     def as_dict(self) -> Dict[str, Any]:
         """The JSON object ``woodpile simulate`` prints for this scene (a copy)."""
