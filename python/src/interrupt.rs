@@ -123,8 +123,12 @@ pub(crate) fn internal_message(panic: &Box<dyn std::any::Any + Send>) -> String 
 #[pyfunction]
 #[pyo3(name = "_panic_in_worker")]
 pub(crate) fn panic_in_worker(py: Python<'_>) -> PyResult<()> {
-    let here = on_this_thread(py, |_| -> () { panic!("deliberate panic on the calling thread") });
-    let worker = interruptible(py, |_| -> () { panic!("deliberate panic on a worker thread") });
+    let here = on_this_thread(py, |_| -> () {
+        panic!("deliberate panic on the calling thread")
+    });
+    let worker = interruptible(py, |_| -> () {
+        panic!("deliberate panic on a worker thread")
+    });
     here.and(worker)
 }
 

@@ -46,7 +46,11 @@ pub(crate) fn sweep<'py>(
     let label = shown(&source.label());
     let template = source.table()?;
     let axes = parse_axes(scene_input::table(axes, "axes")?).map_err(|(key, reason)| {
-        let key = if key.is_empty() { "axes".into() } else { format!("axes.{key}") };
+        let key = if key.is_empty() {
+            "axes".into()
+        } else {
+            format!("axes.{key}")
+        };
         SceneError::new_err(format!("{label}: key `{key}`: {reason}"))
     })?;
     let template = Template::new(template, &axes).map_err(|(key, reason)| {
@@ -105,11 +109,17 @@ impl Grid {
             .zip(&values)
             .map(|(a, v)| format!("{} = {v}", a.name))
             .collect();
-        let at = if at.is_empty() { String::new() } else { format!(" (at {})", at.join(", ")) };
+        let at = if at.is_empty() {
+            String::new()
+        } else {
+            format!(" (at {})", at.join(", "))
+        };
         let table = self
             .template
             .instantiate(&self.axes, &values)
-            .map_err(|(key, reason)| format!("{}: key `{}`: {reason}{at}", self.label, unprefixed(&key)))?;
+            .map_err(|(key, reason)| {
+                format!("{}: key `{}`: {reason}{at}", self.label, unprefixed(&key))
+            })?;
         woodpile_scene::from_table(table, std::path::Path::new(&self.label))
             .map_err(|e| format!("{e}{at}"))
     }
@@ -133,7 +143,14 @@ impl Grid {
                     series: Some(watched.inner),
                 })
             } else {
-                let outcome = simulate(s, &mut Watch { inner: (), stop: &stop }).map_err(|e| e.to_string())?;
+                let outcome = simulate(
+                    s,
+                    &mut Watch {
+                        inner: (),
+                        stop: &stop,
+                    },
+                )
+                .map_err(|e| e.to_string())?;
                 Ok(Point {
                     outcome,
                     series: None,
@@ -156,7 +173,9 @@ impl Grid {
             .iter()
             .enumerate()
             .flat_map(|(i, p)| match p {
-                Ok(Point { series: Some(s), .. }) => (0..s.t.len()).map(|k| (i, Some(k))).collect(),
+                Ok(Point {
+                    series: Some(s), ..
+                }) => (0..s.t.len()).map(|k| (i, Some(k))).collect(),
                 _ => vec![(i, None)],
             })
             .collect();
@@ -182,14 +201,15 @@ impl Grid {
             names.push(axis.name.clone());
         }
         let ok = |i: usize| points[i].as_ref().ok();
-        let mut float = |name: &str, f: &dyn Fn(&Point, Option<usize>) -> Option<f64>| -> PyResult<()> {
-            let v: Vec<f64> = rows
-                .iter()
-                .map(|&(i, k)| ok(i).and_then(|p| f(p, k)).unwrap_or(f64::NAN))
-                .collect();
-            names.push(name.to_string());
-            out.set_item(name, v.into_pyarray(py))
-        };
+        let mut float =
+            |name: &str, f: &dyn Fn(&Point, Option<usize>) -> Option<f64>| -> PyResult<()> {
+                let v: Vec<f64> = rows
+                    .iter()
+                    .map(|&(i, k)| ok(i).and_then(|p| f(p, k)).unwrap_or(f64::NAN))
+                    .collect();
+                names.push(name.to_string());
+                out.set_item(name, v.into_pyarray(py))
+            };
         if series {
             let sample = |p: &Point, k: Option<usize>, pick: fn(&FractionSeries) -> &Vec<f64>| {
                 Some(pick(p.series.as_ref()?)[k?])
@@ -209,7 +229,10 @@ impl Grid {
         float("error_estimate", &|p, _| p.outcome.error_estimate)?;
         float("dt", &|p, _| p.outcome.plan.dt())?;
         let mut integer = |name: &str, f: &dyn Fn(&Point) -> u64| -> PyResult<()> {
-            let v: Vec<i64> = rows.iter().map(|&(i, _)| ok(i).map_or(0, |p| f(p) as i64)).collect();
+            let v: Vec<i64> = rows
+                .iter()
+                .map(|&(i, _)| ok(i).map_or(0, |p| f(p) as i64))
+                .collect();
             names.push(name.to_string());
             out.set_item(name, v.into_pyarray(py))
         };
@@ -222,9 +245,19 @@ impl Grid {
         };
         out.set_item(
             "method",
-            PyList::new(py, text(&|p| p.as_ref().ok().map(|p| p.outcome.plan.method.name().to_string())))?,
+            PyList::new(
+                py,
+                text(&|p| {
+                    p.as_ref()
+                        .ok()
+                        .map(|p| p.outcome.plan.method.name().to_string())
+                }),
+            )?,
         )?;
-        out.set_item("failure", PyList::new(py, text(&|p| p.as_ref().err().cloned()))?)?;
+        out.set_item(
+            "failure",
+            PyList::new(py, text(&|p| p.as_ref().err().cloned()))?,
+        )?;
         names.push("method".into());
         names.push("failure".into());
         out.set_item("names", names)?;

@@ -311,7 +311,12 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
     let states: Vec<(&woodpile_pipeline::stage::Stage, State)> = pipeline
         .stages()
         .iter()
-        .map(|stage| (stage, state(&pipeline, &args.at.results, &args.at.figures, stage)))
+        .map(|stage| {
+            (
+                stage,
+                state(&pipeline, &args.at.results, &args.at.figures, stage),
+            )
+        })
         .collect();
     let not_fresh = states.iter().filter(|(_, st)| *st != State::Fresh).count();
     if args.json {

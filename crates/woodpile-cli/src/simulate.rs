@@ -34,7 +34,12 @@ pub(crate) struct Args {
     #[arg(long, value_name = "OUT.parquet")]
     field: Option<PathBuf>,
     /// The paper sites the field keeps, inclusive (default: the whole chain).
-    #[arg(long, value_name = "LO,HI", requires = "field", allow_hyphen_values = true)]
+    #[arg(
+        long,
+        value_name = "LO,HI",
+        requires = "field",
+        allow_hyphen_values = true
+    )]
     sites: Option<String>,
 }
 
@@ -86,7 +91,9 @@ fn field_sites(scene: &Scene, spec: Option<&str>) -> anyhow::Result<(usize, usiz
         .split_once(',')
         .and_then(|(a, b)| Some((a.trim().parse::<i64>().ok()?, b.trim().parse::<i64>().ok()?)));
     let Some((lo, hi)) = parsed else {
-        return Err(anyhow!("--sites `{spec}`: expected LO,HI (two paper site numbers)"));
+        return Err(anyhow!(
+            "--sites `{spec}`: expected LO,HI (two paper site numbers)"
+        ));
     };
     if lo > hi || lo < first || hi > last {
         return Err(anyhow!(
@@ -136,8 +143,12 @@ fn write_series(
         .f64("E_tr", some(&series.trapped))
         .f64("E", some(&series.energy));
     let frame = columns.into_frame().map_err(Failure::simulation)?;
-    table::write(path, frame, &manifest("series", file, scene, out, Value::Null))
-        .map_err(Failure::input)
+    table::write(
+        path,
+        frame,
+        &manifest("series", file, scene, out, Value::Null),
+    )
+    .map_err(Failure::input)
 }
 
 fn write_field(
@@ -154,13 +165,22 @@ fn write_field(
     columns
         .f64(
             "t",
-            field.t.iter().flat_map(|t| std::iter::repeat_n(Some(*t), width)).collect(),
+            field
+                .t
+                .iter()
+                .flat_map(|t| std::iter::repeat_n(Some(*t), width))
+                .collect(),
         )
         .i64(
             "site",
-            (0..rows).map(|i| Some(first + (i % width) as i64)).collect(),
+            (0..rows)
+                .map(|i| Some(first + (i % width) as i64))
+                .collect(),
         )
-        .f64("velocity", field.velocity.iter().map(|v| Some(*v)).collect())
+        .f64(
+            "velocity",
+            field.velocity.iter().map(|v| Some(*v)).collect(),
+        )
         .f64(
             "displacement",
             field.displacement.iter().map(|u| Some(*u)).collect(),

@@ -37,7 +37,8 @@ mod tests {
     #[test]
     fn errors_name_the_file_and_the_dotted_key() {
         let msg = |t: &str| axes(t).unwrap_err().to_string();
-        assert!(msg("eps = { from = 0.1, to = 1.05, step = 0.1 }").contains("s.toml: key `axes.eps.to`"));
+        assert!(msg("eps = { from = 0.1, to = 1.05, step = 0.1 }")
+            .contains("s.toml: key `axes.eps.to`"));
         assert!(msg("eps = { from = 1, to = 2, step = 1, by = 3 }").contains("axes.eps.by"));
         assert!(msg("t = [1.0]").contains("axes.t"));
         assert!(msg("a = [1, 2]\nb = { from = 1, to = 1000000, step = 1 }").contains("key `axes`"));

@@ -44,12 +44,12 @@ pub mod status;
 pub mod table;
 
 pub use error::{PipelineError, Result};
-pub use woodpile_scene::template;
 pub use kinds::{
     approximate, design, fit, optimize, reduce, render, report, spacetime, stability, sweep,
     workprecision,
 };
 pub use pipeline::Pipeline;
+pub use woodpile_scene::template;
 
 /// What a stage computed, before it is written with its manifest.
 pub struct Output {

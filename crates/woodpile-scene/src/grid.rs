@@ -99,8 +99,9 @@ pub fn parse_axes(table: toml::Table) -> Result<Vec<Axis>, AxisError> {
         }
         let values = match value {
             toml::Value::Array(items) => list(&name, items)?,
-            toml::Value::Table(table) => range(table)
-                .map_err(|(key, reason)| (format!("{name}.{key}"), reason))?,
+            toml::Value::Table(table) => {
+                range(table).map_err(|(key, reason)| (format!("{name}.{key}"), reason))?
+            }
             _ => {
                 return Err((
                     name,
@@ -246,7 +247,10 @@ mod tests {
         let key = |t: &str| axes(t).unwrap_err().0;
         assert_eq!(key("eps = { from = 0.1, to = 1.05, step = 0.1 }"), "eps.to");
         assert_eq!(key("eps = { from = 0.1, to = 1.0 }"), "eps.step");
-        assert_eq!(key("eps = { from = 1, to = 2, step = 1, by = 3 }"), "eps.by");
+        assert_eq!(
+            key("eps = { from = 1, to = 2, step = 1, by = 3 }"),
+            "eps.by"
+        );
         assert_eq!(key("t = [1.0]"), "t");
         assert!(axes("eps = []").unwrap_err().1.contains("at least one"));
         assert_eq!(key("eps = \"x\""), "eps");

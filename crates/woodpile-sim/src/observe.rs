@@ -10,8 +10,8 @@
 
 use crate::energy::{energy_density, kinetic_density, Fractions, Region};
 use crate::integrate::{intervals, Observer};
-use crate::run::Scenario;
 use crate::model::Model;
+use crate::run::Scenario;
 
 /// Which energy a [`FractionSeries`] splits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -306,7 +306,10 @@ mod tests {
     #[test]
     fn site_field_keeps_its_sites_at_every_sample() {
         let s = scene();
-        let mut both = (SiteField::new(&s.model, 70, 80), SpaceTimeField::new(&s.model, 1, 1));
+        let mut both = (
+            SiteField::new(&s.model, 70, 80),
+            SpaceTimeField::new(&s.model, 1, 1),
+        );
         let out = simulate(&s, &mut both).unwrap();
         let (field, map) = both;
         assert_eq!(field.width(), 11);
@@ -321,7 +324,10 @@ mod tests {
         assert_eq!(last_row, &out.final_state[70..=80]);
         // Only the impulse site (index 75) moves at t = 0.
         assert_eq!(field.velocity[5], 1.0);
-        assert_eq!(field.velocity[..11].iter().filter(|v| **v != 0.0).count(), 1);
+        assert_eq!(
+            field.velocity[..11].iter().filter(|v| **v != 0.0).count(),
+            1
+        );
     }
 
     /// An observer that asks to stop ends the run at the next sample, `auto`'s verification
@@ -341,11 +347,17 @@ mod tests {
         let mut s = scene();
         let mut stop = StopAfter(0, 5);
         let err = simulate(&s, &mut stop).unwrap_err();
-        assert!(matches!(err, crate::SimError::Cancelled { t } if t == 4.0), "{err:?}");
+        assert!(
+            matches!(err, crate::SimError::Cancelled { t } if t == 4.0),
+            "{err:?}"
+        );
         s.method = MethodChoice::Auto;
         let mut stop = StopAfter(0, 0);
         let err = simulate(&s, &mut stop).unwrap_err();
         // The coarse verification run is the first to see the request, at its first sample.
-        assert!(matches!(err, crate::SimError::Cancelled { t } if t == 1.0), "{err:?}");
+        assert!(
+            matches!(err, crate::SimError::Cancelled { t } if t == 1.0),
+            "{err:?}"
+        );
     }
 }

@@ -97,7 +97,11 @@ fn verified<O: Observer + ?Sized>(
     };
     let mut dt = auto_first_step(scenario, &plan);
     let mut spent = 0;
-    let mut coarse = match run_plan(scenario, &guarded.with_dt(2.0 * dt), &mut CancelOnly(&*observer)) {
+    let mut coarse = match run_plan(
+        scenario,
+        &guarded.with_dt(2.0 * dt),
+        &mut CancelOnly(&*observer),
+    ) {
         Ok(out) => {
             spent += out.stats.rhs_evals;
             Some(out)
