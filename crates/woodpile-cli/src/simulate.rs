@@ -123,6 +123,7 @@ fn manifest(what: &str, file: &Path, scene: &Scene, out: &Outcome, extra: Value)
         params,
         inputs: Default::default(),
         summary,
+        files: Default::default(),
         checksum: None,
     }
 }

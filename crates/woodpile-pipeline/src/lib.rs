@@ -34,9 +34,11 @@ pub mod lock;
 pub mod manifest;
 pub mod pipeline;
 pub mod points;
+pub mod regular;
 pub mod run;
 #[cfg(feature = "testing")]
 pub mod sampling;
+pub mod sealed_files;
 pub mod shard;
 pub mod slurm;
 pub mod stage;

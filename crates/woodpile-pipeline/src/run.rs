@@ -18,7 +18,7 @@ use crate::stage::Stage;
 use crate::status::{output_path, state, State};
 use crate::sweep::points_dir;
 use crate::sweep::Sweep;
-use crate::table;
+use crate::{sealed_files, table};
 
 /// How to run.
 #[derive(Debug, Clone, Default)]
@@ -376,7 +376,11 @@ fn execute(
         store,
         events,
     })?;
-    let manifest = manifest_for(pipeline, stage, output.summary.clone());
+    let mut manifest = manifest_for(pipeline, stage, output.summary.clone());
+    // The table comes last and records what every other file of the stage now holds: a run
+    // stopped before it leaves the stage stale, never fresh with someone else's figure.
+    manifest.files =
+        sealed_files::record(&stage.spec.files(&stage.name, results, &options.figures))?;
     let rows = output.frame.height();
     table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
     let count = |k: &str| output.summary.get(k).and_then(|v| v.as_u64());
@@ -405,6 +409,7 @@ pub(crate) fn manifest_for(
             .map(|i| (i.clone(), pipeline.key(i).to_string()))
             .collect::<BTreeMap<_, _>>(),
         summary,
+        files: BTreeMap::new(),
         checksum: None,
     }
 }

@@ -52,38 +52,30 @@ pub fn output_path(results: &Path, name: &str) -> PathBuf {
 /// The state of `stage` given the outputs under `results` (and, for render stages, the figure
 /// files under `figures`).
 ///
-/// The whole table is read and checked against its manifest's checksum, so a damaged output is
-/// never reported fresh (the results are a few MB: this costs well under a second).
+/// The whole table is read and checked against its manifest's seal, and every other file the
+/// stage wrote (figures, Markdown, a design's scene) against the checksum the manifest recorded
+/// for it, so neither a damaged output nor a file from an abandoned edit is reported fresh
+/// (the results are a few MB: this costs well under a second).
 pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage) -> State {
     let path = output_path(results, &stage.name);
-    if !path.exists() {
-        return State::Missing;
-    }
-    let checked = match table::read_checked(&path) {
-        Ok(checked) => checked,
-        Err(e) => return State::Damaged(format!("output unreadable ({e})")),
-    };
-    let stored = match (checked.manifest, checked.integrity) {
-        (None, _) => return State::Damaged("output has no `woodpile` manifest".into()),
-        (Some(_), Integrity::Damaged) => {
+    let stored = match table::read_checked_manifest(&path) {
+        Ok(None) => return State::Missing,
+        Ok(Some((_, Integrity::Damaged))) => {
             return State::Damaged(format!("output {}", table::DAMAGED))
         }
-        (Some(_), Integrity::Unchecked) => {
-            return State::Damaged("output has no checksum to check its content against".into())
+        Ok(Some((None, _))) => return State::Damaged("output has no `woodpile` manifest".into()),
+        Ok(Some((Some(_), Integrity::Unchecked))) => {
+            return State::Damaged("output has no seal to check its content against".into())
         }
-        (Some(m), Integrity::Intact) => m,
+        Ok(Some((Some(m), Integrity::Intact))) => m,
+        Err(e) => return State::Damaged(format!("output unreadable ({e})")),
     };
     let key = pipeline.key(&stage.name);
     if stored.key == key.as_str() {
-        let missing: Vec<String> = stage
-            .spec
-            .files(&stage.name, results, figures)
-            .iter()
-            .filter(|f| !f.exists())
-            .map(|f| format!("{} missing", f.display()))
-            .collect();
-        if !missing.is_empty() {
-            return State::Stale(missing);
+        let files = stage.spec.files(&stage.name, results, figures);
+        let changed = crate::sealed_files::changed(&files, &stored.files);
+        if !changed.is_empty() {
+            return State::Stale(changed);
         }
         return State::Fresh;
     }

@@ -2,7 +2,6 @@
 //! metadata (key `woodpile`), so that every result file explains itself to any reader
 //! (`pyarrow.parquet.read_metadata(path).metadata[b"woodpile"]`).
 
-use std::fs::File;
 use std::path::Path;
 
 use polars::prelude::*;
@@ -10,6 +9,7 @@ use polars::prelude::*;
 use crate::atomic;
 use crate::error::{PipelineError, Result};
 use crate::manifest::{Manifest, METADATA_KEY};
+use crate::regular;
 
 /// Columns of a table under construction, in output order: for tables whose columns are
 /// computed whole (a grid, a field); tables built row by row use [`Row`] and [`rows_frame`].
@@ -183,34 +183,34 @@ pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
 }
 
 /// Writes `frame` to `path` atomically, with `manifest` in the metadata, sealed: the manifest's
-/// `checksum` covers the file's data pages, the decoded content and the manifest itself
-/// ([`seal`]), so that a byte changed anywhere that matters is caught on reading.
+/// `checksum` is the blake3 of the whole file's bytes with the seal itself replaced by a
+/// placeholder ([`seal`]), so that every byte is checked before a reader decodes any.
 pub fn write(path: &Path, mut frame: DataFrame, manifest: &Manifest) -> Result<()> {
-    // The manifest's text with a placeholder seal: the seal is computed over this exact text,
-    // then written in the placeholder's place, so checking it needs no re-serialisation.
     let placeholder = Manifest {
         checksum: Some(UNSEALED.into()),
         ..manifest.clone()
     }
     .to_json_text();
-    // The data pages come before the footer that holds the manifest, so they are the same
-    // bytes with either text: encode once to learn them, then again with the seal.
-    let unsealed = encode(&mut frame, placeholder.clone())?;
-    let pages = data_pages(&unsealed)
-        .ok_or_else(|| PipelineError::io(path, "parquet writer produced no footer"))?;
-    let seal = seal(pages, &checksum(&frame)?, &placeholder);
-    let bytes = encode(&mut frame, placeholder.replace(UNSEALED, &seal))?;
-    if data_pages(&bytes) != Some(pages) {
-        return Err(PipelineError::io(
-            path,
-            "parquet writer is not deterministic: cannot seal",
-        ));
-    }
+    let mut bytes = encode(&mut frame, placeholder)?;
+    let at = seal_position(&bytes)
+        .filter(|&at| &bytes[at..at + SEAL_LEN] == UNSEALED.as_bytes())
+        .ok_or_else(|| {
+            PipelineError::io(path, "the parquet writer lost the manifest: cannot seal")
+        })?;
+    let sealed = seal(&bytes, at);
+    bytes[at..at + SEAL_LEN].copy_from_slice(sealed.as_bytes());
     atomic::write(path, &bytes)
 }
 
 /// The seal's placeholder while it is computed: 64 characters, as the seal itself.
 const UNSEALED: &str = "unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-u";
+const SEAL_LEN: usize = 64;
+/// What precedes the seal in the manifest's text (its last field).
+const SEAL_MARK: &[u8] = b"\"checksum\":\"";
+
+/// The largest table woodpile reads: a thousand times its largest result. A file beyond it is
+/// refused unread, so no decoder is asked to allocate for it.
+pub const MAX_TABLE_BYTES: u64 = 1 << 30;
 
 fn encode(frame: &mut DataFrame, manifest_text: String) -> Result<Vec<u8>> {
     let metadata = KeyValueMetadata::from_static(vec![(METADATA_KEY.to_string(), manifest_text)]);
@@ -223,85 +223,95 @@ fn encode(frame: &mut DataFrame, manifest_text: String) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// A parquet file's bytes before its footer (magic, column chunks, page headers, pages), or
-/// `None` when the trailer is not a parquet one.
-fn data_pages(bytes: &[u8]) -> Option<&[u8]> {
-    let n = bytes.len();
-    if n < 12 || &bytes[n - 4..] != b"PAR1" {
-        return None;
-    }
-    let footer = u32::from_le_bytes(bytes[n - 8..n - 4].try_into().ok()?) as usize;
-    let start = n.checked_sub(8)?.checked_sub(footer)?;
-    (start >= 4).then(|| &bytes[..start])
+/// Where the seal's 64 characters start in a sealed file: after the last `"checksum":"`
+/// (the manifest's last field, in the footer near the end of the file).
+fn seal_position(bytes: &[u8]) -> Option<usize> {
+    let at = bytes
+        .windows(SEAL_MARK.len())
+        .rposition(|w| w == SEAL_MARK)?
+        + SEAL_MARK.len();
+    (at + SEAL_LEN <= bytes.len()).then_some(at)
 }
 
-/// The checksum a manifest records: blake3 over the data pages' bytes, the decoded content's
-/// [`checksum`] and the manifest's exact text with the seal replaced by [`UNSEALED`]. A changed
-/// page, a footer change that alters what is decoded, and an edited manifest all break it.
-fn seal(pages: &[u8], content: &str, placeholder_text: &str) -> String {
+/// The seal of a file whose seal starts at `at`: blake3 of every byte, with the seal's own
+/// 64 characters read as [`UNSEALED`]. A changed byte anywhere (data, footer, manifest) breaks it.
+fn seal(bytes: &[u8], at: usize) -> String {
     let mut hasher = blake3::Hasher::new();
-    hasher.update(&(pages.len() as u64).to_le_bytes());
-    hasher.update(pages);
-    hasher.update(content.as_bytes());
-    hasher.update(placeholder_text.as_bytes());
+    hasher.update(b"woodpile table seal 2\n");
+    hasher.update(&bytes[..at]);
+    hasher.update(UNSEALED.as_bytes());
+    hasher.update(&bytes[at + SEAL_LEN..]);
     hasher.finalize().to_hex().to_string()
 }
 
-/// Whether a table's content still matches the checksum its manifest recorded.
+/// Whether a table's bytes still match the seal its manifest recorded.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Integrity {
-    /// It does.
+    /// They do.
     Intact,
-    /// It does not: the file was damaged after it was written.
+    /// They do not: the file was damaged (or edited) after it was written. It is not decoded.
     Damaged,
-    /// There is no manifest, or the manifest records no checksum: nothing to check against.
+    /// There is no seal to check against: not a woodpile table.
     Unchecked,
 }
 
-/// A table as read, with its manifest and whether its content matches the manifest.
+/// A table as read, with its manifest and whether its bytes match the manifest's seal.
 #[derive(Debug)]
 pub struct Checked {
-    /// The table.
+    /// The table (empty when damaged: a damaged file is never decoded).
     pub frame: DataFrame,
-    /// Its manifest, if it has one.
+    /// Its manifest, if it has one (none when damaged).
     pub manifest: Option<Manifest>,
-    /// Content against the manifest's checksum.
+    /// The bytes against the manifest's seal.
     pub integrity: Integrity,
 }
 
-/// Reads the whole table at `path` and checks its content against its manifest's checksum.
+/// The bytes of the table at `path` (a regular file of at most [`MAX_TABLE_BYTES`]) and
+/// whether they match their seal, checked before anything decodes them. A file that carries
+/// woodpile's marks (the `woodpile` metadata key or a seal field) but no matching seal is
+/// damaged; only a file with neither is unchecked (a foreign parquet file).
+fn sealed_bytes(path: &Path) -> Result<(Vec<u8>, Integrity)> {
+    let bytes = regular::read(path, MAX_TABLE_BYTES).map_err(|e| PipelineError::io(path, e))?;
+    let integrity = match seal_position(&bytes) {
+        Some(at) if bytes[at..at + SEAL_LEN] == *seal(&bytes, at).as_bytes() => Integrity::Intact,
+        Some(_) => Integrity::Damaged,
+        None if contains(&bytes, METADATA_KEY.as_bytes()) => Integrity::Damaged,
+        None => Integrity::Unchecked,
+    };
+    Ok((bytes, integrity))
+}
+
+fn contains(haystack: &[u8], needle: &[u8]) -> bool {
+    haystack.windows(needle.len()).any(|w| w == needle)
+}
+
+/// Runs a polars decoder on bytes: some damaged files make it panic rather than return an
+/// error (sealed files never reach it damaged; foreign ones may).
+fn decode<T>(path: &Path, work: impl FnOnce() -> PolarsResult<T>) -> Result<T> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)) {
+        Ok(result) => result.map_err(|e| PipelineError::io(path, e)),
+        Err(_) => Err(PipelineError::io(path, "the parquet decoder failed on it")),
+    }
+}
+
+/// Reads the whole table at `path`, after checking its bytes against its manifest's seal.
 pub fn read_checked(path: &Path) -> Result<Checked> {
-    let bytes = std::fs::read(path).map_err(|e| PipelineError::io(path, e))?;
-    // polars' decoder panics on some damaged files (a page header out of range) instead of
-    // returning an error: a damaged file is an error here, never a crash.
-    let decoded = std::panic::catch_unwind(|| {
+    let (bytes, integrity) = sealed_bytes(path)?;
+    if integrity == Integrity::Damaged {
+        return Ok(Checked {
+            frame: DataFrame::empty(),
+            manifest: None,
+            integrity,
+        });
+    }
+    let (metadata, frame) = decode(path, || {
         let mut reader = ParquetReader::new(std::io::Cursor::new(&bytes));
         let metadata = reader.get_metadata()?.clone();
         reader.finish().map(|frame| (metadata, frame))
-    });
-    let (metadata, frame) = match decoded {
-        Ok(result) => result.map_err(|e| PipelineError::io(path, e))?,
-        Err(_) => return Err(PipelineError::io(path, "the parquet decoder failed on it")),
-    };
-    let text = manifest_text(&metadata);
-    let manifest = text
-        .as_deref()
-        .map(|t| parse_manifest(path, t))
+    })?;
+    let manifest = manifest_text(&metadata)
+        .map(|t| parse_manifest(path, &t))
         .transpose()?;
-    let integrity = match (&manifest, &text, data_pages(&bytes)) {
-        (Some(m), Some(text), Some(pages)) => match &m.checksum {
-            None => Integrity::Unchecked,
-            Some(recorded) => {
-                let placeholder = text.replacen(recorded.as_str(), UNSEALED, 1);
-                match *recorded == seal(pages, &checksum(&frame)?, &placeholder) {
-                    true => Integrity::Intact,
-                    false => Integrity::Damaged,
-                }
-            }
-        },
-        (Some(_), _, _) => Integrity::Damaged,
-        (None, _, _) => Integrity::Unchecked,
-    };
     Ok(Checked {
         frame,
         manifest,
@@ -309,8 +319,29 @@ pub fn read_checked(path: &Path) -> Result<Checked> {
     })
 }
 
-/// Reads the whole table at `path` (a stage's input): an error if its content no longer
-/// matches the checksum in its manifest, so a damaged table never flows downstream.
+/// The manifest of the table at `path` and the table's integrity, from its footer alone (no
+/// data page is decoded): what `status` needs. `Ok(None)` when the file does not exist.
+pub fn read_checked_manifest(path: &Path) -> Result<Option<(Option<Manifest>, Integrity)>> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return Ok(None);
+    }
+    let (bytes, integrity) = sealed_bytes(path)?;
+    if integrity == Integrity::Damaged {
+        return Ok(Some((None, integrity)));
+    }
+    let metadata = decode(path, || {
+        ParquetReader::new(std::io::Cursor::new(&bytes))
+            .get_metadata()
+            .cloned()
+    })?;
+    let manifest = manifest_text(&metadata)
+        .map(|t| parse_manifest(path, &t))
+        .transpose()?;
+    Ok(Some((manifest, integrity)))
+}
+
+/// Reads the whole table at `path` (a stage's input): an error if its bytes no longer
+/// match the seal in its manifest, so a damaged table never flows downstream.
 pub fn read(path: &Path) -> Result<DataFrame> {
     let checked = read_checked(path)?;
     if checked.integrity == Integrity::Damaged {
@@ -332,62 +363,21 @@ pub fn read_with_manifest(path: &Path) -> Result<(DataFrame, Manifest)> {
     }
 }
 
-/// What a table that fails its checksum is told.
-pub const DAMAGED: &str = "damaged: its bytes no longer match the checksum in its manifest";
+/// What a table that fails its seal is told.
+pub const DAMAGED: &str = "damaged: its bytes no longer match the seal in its manifest";
 
-/// The blake3 checksum (hex) of a table's content: every column's name, type and values in
-/// order, nulls marked. It is computed from the decoded values, so it catches a damaged data
-/// page whatever the parquet encoding, and it does not depend on how the file was compressed.
-pub fn checksum(frame: &DataFrame) -> Result<String> {
-    let mut hasher = blake3::Hasher::new();
-    let mut put = |bytes: &[u8]| {
-        hasher.update(&(bytes.len() as u64).to_le_bytes());
-        hasher.update(bytes);
-    };
-    put(&(frame.height() as u64).to_le_bytes());
-    for column in frame.columns() {
-        let name = column.name().as_str();
-        let bad = |e: PolarsError| PipelineError::stage("table", format!("column `{name}`: {e}"));
-        put(name.as_bytes());
-        let dtype = column.dtype();
-        put(dtype.to_string().as_bytes());
-        if dtype.is_float() {
-            let values = column.cast(&DataType::Float64).map_err(bad)?;
-            for v in values.f64().map_err(bad)?.iter() {
-                put(&v.map_or([0xff; 8], |x| x.to_bits().to_le_bytes()));
-                put(&[u8::from(v.is_some())]);
-            }
-        } else if dtype.is_integer() || dtype.is_bool() {
-            let values = column.cast(&DataType::Int64).map_err(bad)?;
-            for v in values.i64().map_err(bad)?.iter() {
-                put(&v.unwrap_or(0).to_le_bytes());
-                put(&[u8::from(v.is_some())]);
-            }
-        } else {
-            let values = column.cast(&DataType::String).map_err(bad)?;
-            for v in values.str().map_err(bad)?.iter() {
-                put(v.unwrap_or("").as_bytes());
-                put(&[u8::from(v.is_some())]);
-            }
-        }
-    }
-    Ok(hasher.finalize().to_hex().to_string())
-}
-
-/// Reads only the manifest in `path`'s footer: `Ok(None)` when the file does not exist.
+/// Reads only the manifest of the table at `path`: `Ok(None)` when the file does not exist,
+/// an error when it is damaged or has no manifest.
 pub fn read_manifest(path: &Path) -> Result<Option<Manifest>> {
-    let file = match File::open(path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(PipelineError::io(path, e)),
-    };
-    let mut reader = ParquetReader::new(file);
-    let metadata = reader
-        .get_metadata()
-        .map_err(|e| PipelineError::io(path, e))?;
-    let text = manifest_text(metadata)
-        .ok_or_else(|| PipelineError::io(path, "no `woodpile` manifest in the metadata"))?;
-    parse_manifest(path, &text).map(Some)
+    match read_checked_manifest(path)? {
+        None => Ok(None),
+        Some((_, Integrity::Damaged)) => Err(PipelineError::io(path, DAMAGED)),
+        Some((None, _)) => Err(PipelineError::io(
+            path,
+            "no `woodpile` manifest in the metadata",
+        )),
+        Some((Some(manifest), _)) => Ok(Some(manifest)),
+    }
 }
 
 /// The manifest's text in a parquet footer, `None` when it has none.
@@ -457,6 +447,7 @@ mod tests {
             params: serde_json::json!({"a": 1e-6, "b": [1, 2.5], "c": "x"}),
             inputs: Default::default(),
             summary: serde_json::json!({"points": 3}),
+            files: Default::default(),
             checksum: None,
         }
     }
@@ -493,13 +484,48 @@ mod tests {
             .i64("n", vec![Some(1), Some(2), None])
             .str("s", vec![Some("a".into()), None, Some("c".into())]);
         let frame = columns.into_frame().unwrap();
-        let before = checksum(&frame).unwrap();
-        write(&path, frame, &manifest()).unwrap();
+        write(&path, frame.clone(), &manifest()).unwrap();
         let checked = read_checked(&path).unwrap();
-        assert_eq!(checksum(&checked.frame).unwrap(), before, "content");
+        assert!(checked.frame.equals_missing(&frame), "content");
         let mut m = checked.manifest.clone().unwrap();
         m.checksum = None;
         assert_eq!(m.to_json_text(), manifest().to_json_text(), "manifest");
         assert_eq!(checked.integrity, Integrity::Intact);
+    }
+
+    /// Every single-bit flip of a sealed table reads as damaged (and is never decoded), or
+    /// leaves a table that is still intact: never an abort, a panic or a different table.
+    #[test]
+    fn every_flipped_bit_is_caught_before_decoding() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.parquet");
+        let mut columns = Columns::new();
+        columns
+            .f64("R", (0..40).map(|i| Some(f64::from(i) * 0.25)).collect())
+            .i64("point", (0..40).map(Some).collect())
+            .str(
+                "failure",
+                (0..40)
+                    .map(|i| (i % 7 == 0).then(|| format!("f{i}")))
+                    .collect(),
+            );
+        write(&path, columns.into_frame().unwrap(), &manifest()).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let flipped = dir.path().join("flipped.parquet");
+        for byte in 0..bytes.len() {
+            for bit in 0..8 {
+                let mut copy = bytes.clone();
+                copy[byte] ^= 1 << bit;
+                std::fs::write(&flipped, &copy).unwrap();
+                let checked = read_checked(&flipped).unwrap();
+                assert_eq!(
+                    checked.integrity,
+                    Integrity::Damaged,
+                    "byte {byte} bit {bit}"
+                );
+                assert!(read(&flipped).is_err());
+                assert!(read_manifest(&flipped).is_err());
+            }
+        }
     }
 }
