@@ -101,6 +101,10 @@ impl Failure {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Err(reason) = start_threads() {
+        eprintln!("error: {reason}");
+        return ExitCode::from(2);
+    }
     let result = match cli.command {
         Command::Simulate(args) => simulate::run(&args),
         Command::Run(args) => pipeline_cmd::run_command(&args),
@@ -120,6 +124,29 @@ fn main() -> ExitCode {
             ExitCode::from(f.code)
         }
     }
+}
+
+/// Most worker threads `RAYON_NUM_THREADS` may ask for.
+const MAX_THREADS: usize = 1024;
+
+/// Starts the worker threads now, so that a bad `RAYON_NUM_THREADS` (not a number, or more
+/// threads than the system gives) is an input error rather than a panic deep inside a run.
+fn start_threads() -> Result<(), String> {
+    let asked = std::env::var("RAYON_NUM_THREADS").ok();
+    let mut builder = rayon::ThreadPoolBuilder::new();
+    if let Some(text) = &asked {
+        match text.trim().parse::<usize>() {
+            Ok(n) if n <= MAX_THREADS => builder = builder.num_threads(n),
+            _ => {
+                return Err(format!(
+                    "RAYON_NUM_THREADS=`{text}`: expected a whole number from 0 (all cores) to {MAX_THREADS}"
+                ))
+            }
+        }
+    }
+    builder
+        .build_global()
+        .map_err(|e| format!("cannot start the worker threads: {e}"))
 }
 
 /// The error and its causes on one line, each cause once: an error that already states its

@@ -43,6 +43,10 @@ pub(crate) struct RunArgs {
     /// a SLURM array job the shard comes from SLURM_ARRAY_TASK_ID / SLURM_ARRAY_TASK_COUNT.
     #[arg(long, value_name = "I/N")]
     shard: Option<String>,
+    /// Take the shard from SLURM's array variables (SLURM_ARRAY_TASK_ID, _COUNT, _MIN): a
+    /// plain `run` inside a SLURM job never shards unless asked.
+    #[arg(long, conflicts_with = "shard")]
+    shard_from_env: bool,
     /// Print what ran (or would run) as one JSON object on stdout: `stages` (each with
     /// `stage`, `runs`, `why`, `points`, `cached`), `ran`, `fresh`, `scenes_simulated`,
     /// `seconds`. Progress still goes to stderr.
@@ -105,11 +109,11 @@ pub(crate) struct DiffArgs {
     a: PathBuf,
     /// The result file or tree to compare with.
     b: PathBuf,
-    /// Absolute tolerance of every column.
-    #[arg(long, default_value_t = 0.0)]
+    /// Absolute tolerance of every column (a number >= 0, or inf).
+    #[arg(long, default_value_t = 0.0, value_parser = tolerance_value)]
     abs: f64,
-    /// Relative tolerance of every column.
-    #[arg(long, default_value_t = 0.0)]
+    /// Relative tolerance of every column (a number >= 0, or inf).
+    #[arg(long, default_value_t = 0.0, value_parser = tolerance_value)]
     rel: f64,
     /// A column's own tolerance: COLUMN=ABS or COLUMN=ABS,REL (repeatable).
     #[arg(long = "tol", value_name = "COLUMN=ABS[,REL]")]
@@ -117,6 +121,14 @@ pub(crate) struct DiffArgs {
 }
 
 fn load(at: &Locations) -> Result<Pipeline, Failure> {
+    for (flag, dir) in [("--results", &at.results), ("--figures", &at.figures)] {
+        if std::fs::metadata(dir).is_ok_and(|m| !m.is_dir()) {
+            return Err(Failure::input(anyhow::anyhow!(
+                "{flag} {}: not a directory",
+                dir.display()
+            )));
+        }
+    }
     Pipeline::load(&at.pipeline).map_err(Failure::input)
 }
 
@@ -135,9 +147,11 @@ fn requested_shard(args: &RunArgs) -> Result<Option<Shard>, Failure> {
     let bad = |reason: String| Failure::input(anyhow::anyhow!("--shard: {reason}"));
     let shard = match &args.shard {
         Some(text) => Some(Shard::parse(text).map_err(bad)?),
-        None if args.stages.len() == 1 => {
-            Shard::from_slurm(|k| std::env::var(k).ok()).map_err(bad)?
-        }
+        None if args.shard_from_env => Some(
+            Shard::from_slurm(|k| std::env::var(k).ok())
+                .map_err(bad)?
+                .ok_or_else(|| bad("--shard-from-env: SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT are not set".into()))?,
+        ),
         None => None,
     };
     if shard.is_some() && (args.stages.len() != 1 || args.force || args.dry_run) {
@@ -251,16 +265,23 @@ pub(crate) fn merge_command(args: &MergeArgs) -> Result<(), Failure> {
 pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
     let pipeline = load(&args.at)?;
     let stage = pipeline.stage(&args.stage).map_err(Failure::input)?;
-    if pipeline.sweep_axes(&stage.name).is_none() {
+    let Some(axes) = pipeline.sweep_axes(&stage.name) else {
         return Err(Failure::input(anyhow::anyhow!(
             "`{}` is a {} stage: only sweeps are sharded",
             stage.name,
             stage.kind
         )));
-    }
+    };
+    let points = woodpile_pipeline::grid::point_count(axes);
     if args.tasks == 0 || args.cpus == 0 {
         return Err(Failure::input(anyhow::anyhow!(
             "--tasks and --cpus must be at least 1"
+        )));
+    }
+    if args.tasks > points {
+        return Err(Failure::input(anyhow::anyhow!(
+            "--tasks {}: more tasks than the sweep's {points} points; use at most one task per point",
+            args.tasks
         )));
     }
     let absolute = |p: &PathBuf| -> Result<PathBuf, Failure> {
@@ -283,6 +304,8 @@ pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
         results: &absolute(&args.at.results)?,
         logs: &logs,
     };
+    job.validate()
+        .map_err(|reason| Failure::input(anyhow::anyhow!(reason)))?;
     let array = out.join(format!("{}.array.sbatch", stage.name));
     let merge = out.join(format!("{}.merge.sbatch", stage.name));
     let submit = out.join(format!("{}.submit.sh", stage.name));
@@ -368,11 +391,24 @@ pub(crate) fn diff_command(args: &DiffArgs) -> Result<bool, Failure> {
     for spec in &args.tolerances {
         let (column, tol) = parse_tolerance(spec)
             .map_err(|reason| Failure::input(anyhow::anyhow!("--tol `{spec}`: {reason}")))?;
-        options.columns.insert(column, tol);
+        if options.columns.insert(column.clone(), tol).is_some() {
+            return Err(Failure::input(anyhow::anyhow!(
+                "--tol `{spec}`: column `{column}` was given a tolerance already"
+            )));
+        }
     }
     let report = diff(&args.a, &args.b, &options).map_err(Failure::input)?;
     print_report(&report);
     Ok(report.agrees())
+}
+
+/// A tolerance flag's value: a number >= 0 (inf allowed), never negative or NaN.
+fn tolerance_value(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|x| *x >= 0.0)
+        .ok_or_else(|| format!("`{text}` is not a tolerance (a number >= 0 or inf)"))
 }
 
 fn parse_tolerance(spec: &str) -> Result<(String, Tolerance), String> {
@@ -385,15 +421,8 @@ fn parse_tolerance(spec: &str) -> Result<(String, Tolerance), String> {
     if parts.len() > 2 {
         return Err(format!("{} numbers; {FORM}", parts.len()));
     }
-    let number = |s: &str| -> Result<f64, String> {
-        s.trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|x| *x >= 0.0)
-            .ok_or_else(|| format!("`{s}` is not a tolerance (a number >= 0 or inf)"))
-    };
-    let abs = number(parts[0])?;
-    let rel = parts.get(1).map_or(Ok(0.0), |r| number(r))?;
+    let abs = tolerance_value(parts[0])?;
+    let rel = parts.get(1).map_or(Ok(0.0), |r| tolerance_value(r))?;
     Ok((column.trim().to_string(), Tolerance { abs, rel }))
 }
 

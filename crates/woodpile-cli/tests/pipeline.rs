@@ -133,14 +133,24 @@ fn shards_from_flags_and_slurm_variables_merge_to_the_local_result() {
     .success());
     let incomplete = woodpile(d, &["merge", "sweep", "--results", "cluster"]);
     assert!(
-        text(&incomplete.stderr).contains("missing shard(s) 1 of 2"),
+        text(&incomplete.stderr).contains("1 of 2 shard(s) missing (1;"),
         "{}",
         text(&incomplete.stderr)
     );
-    // Shard 1 from a SLURM array task's environment.
+    // Inside a SLURM array job a plain run does not shard: it writes the table.
+    let plain = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .current_dir(d)
+        .args(["run", "sweep", "--results", "plain"])
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "2")
+        .output()
+        .unwrap();
+    assert!(plain.status.success());
+    assert!(d.join("plain/sweep.parquet").exists());
+    // Shard 1 from a SLURM array task's environment, when asked.
     let task = Command::new(env!("CARGO_BIN_EXE_woodpile"))
         .current_dir(d)
-        .args(["run", "sweep", "--results", "cluster"])
+        .args(["run", "sweep", "--shard-from-env", "--results", "cluster"])
         .env("SLURM_ARRAY_TASK_ID", "1")
         .env("SLURM_ARRAY_TASK_COUNT", "2")
         .output()
@@ -165,13 +175,26 @@ fn shards_from_flags_and_slurm_variables_merge_to_the_local_result() {
         Some(2)
     );
 
+    for bad in [
+        vec!["--tasks", "3"],
+        vec!["--tasks", "1000000000"],
+        vec!["--partition", "short\ntouch x"],
+        vec!["--time", "1:00; rm -rf ~"],
+        vec!["--out", "slurm\nx"],
+    ] {
+        let mut args = vec!["slurm", "sweep"];
+        args.extend(bad.iter().copied());
+        let out = woodpile(d, &args);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", text(&out.stderr));
+    }
+    assert!(!d.join("x").exists());
     let scripts = woodpile(
         d,
-        &["slurm", "sweep", "--tasks", "3", "--partition", "short"],
+        &["slurm", "sweep", "--tasks", "2", "--partition", "short"],
     );
     assert!(scripts.status.success(), "{}", text(&scripts.stderr));
     let array = std::fs::read_to_string(d.join("slurm/sweep.array.sbatch")).unwrap();
-    assert!(array.contains("#SBATCH --array=0-2") && array.contains("#SBATCH --partition=short"));
+    assert!(array.contains("#SBATCH --array=0-1") && array.contains("#SBATCH --partition=short"));
     let submit = std::fs::read_to_string(d.join("slurm/sweep.submit.sh")).unwrap();
     assert!(submit.contains("--dependency=afterok"));
 }
@@ -181,7 +204,7 @@ fn malformed_or_unknown_tolerance_columns_exit_2() {
     let dir = project();
     let d = dir.path();
     assert!(woodpile(d, &["run"]).status.success());
-    for tol in ["R=1,2,3", "nope=1", "=1", "E_tr=x", "E_tr=-1"] {
+    for tol in ["R=1,2,3", "nope=1", "=1", "E_tr=x", "E_tr=-1", "E_tr=nan"] {
         let out = woodpile(d, &["diff", "results", "results", "--tol", tol]);
         assert_eq!(
             out.status.code(),
@@ -195,6 +218,46 @@ fn malformed_or_unknown_tolerance_columns_exit_2() {
             text(&out.stderr)
         );
     }
+    for args in [
+        vec!["--abs=-1"],
+        vec!["--abs", "nan"],
+        vec!["--rel", "-0.5"],
+        vec!["--tol", "E_tr=1", "--tol", "E_tr=2"],
+    ] {
+        let mut all = vec!["diff", "results", "results"];
+        all.extend(args.iter().copied());
+        let out = woodpile(d, &all);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            text(&out.stderr)
+        );
+    }
+    std::fs::create_dir_all(d.join("empty_a")).unwrap();
+    std::fs::create_dir_all(d.join("empty_b")).unwrap();
+    let empty = woodpile(d, &["diff", "empty_a", "empty_b"]);
+    assert_eq!(empty.status.code(), Some(1), "{}", text(&empty.stdout));
+    assert!(text(&empty.stdout).contains("nothing to compare"));
+    std::fs::write(d.join("a_file"), "x").unwrap();
+    let not_dir = woodpile(d, &["run", "--results", "a_file"]);
+    assert_eq!(not_dir.status.code(), Some(2));
+    assert!(
+        text(&not_dir.stderr).contains("not a directory"),
+        "{}",
+        text(&not_dir.stderr)
+    );
+    let threads = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .current_dir(d)
+        .args(["status"])
+        .env("RAYON_NUM_THREADS", "100000")
+        .output()
+        .unwrap();
+    assert_eq!(threads.status.code(), Some(2));
+    assert!(
+        text(&threads.stderr).contains("RAYON_NUM_THREADS")
+            && !text(&threads.stderr).contains("panicked")
+    );
     let ok = woodpile(
         d,
         &["diff", "results", "results", "--tol", "E_tr=1e-9,1e-6"],
@@ -268,4 +331,69 @@ fn a_closed_pipe_is_not_a_panic() {
         "{:?}",
         out.status
     );
+}
+
+const REDUCE: &str = r#"
+kind = "reduce"
+inputs = ["sweep"]
+at = 10.0
+"#;
+
+const FIGURE: &str = r#"
+kind = "render"
+inputs = ["at_end"]
+title = "TITLE"
+[lines]
+x = "eps"
+y = ["R", "E_tr"]
+x_label = "eps"
+y_label = "fraction"
+"#;
+
+/// `kill -9` at spread-out moments of a render run for an edited title, then the edit
+/// reverted: whatever the kill left, `status` never calls the figure fresh unless it is the
+/// original's, and the next run restores it.
+#[test]
+fn a_killed_render_followed_by_a_revert_is_never_fresh_with_the_wrong_figure() {
+    let dir = project();
+    let d = dir.path();
+    let write = |title: &str| {
+        std::fs::write(d.join("pipeline/at_end.toml"), REDUCE).unwrap();
+        std::fs::write(d.join("pipeline/fig.toml"), FIGURE.replace("TITLE", title)).unwrap();
+    };
+    write("original");
+    assert!(woodpile(d, &["run"]).status.success());
+    let png = d.join("figures/fig.png");
+    let original = std::fs::read(&png).unwrap();
+    // Delays from 0 to about 150 ms, spread by a fixed sequence (the render takes about that).
+    let mut seed: u64 = 12345;
+    for trial in 0..12 {
+        write(&format!("edited {trial}"));
+        let mut child = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+            .current_dir(d)
+            .args(["run"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        std::thread::sleep(std::time::Duration::from_millis((seed >> 33) % 150));
+        let _ = child.kill();
+        let _ = child.wait();
+        write("original");
+        let status = woodpile(d, &["status", "--json"]);
+        let fresh = text(&status.stdout)
+            .contains(r#"{"kind":"render","stage":"fig","state":"fresh","why":""}"#);
+        if fresh {
+            assert_eq!(
+                std::fs::read(&png).unwrap(),
+                original,
+                "trial {trial}: fresh with another figure"
+            );
+        }
+        assert!(woodpile(d, &["run"]).status.success());
+        assert_eq!(std::fs::read(&png).unwrap(), original, "trial {trial}");
+    }
 }

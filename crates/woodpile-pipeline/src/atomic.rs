@@ -77,7 +77,7 @@ fn temp_file(path: &Path, dir: &Path) -> std::io::Result<tempfile::NamedTempFile
     tempfile::Builder::new()
         .prefix(&format!(".{name}~{}~{}~", host(), std::process::id()))
         .suffix(".tmp")
-        .rand_bytes(12)
+        .rand_bytes(TEMP_RANDOM)
         .tempfile_in(dir)
 }
 
@@ -107,16 +107,24 @@ fn host() -> &'static str {
     })
 }
 
-/// The writer (host, process id) of one of [`temp_file`]'s temporaries; the `.{name}.{pid}.tmp`
-/// of earlier versions counts as this host's.
+/// The writer (host, process id) of one of [`temp_file`]'s temporaries, recognised by their
+/// exact form `.{name}~{host}~{pid}~{12 random alphanumerics}.tmp`: a user's own `.x.123.tmp`
+/// in a figures folder is not woodpile's, and is never removed.
 fn temp_owner(name: &str) -> Option<(&str, u32)> {
     let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
     let mut parts = rest.rsplitn(4, '~');
-    match (parts.next(), parts.next(), parts.next(), parts.next()) {
-        (Some(_token), Some(pid), Some(host), Some(_name)) => Some((host, pid.parse().ok()?)),
-        _ => Some((host(), rest.rsplit_once('.')?.1.parse().ok()?)),
-    }
+    let (Some(token), Some(pid), Some(host), Some(_name)) =
+        (parts.next(), parts.next(), parts.next(), parts.next())
+    else {
+        return None;
+    };
+    let random = token.len() == TEMP_RANDOM && token.chars().all(|c| c.is_ascii_alphanumeric());
+    let digits = !pid.is_empty() && pid.chars().all(|c| c.is_ascii_digit());
+    (random && digits && !host.is_empty()).then(|| Some((host, pid.parse().ok()?)))?
 }
+
+/// Random characters in a temporary's name.
+const TEMP_RANDOM: usize = 12;
 
 /// How old another machine's temporary must be before a sweep removes it: its writer cannot be
 /// asked whether it still runs, and no writer spends a day on one file.
@@ -190,17 +198,23 @@ mod tests {
     fn stale_temporaries_of_dead_writers_are_swept_live_ones_kept() {
         let dir = tempfile::tempdir().unwrap();
         // pid 0 is never a user process; our own pid is alive.
-        let dead = dir.path().join(format!(".out.bin~{}~0~1-ab.tmp", host()));
+        let dead = dir
+            .path()
+            .join(format!(".out.bin~{}~0~Ab3dEf6hIj9l.tmp", host()));
         let live_file = temp_file(&dir.path().join("out.bin"), dir.path()).unwrap();
         let live = live_file.path().to_path_buf();
         // Another machine's fresh temporary: its writer may be running there.
-        let foreign = dir.path().join(".out.bin~elsewhere~0~1-ab.tmp");
+        let foreign = dir.path().join(".out.bin~elsewhere~0~Ab3dEf6hIj9l.tmp");
         let other = dir.path().join("keep.tmp");
-        for p in [&dead, &live, &foreign, &other] {
+        // A user's own temporaries that only look alike.
+        let users = dir.path().join(".notes.123.tmp");
+        let short = dir.path().join(format!(".out.bin~{}~0~1-ab.tmp", host()));
+        for p in [&dead, &live, &foreign, &other, &users, &short] {
             fs::write(p, b"x").unwrap();
         }
         assert_eq!(sweep_stale_temps(dir.path()), 1);
         assert!(!dead.exists() && live.exists() && foreign.exists() && other.exists());
+        assert!(users.exists() && short.exists());
     }
 
     #[test]
@@ -217,7 +231,7 @@ mod tests {
         assert_eq!(temp_owner("a.parquet"), None);
         assert_eq!(temp_owner(".a.tmp"), None);
         assert_eq!(temp_owner(".a~h~x~t.tmp"), None);
-        assert_eq!(temp_owner(".a.parquet.123.tmp"), Some((host(), 123)));
+        assert_eq!(temp_owner(".a.parquet.123.tmp"), None);
     }
 
     #[test]

@@ -98,6 +98,13 @@ pub fn diff(a: &Path, b: &Path, options: &DiffOptions) -> Result<DiffReport> {
                 .problems
                 .push(format!("{name}: only in {}", b.display()));
         }
+        if fa.is_empty() && fb.is_empty() {
+            report.problems.push(format!(
+                "no tables in {} or {}: nothing to compare",
+                a.display(),
+                b.display()
+            ));
+        }
         for (name, pa) in &fa {
             if let Some(pb) = fb.get(name) {
                 compare_files(name, pa, pb, options, &mut report)?;
@@ -140,7 +147,10 @@ fn parquet_files(root: &Path) -> Result<BTreeMap<String, PathBuf>> {
                 .unwrap_or(&path)
                 .to_string_lossy()
                 .into_owned();
-            if path.is_dir() {
+            // The entry's own type: a symbolic link to a folder is not followed (a link to
+            // `.` would make the walk endless).
+            let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+            if is_dir {
                 if rel != "points" && rel != "parts" {
                     walk(root, &path, out)?;
                 }

@@ -199,7 +199,9 @@ fn stage_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
     let entries = std::fs::read_dir(dir).map_err(|e| PipelineError::io(dir, e))?;
     for entry in entries.flatten() {
         let path = entry.path();
-        if path.is_dir() {
+        // The entry's own type: a symbolic link to a folder is not followed (a link to `.`
+        // would make the walk endless).
+        if entry.file_type().is_ok_and(|t| t.is_dir()) {
             stage_files(&path, out)?;
         } else if path.extension().is_some_and(|x| x == "toml") {
             out.push(path);

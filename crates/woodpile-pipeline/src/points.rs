@@ -22,6 +22,8 @@ use crate::canonical::Key;
 use crate::error::Result;
 
 const MAGIC: &[u8; 4] = b"WPPT";
+/// The largest point file read: far beyond a series of the sample budget's length.
+const MAX_POINT_BYTES: u64 = 1 << 30;
 const FORMAT: u8 = 1;
 
 /// What simulating one scene gave: its fraction time series, or why it failed.
@@ -130,7 +132,9 @@ impl PointStore {
 
     /// The cached result of `key`, or `None` when absent or damaged.
     pub fn load(&self, key: &Key) -> Option<PointResult> {
-        let bytes = std::fs::read(self.path(key)).ok()?;
+        // Only a regular file of bounded size: a FIFO or a link to /dev/zero in the cache
+        // reads as absent (and is recomputed), never blocks or fills the memory.
+        let bytes = crate::regular::read(&self.path(key), MAX_POINT_BYTES).ok()?;
         decode(&bytes, key)
     }
 

@@ -5,7 +5,7 @@
 //! `fstat` on the open descriptor, so nothing can be swapped in between the check and the use.
 
 use std::fs::{File, OpenOptions};
-use std::io::Read;
+use std::io::{Error, Read};
 use std::path::Path;
 
 /// Why a path is refused, for messages: `None` when it is a regular file (or absent).
@@ -34,33 +34,34 @@ fn no_follow(options: &mut OpenOptions) -> &mut OpenOptions {
 }
 
 /// Opens `path` with `options` (plus no-follow), then checks that it is a regular file.
-pub fn open(path: &Path, options: &mut OpenOptions) -> Result<File, String> {
+pub fn open(path: &Path, options: &mut OpenOptions) -> Result<File, Error> {
     if let Some(reason) = refusal(path) {
-        return Err(reason);
+        return Err(Error::other(reason));
     }
     let file = no_follow(options)
         .open(path)
-        .map_err(|e| refusal(path).unwrap_or_else(|| e.to_string()))?;
-    let meta = file.metadata().map_err(|e| e.to_string())?;
-    if !meta.is_file() {
-        return Err("not a regular file".into());
+        .map_err(|e| refusal(path).map_or(e, Error::other))?;
+    if !file.metadata()?.is_file() {
+        return Err(Error::other("not a regular file"));
     }
     Ok(file)
 }
 
 /// The whole of the regular file `path`, if it has at most `limit` bytes.
-pub fn read(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+pub fn read(path: &Path, limit: u64) -> Result<Vec<u8>, Error> {
     let file = open(path, OpenOptions::new().read(true))?;
-    let too_big = |n: u64| format!("{n} bytes, more than the {limit} a file here may have");
-    let len = file.metadata().map_err(|e| e.to_string())?.len();
+    let too_big = |n: u64| {
+        Error::other(format!(
+            "{n} bytes, more than the {limit} a file here may have"
+        ))
+    };
+    let len = file.metadata()?.len();
     if len > limit {
         return Err(too_big(len));
     }
     let mut bytes = Vec::with_capacity(len as usize);
     // The file may grow between the check and the read: never read more than the limit.
-    file.take(limit + 1)
-        .read_to_end(&mut bytes)
-        .map_err(|e| e.to_string())?;
+    file.take(limit + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
         return Err(too_big(bytes.len() as u64));
     }
@@ -77,20 +78,21 @@ mod tests {
         let file = dir.path().join("t.parquet");
         std::fs::write(&file, b"1234").unwrap();
         assert_eq!(read(&file, 4).unwrap(), b"1234");
-        assert!(read(&file, 3).unwrap_err().contains("more than the 3"));
-        assert!(read(dir.path(), 10).unwrap_err().contains("directory"));
+        let message = |p: &Path, limit| read(p, limit).unwrap_err().to_string();
+        assert!(message(&file, 3).contains("more than the 3"));
+        assert!(message(dir.path(), 10).contains("directory"));
         #[cfg(unix)]
         {
             let link = dir.path().join("link.parquet");
             std::os::unix::fs::symlink(&file, &link).unwrap();
-            assert!(read(&link, 10).unwrap_err().contains("symbolic link"));
+            assert!(message(&link, 10).contains("symbolic link"));
             let zero = dir.path().join("zero.parquet");
             std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
-            assert!(read(&zero, 10).unwrap_err().contains("symbolic link"));
+            assert!(message(&zero, 10).contains("symbolic link"));
             let fifo = dir.path().join("fifo.parquet");
             let made = std::process::Command::new("mkfifo").arg(&fifo).status();
             if made.is_ok_and(|s| s.success()) {
-                assert!(read(&fifo, 10).unwrap_err().contains("FIFO"));
+                assert!(message(&fifo, 10).contains("FIFO"));
             }
         }
     }

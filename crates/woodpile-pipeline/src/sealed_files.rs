@@ -22,7 +22,7 @@ fn name(path: &Path) -> String {
     )
 }
 
-fn hash(path: &Path) -> std::result::Result<String, String> {
+fn hash(path: &Path) -> std::io::Result<String> {
     regular::read(path, MAX_FILE_BYTES).map(|bytes| blake3::hash(&bytes).to_hex().to_string())
 }
 

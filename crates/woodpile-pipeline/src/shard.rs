@@ -150,6 +150,16 @@ pub fn run_shard(
 ) -> Result<ShardRun> {
     let (stage, sweep) = sweep_of(pipeline, name)?;
     let key = pipeline.key(name).to_string();
+    if shard.count > sweep.count() {
+        return Err(PipelineError::stage(
+            name,
+            format!(
+                "--shard {shard}: {} shards for a sweep of {} points; use at most one shard per point",
+                shard.count,
+                sweep.count()
+            ),
+        ));
+    }
     let part = part_path(results, name, &key, shard);
     let indices = shard.points(sweep.count());
     // Done only if the part is for this definition and intact: a damaged part is recomputed.
@@ -228,15 +238,22 @@ pub fn merge(
         ));
     }
     let n = counts[0];
-    current.sort_by_key(|(s, _)| s.index);
-    let missing: Vec<String> = (0..n)
-        .filter(|i| !current.iter().any(|(s, _)| s.index == *i))
-        .map(|i| i.to_string())
-        .collect();
-    if !missing.is_empty() {
+    if n > sweep.count() {
         return fail(format!(
-            "incomplete: missing shard(s) {} of {n} (run `woodpile run {name} --shard I/{n}` for each)",
-            missing.join(", ")
+            "parts were made with {n} shards, more than the sweep's {} points: re-run them with at most one shard per point",
+            sweep.count()
+        ));
+    }
+    current.sort_by_key(|(s, _)| s.index);
+    let present: std::collections::HashSet<usize> = current.iter().map(|(s, _)| s.index).collect();
+    let missing = (0..n).filter(|i| !present.contains(i));
+    let examples: Vec<String> = missing.clone().take(5).map(|i| i.to_string()).collect();
+    if !examples.is_empty() {
+        let count = missing.count();
+        let more = if count > examples.len() { ", ..." } else { "" };
+        return fail(format!(
+            "incomplete: {count} of {n} shard(s) missing ({}{more}; run `woodpile run {name} --shard I/{n}` for each)",
+            examples.join(", ")
         ));
     }
     let mut frame: Option<DataFrame> = None;

@@ -34,6 +34,43 @@ fn quote(path: &Path) -> String {
 }
 
 impl SlurmJob<'_> {
+    /// Refuses what a script cannot carry safely: a value with a character outside
+    /// `[A-Za-z0-9-_:.,+]` (partition, time), or a path with a control character such as a
+    /// newline, which no quoting protects in an `#SBATCH` line. The error names the flag.
+    pub fn validate(&self) -> Result<(), String> {
+        for (flag, value) in [("--partition", self.partition), ("--time", self.time)] {
+            if let Some(v) = value {
+                if v.is_empty()
+                    || !v
+                        .chars()
+                        .all(|c| c.is_ascii_alphanumeric() || "-_:.,+".contains(c))
+                {
+                    return Err(format!(
+                        "{flag} `{}`: only letters, digits and -_:.,+ may go into a SLURM script",
+                        v.escape_debug()
+                    ));
+                }
+            }
+        }
+        let paths = [
+            ("the woodpile binary", self.binary),
+            ("the working directory", self.workdir),
+            ("--pipeline", self.pipeline),
+            ("--results", self.results),
+            ("--out", self.logs),
+        ];
+        for (what, path) in paths {
+            let text = path.display().to_string();
+            if text.chars().any(char::is_control) {
+                return Err(format!(
+                    "{what} `{}`: a path with a control character (a newline, a tab) cannot go into a SLURM script",
+                    text.escape_debug()
+                ));
+            }
+        }
+        Ok(())
+    }
+
     fn header(&self, name: &str, log: &str) -> String {
         let mut h = format!(
             "#!/bin/bash\n#SBATCH --job-name={name}\n#SBATCH --output={}/{log}\n#SBATCH --cpus-per-task={}\n",

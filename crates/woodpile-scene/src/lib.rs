@@ -47,6 +47,10 @@ pub enum SceneError {
     },
 }
 
+/// Most defects a scene may have: a thousand times the paper's largest block, and few enough
+/// that planning a sweep of such scenes never needs gigabytes.
+pub const MAX_DEFECTS: usize = 10_000;
+
 /// Largest scene or stage file accepted: a hundred times the largest the paper needs, and small
 /// enough that parsing it never takes long or much memory.
 pub const MAX_FILE_BYTES: u64 = 1 << 20;

@@ -167,22 +167,32 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         None => None,
     };
 
-    if file.defect.len() > n_sites {
+    if file.defect.len() > n_sites.min(crate::MAX_DEFECTS) {
         return Err(invalid(
             "defect",
             format!(
-                "{} defects on a chain of {n_sites} sites: at most one resonator per site",
-                file.defect.len()
+                "{} defects on a chain of {n_sites} sites: at most one resonator per site, and at most {} in a scene",
+                file.defect.len(),
+                crate::MAX_DEFECTS
             ),
         ));
     }
     let mut resonators = Vec::with_capacity(file.defect.len());
     let mut masses = vec![1.0; n_sites];
     let mut derived = Vec::new();
+    let mut taken = std::collections::HashMap::new();
     for (i, d) in file.defect.iter().enumerate() {
         let key = |k: &str| format!("defect[{i}].{k}");
         let site_paper = d.site.ok_or_else(|| invalid(key("site"), "is required"))?;
         let site = on_chain(&key("site"), site_paper)?;
+        if let Some(first) = taken.insert(site_paper, i) {
+            return Err(invalid(
+                key("site"),
+                format!(
+                    "site {site_paper} already has defect[{first}]: at most one resonator per site"
+                ),
+            ));
+        }
         let p = d.p.unwrap_or(1);
         if !(p == 1 || (p >= 3 && p % 2 == 1 && p <= 99)) {
             return Err(invalid(
@@ -607,6 +617,12 @@ mod tests {
             text.push_str("[[defect]]\nsite = 0\neps = 1.0\n");
         }
         assert_eq!(invalid_key(&text), "defect");
+    }
+
+    #[test]
+    fn two_defects_on_one_site_are_refused() {
+        let text = "[[defect]]\nsite = 3\neps = 1.0\n[[defect]]\nsite = 3\neps = 2.0\n";
+        assert_eq!(invalid_key(text), "defect[1].site");
     }
 
     #[test]

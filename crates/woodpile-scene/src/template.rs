@@ -171,10 +171,14 @@ fn expand_blocks(table: &mut toml::Table) -> Result<(), TemplateError> {
         // Never build more defects than the chain has sites (the scene would refuse them
         // anyway): `through = 99999999` must not allocate a hundred million tables first.
         let block = last.saturating_sub(site).saturating_add(1);
-        if block.saturating_add(expanded.len() as i64) > sites {
+        let most = sites.min(crate::MAX_DEFECTS as i64);
+        if block.saturating_add(expanded.len() as i64) > most {
             return Err((
                 key("through"),
-                format!("a block of {block} defects on a chain of {sites} sites"),
+                format!(
+                    "a block of {block} defects on a chain of {sites} sites (a scene may have at most {} defects)",
+                    crate::MAX_DEFECTS
+                ),
             ));
         }
         for s in site..=last {

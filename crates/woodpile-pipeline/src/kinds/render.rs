@@ -219,6 +219,12 @@ impl Render {
             let drawn = spec.draw(frame, title).map_err(fail)?;
             names.extend(std::iter::repeat_n(spec.columns(), drawn.len()));
             panels.extend(drawn);
+            if panels.len() > MAX_PANELS {
+                return Err(PipelineError::stage(
+                    stage,
+                    format!("more than the {MAX_PANELS} panels a figure may have"),
+                ));
+            }
         }
         if self.same_colour_scale {
             share_colour_scale(&mut panels);
@@ -415,37 +421,83 @@ fn quotes(text: &str) -> impl Iterator<Item = &str> {
         .filter_map(|part| part.split_once('}').map(|(q, _)| q))
 }
 
-/// `text` with every `{stage.path}` replaced by that value of the stage's manifest.
+/// Most panels one figure may have: more are unreadable, and each costs memory to draw.
+const MAX_PANELS: usize = 64;
+
+/// Longest text a title or label may expand to: far more than any figure shows.
+const MAX_EXPANDED_CHARS: usize = 100_000;
+
+/// `text` with every `{stage.path}` replaced by that value of the stage's manifest, in one
+/// pass over `text`: inserted values are never expanded again (a quoted value cannot inject
+/// quotes, and the order of the quotes does not matter), each distinct quote is looked up
+/// once, and the result is at most [`MAX_EXPANDED_CHARS`] long.
 fn quoted(
     text: &str,
     inputs: &HashMap<String, (DataFrame, Manifest)>,
 ) -> std::result::Result<String, String> {
-    let mut out = text.to_string();
-    for quote in quotes(text) {
-        let (stage, path) = quote.split_once('.').unwrap_or((quote, ""));
+    let mut manifests: HashMap<&str, Value> = HashMap::new();
+    let mut values: HashMap<&str, String> = HashMap::new();
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(open) = rest.find('{') {
+        out.push_str(&rest[..open]);
+        let after = &rest[open + 1..];
+        // A quote runs to the next `}` with no `{` before it; anything else is literal.
+        let Some(close) = after
+            .find(['{', '}'])
+            .filter(|&i| after.as_bytes()[i] == b'}')
+        else {
+            out.push('{');
+            rest = after;
+            continue;
+        };
+        let quote = &after[..close];
+        if !values.contains_key(quote) {
+            let shown = quote_value(quote, inputs, &mut manifests)?;
+            values.insert(quote, shown);
+        }
+        out.push_str(&values[quote]);
+        if out.len() > MAX_EXPANDED_CHARS {
+            return Err(format!(
+                "the text expands to more than {MAX_EXPANDED_CHARS} characters; quote less"
+            ));
+        }
+        rest = &after[close + 1..];
+    }
+    out.push_str(rest);
+    Ok(out)
+}
+
+/// The shown value of one quote `stage.path`.
+fn quote_value<'a>(
+    quote: &'a str,
+    inputs: &HashMap<String, (DataFrame, Manifest)>,
+    manifests: &mut HashMap<&'a str, Value>,
+) -> std::result::Result<String, String> {
+    let (stage, path) = quote.split_once('.').unwrap_or((quote, ""));
+    if !manifests.contains_key(stage) {
         let manifest = inputs
             .get(stage)
             .map(|(_, m)| serde_json::to_value(m).unwrap_or(Value::Null))
             .ok_or_else(|| format!("`{{{quote}}}`: no input `{stage}`"))?;
-        // Dotted keys; a number indexes an array (`params.scene.defect.0.eps`).
-        let value = path
-            .split('.')
-            .filter(|k| !k.is_empty())
-            .try_fold(&manifest, |v, k| match (v, k.parse::<usize>()) {
-                (Value::Array(items), Ok(i)) => items.get(i),
-                _ => v.get(k),
-            })
-            .ok_or_else(|| format!("`{{{quote}}}`: the manifest of `{stage}` has no `{path}`"))?;
-        let shown = match value {
-            Value::Number(n) => n
-                .as_f64()
-                .map_or(n.to_string(), |x| woodpile_plot::tick(&x)),
-            Value::String(s) => s.clone(),
-            other => other.to_string(),
-        };
-        out = out.replace(&format!("{{{quote}}}"), &shown);
+        manifests.insert(stage, manifest);
     }
-    Ok(out)
+    // Dotted keys; a number indexes an array (`params.scene.defect.0.eps`).
+    let value = path
+        .split('.')
+        .filter(|k| !k.is_empty())
+        .try_fold(&manifests[stage], |v, k| match (v, k.parse::<usize>()) {
+            (Value::Array(items), Ok(i)) => items.get(i),
+            _ => v.get(k),
+        })
+        .ok_or_else(|| format!("`{{{quote}}}`: the manifest of `{stage}` has no `{path}`"))?;
+    Ok(match value {
+        Value::Number(n) => n
+            .as_f64()
+            .map_or(n.to_string(), |x| woodpile_plot::tick(&x)),
+        Value::String(s) => s.clone(),
+        other => other.to_string(),
+    })
 }
 
 /// Gives every heat map the union of their colour ranges.
@@ -615,6 +667,16 @@ impl PanelSpec {
         let mut keys: Vec<f64> = panel_values.iter().flatten().copied().collect();
         keys.sort_by(f64::total_cmp);
         keys.dedup();
+        if keys.len() > MAX_PANELS {
+            return Err(PipelineError::stage(
+                "render",
+                format!(
+                    "`panels = \"{}\"` makes {} panels, more than the {MAX_PANELS} a figure may have; filter the rows with `where` or choose another column",
+                    panel_name.map_or("", |p| p.as_str()),
+                    keys.len()
+                ),
+            ));
+        }
         let data: Vec<Vec<Option<f64>>> = used.iter().map(|c| column(c)).collect::<Result<_>>()?;
         let labels = match &self.plot {
             Plot::Lines { series_label, .. } => text_column(series_label.as_ref())?,

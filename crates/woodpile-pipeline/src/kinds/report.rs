@@ -182,6 +182,13 @@ impl Report {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Report> {
         let markdown: String = fields.required("markdown")?;
         check_markdown_path(&markdown).map_err(|reason| fields.error("markdown", reason))?;
+        // One spelling per file (`d//x.md`, `./d/x.md` and `d/x.md` are one file), so that the
+        // one-writer check compares files, not strings.
+        let markdown = Path::new(&markdown)
+            .components()
+            .collect::<PathBuf>()
+            .to_string_lossy()
+            .into_owned();
         let title: String = fields.required("title")?;
         let preamble: String = fields.optional("preamble")?.unwrap_or_default();
         let Some(toml::Value::Array(entries)) = fields.take("quote") else {
@@ -226,6 +233,27 @@ impl Report {
     /// and those that carry its generated mark near the top (what a run killed between the
     /// Markdown and the table, or a damaged table, leaves: never a stuck stage).
     fn check_owned(&self, stage: &str, path: &Path, results: &Path) -> Result<()> {
+        // Inside the tree means inside it on disk too: no folder on the way may be a
+        // symbolic link (`docs -> /elsewhere`).
+        let root = results.parent().unwrap_or_else(|| Path::new(""));
+        let mut folder = root.to_path_buf();
+        for part in Path::new(&self.markdown)
+            .parent()
+            .into_iter()
+            .flat_map(Path::components)
+        {
+            folder.push(part);
+            if std::fs::symlink_metadata(&folder).is_ok_and(|m| m.file_type().is_symlink()) {
+                return Err(PipelineError::stage(
+                    stage,
+                    format!(
+                        "`markdown = \"{}\"`: {} is a symbolic link; a report writes only inside the project",
+                        self.markdown,
+                        folder.display()
+                    ),
+                ));
+            }
+        }
         if std::fs::symlink_metadata(path).is_err() {
             return Ok(());
         }
@@ -345,13 +373,18 @@ impl Report {
 }
 
 /// A report's Markdown must stay inside the tree that holds `results/` (a relative path of
-/// plain names, no `..`) and be Markdown: any other extension could overwrite another stage's
+/// plain names, no `..`; `.` and repeated slashes are dropped) and be Markdown: any other extension could overwrite another stage's
 /// table or figure.
 fn check_markdown_path(markdown: &str) -> std::result::Result<(), String> {
     let path = Path::new(markdown);
-    let plain = path
+    let plain = path.components().all(|c| {
+        matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    }) && path
         .components()
-        .all(|c| matches!(c, std::path::Component::Normal(_)));
+        .any(|c| matches!(c, std::path::Component::Normal(_)));
     if markdown.is_empty() || !plain {
         return Err(format!(
             "`{markdown}` must be a relative path inside the project (no `..`, not absolute)"

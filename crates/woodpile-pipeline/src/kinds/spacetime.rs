@@ -60,6 +60,30 @@ pub enum Source {
     Design(String),
 }
 
+/// Most field values a spacetime stage may keep as table rows (about 40 bytes each in memory).
+const MAX_FIELD_ROWS: u64 = 20_000_000;
+/// Most velocities its scenes may record in all, before the field is cut to its sites (f32).
+const MAX_RECORDED: u64 = 250_000_000;
+
+/// Refuses a field too large to hold: `count` scenes like `scene`, kept on `sites`.
+fn field_size(scene: &Scene, count: usize, sites: [i64; 2]) -> std::result::Result<(), String> {
+    let s = &scene.scenario;
+    let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1;
+    let width = (sites[1] - sites[0] + 1).max(0) as u64;
+    let rows = (count as u64).saturating_mul(samples).saturating_mul(width);
+    let recorded = (count as u64)
+        .saturating_mul(samples)
+        .saturating_mul(s.model.n_sites() as u64);
+    if rows > MAX_FIELD_ROWS || recorded > MAX_RECORDED {
+        return Err(format!(
+            "{count} scene(s) of {samples} samples on {width} sites ({} of the chain's {}) would keep {rows} field values, more than the {MAX_FIELD_ROWS} a spacetime stage may keep; keep fewer sites or sample less often",
+            width,
+            s.model.n_sites()
+        ));
+    }
+    Ok(())
+}
+
 impl SpaceTime {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<SpaceTime> {
         if let Some(design) = fields.optional::<String>("design")? {
@@ -85,6 +109,10 @@ impl SpaceTime {
         if sites[0] < first || sites[1] > last {
             return Err(fields.error("field.sites", format!("sites must lie in {first}..{last}")));
         }
+        // The largest scene of the grid (its last point) bounds every point's field.
+        let largest = sweep.scene_at(sweep.count() - 1)?;
+        field_size(&largest, sweep.count(), sites)
+            .map_err(|reason| fields.error("field.sites", reason))?;
         Ok(SpaceTime {
             source: Source::Grid(sweep),
             sites,
@@ -112,6 +140,10 @@ impl SpaceTime {
                         ),
                     ));
                 }
+                // A design's scene is known only now: bound its field before simulating it.
+                field_size(&scene, 1, self.sites).map_err(|reason| {
+                    PipelineError::stage(stage, format!("field.sites: {reason}"))
+                })?;
                 (vec![(Vec::new(), scene)], &[])
             }
         };

@@ -1,0 +1,363 @@
+//! What a results tree cannot do to woodpile: a file left by an interrupted or abandoned run
+//! is never fresh, a report is never stuck, and links, FIFOs, loops and oversized requests are
+//! refused or bounded instead of hanging, aborting or writing outside the tree.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+
+use woodpile_pipeline::events::Silent;
+use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::status::{output_path, state, State};
+use woodpile_pipeline::{table, Pipeline};
+
+const SWEEP: &str = r#"
+kind = "sweep"
+[axes]
+eps = [0.5, 1.0, 1.5]
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
+[[scene.defect]]
+site = 0
+eps = "$eps"
+"#;
+
+const REDUCE: &str = r#"
+kind = "reduce"
+inputs = ["sweep"]
+at = 12.0
+"#;
+
+const FIGURE: &str = r#"
+kind = "render"
+inputs = ["at_end"]
+title = "TITLE"
+[lines]
+x = "eps"
+y = ["R", "E_tr"]
+x_label = "eps"
+y_label = "fraction"
+"#;
+
+const REPORT: &str = r#"
+kind = "report"
+inputs = ["at_end"]
+markdown = "REPORT.md"
+title = "Tiny report"
+[[quote]]
+figure = "X1"
+quantity = "E_tr at eps = 1"
+paper = 0.5
+agree = 1.0
+as_run = "t = 12"
+ours = { stage = "at_end", column = "E_tr", where = { eps = 1.0 } }
+"#;
+
+struct Project {
+    dir: tempfile::TempDir,
+}
+
+impl Project {
+    fn new(stages: &[(&str, &str)]) -> Project {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("pipeline")).unwrap();
+        let p = Project { dir };
+        for (name, text) in stages {
+            p.write(name, text);
+        }
+        p
+    }
+    fn root(&self) -> &Path {
+        self.dir.path()
+    }
+    fn pipeline(&self) -> PathBuf {
+        self.root().join("pipeline")
+    }
+    fn results(&self) -> PathBuf {
+        self.root().join("results")
+    }
+    fn figures(&self) -> PathBuf {
+        self.root().join("figures")
+    }
+    fn write(&self, name: &str, text: &str) {
+        std::fs::write(self.pipeline().join(format!("{name}.toml")), text).unwrap();
+    }
+    fn run(&self, targets: &[&str]) -> woodpile_pipeline::Result<()> {
+        let options = RunOptions {
+            targets: targets.iter().map(|s| s.to_string()).collect(),
+            force: false,
+            dry_run: false,
+            results: self.results(),
+            figures: self.figures(),
+        };
+        run(&Pipeline::load(&self.pipeline())?, &options, &Silent).map(|_| ())
+    }
+    fn state(&self, name: &str) -> State {
+        let p = Pipeline::load(&self.pipeline()).unwrap();
+        state(&p, &self.results(), &self.figures(), p.stage(name).unwrap())
+    }
+    fn output(&self, name: &str) -> PathBuf {
+        output_path(&self.results(), name)
+    }
+}
+
+/// A figure written by a run whose table never followed (killed, or a full disk), after which
+/// the user reverted the stage file: the table's key says fresh, but the figure is the edited
+/// one. Status must call it stale, and a run must draw the figure again.
+#[test]
+fn a_figure_from_an_abandoned_edit_is_never_fresh() {
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("figure", &FIGURE.replace("TITLE", "first")),
+    ]);
+    p.run(&[]).unwrap();
+    let png = p.figures().join("figure.png");
+    let original = std::fs::read(&png).unwrap();
+    let table_before = std::fs::read(p.output("figure")).unwrap();
+
+    p.write("figure", &FIGURE.replace("TITLE", "edited"));
+    p.run(&[]).unwrap();
+    assert_ne!(std::fs::read(&png).unwrap(), original);
+    // The edited run's table is lost; the stage file is reverted.
+    std::fs::write(p.output("figure"), &table_before).unwrap();
+    p.write("figure", &FIGURE.replace("TITLE", "first"));
+
+    match p.state("figure") {
+        State::Stale(why) => assert!(
+            why.join(" ").contains("not what this stage wrote"),
+            "{why:?}"
+        ),
+        other => panic!("{other:?}"),
+    }
+    p.run(&[]).unwrap();
+    assert_eq!(std::fs::read(&png).unwrap(), original);
+    assert_eq!(p.state("figure"), State::Fresh);
+
+    // A figure edited by hand, or deleted, is stale too.
+    std::fs::write(p.figures().join("figure.svg"), "<svg/>").unwrap();
+    assert!(matches!(p.state("figure"), State::Stale(_)));
+    std::fs::remove_file(&png).unwrap();
+    assert!(
+        matches!(p.state("figure"), State::Stale(ref why) if why.iter().any(|w| w.contains("missing")))
+    );
+}
+
+/// A report whose table is gone (a run killed between the Markdown and the table) or damaged
+/// recognises its own Markdown by its generated mark and runs again; a hand-written file of the
+/// same name is still never replaced.
+#[test]
+fn a_report_is_never_stuck_on_its_own_markdown() {
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("rep", REPORT)]);
+    p.run(&[]).unwrap();
+    let markdown = p.root().join("REPORT.md");
+    assert!(std::fs::read_to_string(&markdown)
+        .unwrap()
+        .contains("<!-- Generated by `woodpile run rep`"));
+    std::fs::remove_file(p.output("rep")).unwrap();
+    p.run(&[]).unwrap();
+    assert_eq!(p.state("rep"), State::Fresh);
+    std::fs::write(p.output("rep"), b"not a table").unwrap();
+    p.run(&[]).unwrap();
+    assert_eq!(p.state("rep"), State::Fresh);
+
+    std::fs::remove_file(p.output("rep")).unwrap();
+    std::fs::write(&markdown, "# my own notes\n").unwrap();
+    let err = p.run(&[]).unwrap_err().to_string();
+    assert!(err.contains("which this stage did not write"), "{err}");
+    assert_eq!(
+        std::fs::read_to_string(&markdown).unwrap(),
+        "# my own notes\n"
+    );
+}
+
+/// Two spellings of one Markdown file are one file: the second report is refused at load.
+#[test]
+fn two_reports_cannot_claim_one_file_by_spelling_it_twice() {
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("a", &REPORT.replace("REPORT.md", "d/x.md")),
+        ("b", &REPORT.replace("REPORT.md", "d//x.md")),
+    ]);
+    let err = Pipeline::load(&p.pipeline()).unwrap_err().to_string();
+    assert!(err.contains("written by stage"), "{err}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_report_never_writes_through_a_symlinked_folder() {
+    let elsewhere = tempfile::tempdir().unwrap();
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        ("rep", &REPORT.replace("REPORT.md", "docs/r.md")),
+    ]);
+    std::os::unix::fs::symlink(elsewhere.path(), p.root().join("docs")).unwrap();
+    let err = p.run(&[]).unwrap_err().to_string();
+    assert!(err.contains("symbolic link"), "{err}");
+    assert_eq!(std::fs::read_dir(elsewhere.path()).unwrap().count(), 0);
+}
+
+/// Symbolic links to `.` in the stage folder or a results tree do not make a walk endless.
+#[cfg(unix)]
+#[test]
+fn symlink_loops_are_not_followed() {
+    let p = Project::new(&[("sweep", SWEEP)]);
+    std::os::unix::fs::symlink(".", p.pipeline().join("x")).unwrap();
+    std::os::unix::fs::symlink(".", p.pipeline().join("y")).unwrap();
+    let pipeline = Pipeline::load(&p.pipeline()).unwrap();
+    assert_eq!(pipeline.stages().len(), 1);
+    p.run(&[]).unwrap();
+    let copy = p.root().join("copy");
+    std::fs::create_dir(&copy).unwrap();
+    std::fs::copy(p.output("sweep"), copy.join("sweep.parquet")).unwrap();
+    std::os::unix::fs::symlink(".", p.results().join("loop")).unwrap();
+    std::os::unix::fs::symlink(".", copy.join("loop")).unwrap();
+    let report = woodpile_pipeline::diff::diff(&p.results(), &copy, &Default::default()).unwrap();
+    assert!(report.agrees(), "{:?}", report.problems);
+}
+
+/// A FIFO, a link to /dev/zero or a directory in place of a table reads as damaged at once;
+/// a run recomputes it.
+#[cfg(unix)]
+#[test]
+fn non_regular_files_in_results_are_damaged_never_read() {
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE)]);
+    p.run(&[]).unwrap();
+    let table = p.output("at_end");
+    let fifo_made = |path: &Path| {
+        std::process::Command::new("mkfifo")
+            .arg(path)
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    std::fs::remove_file(&table).unwrap();
+    if fifo_made(&table) {
+        assert!(matches!(p.state("at_end"), State::Damaged(_)));
+        std::fs::remove_file(&table).unwrap();
+    }
+    std::os::unix::fs::symlink("/dev/zero", &table).unwrap();
+    assert!(matches!(p.state("at_end"), State::Damaged(ref why) if why.contains("symbolic link")));
+    assert!(table::read(&table).is_err());
+    std::fs::remove_file(&table).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &table).unwrap();
+    // The run refuses to treat the link as its table but replaces it by a real one.
+    p.run(&[]).unwrap();
+    assert_eq!(p.state("at_end"), State::Fresh);
+    assert!(std::fs::symlink_metadata(&table).unwrap().is_file());
+}
+
+/// Shards are at most one per point, and a merge with shards missing says how many.
+#[test]
+fn shard_counts_are_bounded_and_missing_shards_counted() {
+    use woodpile_pipeline::shard::{merge, run_shard, Shard};
+    let p = Project::new(&[("sweep", SWEEP)]);
+    let pipeline = Pipeline::load(&p.pipeline()).unwrap();
+    let err = run_shard(
+        &pipeline,
+        "sweep",
+        Shard::new(0, 1_000_000_000).unwrap(),
+        &p.results(),
+        &Silent,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("one shard per point"), "{err}");
+    run_shard(
+        &pipeline,
+        "sweep",
+        Shard::new(1, 3).unwrap(),
+        &p.results(),
+        &Silent,
+    )
+    .unwrap();
+    let err = merge(&pipeline, "sweep", &p.results(), &Silent)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("2 of 3 shard(s) missing (0, 2"), "{err}");
+}
+
+fn load_error(stages: &[(&str, &str)]) -> String {
+    let p = Project::new(stages);
+    Pipeline::load(&p.pipeline()).unwrap_err().to_string()
+}
+
+/// Requests whose planning alone would take gigabytes are refused at load, naming the key.
+#[test]
+fn huge_requests_are_refused_at_load() {
+    let blocks = SWEEP
+        .replace("chain = { n = 12 }", "chain = { n = 5000000 }")
+        .replace("site = 0\neps", "site = 0\nthrough = 4000000\neps");
+    let err = load_error(&[("sweep", &blocks)]);
+    assert!(
+        err.contains("defect[0].through") && err.contains("at most 10000"),
+        "{err}"
+    );
+
+    let field = r#"
+kind = "spacetime"
+[scene]
+chain = { n = 5000000 }
+run = { t_end = 1.0, method = "rk4", dt = 0.001, sample_every = 0.01 }
+[field]
+sites = [-5000000, 5000000]
+"#;
+    let err = load_error(&[("map", field)]);
+    assert!(
+        err.contains("field.sites") && err.contains("field values"),
+        "{err}"
+    );
+}
+
+/// A figure may have at most 64 panels; a title is filled in once, in one pass, and bounded.
+#[test]
+fn panels_and_titles_are_bounded() {
+    let many = r#"
+kind = "sweep"
+[axes]
+eps = { from = 0.1, to = 10.0, step = 0.1 }
+[scene]
+chain = { n = 6 }
+impulse = { site = -3 }
+run = { t_end = 2.0, method = "rk4", dt = 0.05, sample_every = 1.0 }
+[[scene.defect]]
+site = 0
+eps = "$eps"
+"#;
+    let panels = r#"
+kind = "render"
+inputs = ["at_end"]
+title = "too many"
+[lines]
+x = "t"
+y = ["E_tr"]
+panels = "eps"
+x_label = "t"
+y_label = "E_tr"
+"#;
+    let p = Project::new(&[
+        ("sweep", many),
+        ("at_end", &REDUCE.replace("12.0", "2.0")),
+        ("fig", panels),
+    ]);
+    let err = p.run(&[]).unwrap_err().to_string();
+    assert!(err.contains("100 panels") && err.contains("64"), "{err}");
+
+    let long = FIGURE.replace("TITLE", &"{at_end.kind}".repeat(20_000));
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("fig", &long)]);
+    let err = p.run(&[]).unwrap_err().to_string();
+    assert!(err.contains("more than 100000 characters"), "{err}");
+
+    // A quoted value is inserted as it is, never expanded again.
+    let quoting = FIGURE.replace("TITLE", "{at_end.kind} at {at_end.params.at} {x");
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("fig", &quoting)]);
+    p.run(&[]).unwrap();
+    let manifest = table::read_manifest(&p.output("fig")).unwrap().unwrap();
+    assert_eq!(
+        manifest.summary["title"], "reduce at 12 {x",
+        "{}",
+        manifest.summary
+    );
+}
