@@ -361,3 +361,38 @@ y_label = "E_tr"
         manifest.summary
     );
 }
+
+const DESIGN: &str = r#"
+kind = "design"
+seed = 7
+budget = 20
+refine = 4
+objective = "E_tr"
+verify_tolerance = 1e-7
+robustness = { samples = 2, spreads = [0.01] }
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "auto", tolerance = 1e-5 }
+fractions = { region = [-1, 4] }
+[space]
+resonators = [1, 2]
+sites = [0, 3]
+eps = { min = 0.1, max = 10.0, log = true }
+kappa = { min = 0.5, max = 2.0 }
+"#;
+
+/// The best design's scene file is covered by the design stage's seal: an edit makes the
+/// stage stale, and a run writes the design it found again.
+#[test]
+fn an_edited_best_design_file_is_noticed() {
+    let p = Project::new(&[("trap", DESIGN)]);
+    p.run(&[]).unwrap();
+    let best = p.results().join("trap.best.toml");
+    let found = std::fs::read_to_string(&best).unwrap();
+    std::fs::write(&best, found.replace("eps = ", "eps = 1")).unwrap();
+    assert!(matches!(p.state("trap"), State::Stale(ref why) if why[0].contains("trap.best.toml")));
+    p.run(&[]).unwrap();
+    assert_eq!(std::fs::read_to_string(&best).unwrap(), found);
+    assert_eq!(p.state("trap"), State::Fresh);
+}
