@@ -22,8 +22,10 @@ macro_rules! say {
         }
     }};
 }
+mod new_study;
 mod pipeline_cmd;
 mod progress;
+mod project;
 mod simulate;
 
 use std::process::ExitCode;
@@ -52,6 +54,8 @@ enum Command {
     Slurm(pipeline_cmd::SlurmArgs),
     /// Compare two result files or trees; exit 1 when they differ beyond tolerance.
     Diff(pipeline_cmd::DiffArgs),
+    /// Make a new study folder that runs as written: `woodpile new study NAME`.
+    New(new_study::Args),
 }
 
 /// The package version and the numerics revision every cache key includes (`woodpile 0.1.0 r5`):
@@ -111,6 +115,7 @@ fn main() -> ExitCode {
         Command::Status(args) => pipeline_cmd::status_command(&args),
         Command::Merge(args) => pipeline_cmd::merge_command(&args),
         Command::Slurm(args) => pipeline_cmd::slurm_command(&args),
+        Command::New(args) => new_study::run(&args),
         Command::Diff(args) => match pipeline_cmd::diff_command(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),

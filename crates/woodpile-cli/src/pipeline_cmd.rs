@@ -9,23 +9,38 @@ use woodpile_pipeline::shard::{merge, run_shard, Shard};
 use woodpile_pipeline::slurm::SlurmJob;
 use woodpile_pipeline::status::output_path;
 use woodpile_pipeline::status::{state, State};
+use woodpile_pipeline::variant::{variant_name, Set};
 use woodpile_pipeline::{Pipeline, PipelineError};
+
+use crate::project::Dirs;
 
 use crate::progress::Progress;
 use crate::Failure;
 
-/// Where the pipeline lives.
+/// Where the pipeline lives. Each folder comes from its flag, else its environment variable,
+/// else the nearest `woodpile.toml`, else `pipeline/`, `results/`, `figures/` here.
 #[derive(Debug, clap::Args)]
 pub(crate) struct Locations {
-    /// Directory of stage files.
-    #[arg(long, default_value = "pipeline")]
-    pipeline: PathBuf,
-    /// Results tree: stage tables and the point cache.
-    #[arg(long, default_value = "results")]
-    results: PathBuf,
-    /// Where render stages write their PNG and SVG figures.
-    #[arg(long, default_value = "figures")]
-    figures: PathBuf,
+    /// Directory of stage files [env: WOODPILE_PIPELINE] [default: pipeline].
+    #[arg(long)]
+    pipeline: Option<PathBuf>,
+    /// Results tree: stage tables and the point cache [env: WOODPILE_RESULTS] [default: results].
+    #[arg(long)]
+    results: Option<PathBuf>,
+    /// Where render stages write their PNG and SVG figures [env: WOODPILE_FIGURES] [default: figures].
+    #[arg(long)]
+    figures: Option<PathBuf>,
+}
+
+impl Locations {
+    fn dirs(&self) -> Result<Dirs, Failure> {
+        crate::project::resolve(
+            self.pipeline.as_deref(),
+            self.results.as_deref(),
+            self.figures.as_deref(),
+        )
+        .map_err(Failure::input)
+    }
 }
 
 /// Arguments of `woodpile run`.
@@ -47,6 +62,11 @@ pub(crate) struct RunArgs {
     /// plain `run` inside a SLURM job never shards unless asked.
     #[arg(long, conflicts_with = "shard")]
     shard_from_env: bool,
+    /// Run a variant of a stage with a key of its file set, without editing it: `--set
+    /// f4_fractions.at=120.0` runs `f4_fractions--at-120_0`, with its own key and output
+    /// (repeatable; each stage named gets one variant).
+    #[arg(long = "set", value_name = "STAGE.KEY=VALUE")]
+    sets: Vec<String>,
     /// Print what ran (or would run) as one JSON object on stdout: `stages` (each with
     /// `stage`, `runs`, `why`, `points`, `cached`), `ran`, `fresh`, `scenes_simulated`,
     /// `seconds`. Progress still goes to stderr.
@@ -120,8 +140,13 @@ pub(crate) struct DiffArgs {
     tolerances: Vec<String>,
 }
 
-fn load(at: &Locations) -> Result<Pipeline, Failure> {
-    for (flag, dir) in [("--results", &at.results), ("--figures", &at.figures)] {
+fn load(at: &Locations) -> Result<(Pipeline, Dirs), Failure> {
+    load_with(at, &[])
+}
+
+fn load_with(at: &Locations, sets: &[Set]) -> Result<(Pipeline, Dirs), Failure> {
+    let dirs = at.dirs()?;
+    for (flag, dir) in [("--results", &dirs.results), ("--figures", &dirs.figures)] {
         if std::fs::metadata(dir).is_ok_and(|m| !m.is_dir()) {
             return Err(Failure::input(anyhow::anyhow!(
                 "{flag} {}: not a directory",
@@ -129,7 +154,8 @@ fn load(at: &Locations) -> Result<Pipeline, Failure> {
             )));
         }
     }
-    Pipeline::load(&at.pipeline).map_err(Failure::input)
+    let pipeline = Pipeline::load_with(&dirs.pipeline, sets).map_err(Failure::input)?;
+    Ok((pipeline, dirs))
 }
 
 fn stage_failure(e: PipelineError) -> Failure {
@@ -163,17 +189,27 @@ fn requested_shard(args: &RunArgs) -> Result<Option<Shard>, Failure> {
 }
 
 pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
-    let pipeline = load(&args.at)?;
+    let sets = args
+        .sets
+        .iter()
+        .map(|text| {
+            Set::parse(text)
+                .map_err(|reason| Failure::input(anyhow::anyhow!("--set `{text}`: {reason}")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let (pipeline, dirs) = load_with(&args.at, &sets)?;
+    // With --set, the variants are what runs (with their inputs), besides any stage named.
+    let mut targets = args.stages.clone();
+    for set in &sets {
+        let name = variant_name(&set.stage, &sets);
+        if !targets.contains(&name) {
+            targets.push(name);
+        }
+    }
     if let Some(shard) = requested_shard(args)? {
         let progress = Progress::new();
-        let done = run_shard(
-            &pipeline,
-            &args.stages[0],
-            shard,
-            &args.at.results,
-            &progress,
-        )
-        .map_err(stage_failure)?;
+        let done = run_shard(&pipeline, &args.stages[0], shard, &dirs.results, &progress)
+            .map_err(stage_failure)?;
         let what = if done.already_done {
             "already done"
         } else {
@@ -188,21 +224,18 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         return Ok(());
     }
     let options = RunOptions {
-        targets: args.stages.clone(),
+        targets,
         force: args.force,
         dry_run: args.dry_run,
-        results: args.at.results.clone(),
-        figures: args.at.figures.clone(),
+        results: dirs.results.clone(),
+        figures: dirs.figures.clone(),
     };
     let progress = Progress::new();
     let started = std::time::Instant::now();
+    let before = woodpile_pipeline::points::simulations();
     let steps = run(&pipeline, &options, &progress).map_err(stage_failure)?;
     let ran = steps.iter().filter(|s| s.runs).count();
-    let scenes: usize = steps
-        .iter()
-        .filter_map(|s| s.points)
-        .map(|(n, cached)| n - cached)
-        .sum();
+    let scenes = woodpile_pipeline::points::simulations() - before;
     let seconds = started.elapsed().as_secs_f64();
     if args.json {
         let stages: Vec<serde_json::Value> = steps
@@ -251,19 +284,19 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
 }
 
 pub(crate) fn merge_command(args: &MergeArgs) -> Result<(), Failure> {
-    let pipeline = load(&args.at)?;
+    let (pipeline, dirs) = load(&args.at)?;
     let parts =
-        merge(&pipeline, &args.stage, &args.at.results, &Progress::new()).map_err(stage_failure)?;
+        merge(&pipeline, &args.stage, &dirs.results, &Progress::new()).map_err(stage_failure)?;
     eprintln!(
         "merged {parts} parts of `{}` into {}",
         args.stage,
-        output_path(&args.at.results, &args.stage).display()
+        output_path(&dirs.results, &args.stage).display()
     );
     Ok(())
 }
 
 pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
-    let pipeline = load(&args.at)?;
+    let (pipeline, dirs) = load(&args.at)?;
     let stage = pipeline.stage(&args.stage).map_err(Failure::input)?;
     let Some(axes) = pipeline.sweep_axes(&stage.name) else {
         return Err(Failure::input(anyhow::anyhow!(
@@ -300,8 +333,8 @@ pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
         cpus: args.cpus,
         binary: &binary,
         workdir: &workdir,
-        pipeline: &absolute(&args.at.pipeline)?,
-        results: &absolute(&args.at.results)?,
+        pipeline: &absolute(&dirs.pipeline)?,
+        results: &absolute(&dirs.results)?,
         logs: &logs,
     };
     job.validate()
@@ -324,7 +357,7 @@ pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
 }
 
 pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
-    let pipeline = load(&args.at)?;
+    let (pipeline, dirs) = load(&args.at)?;
     let width = pipeline
         .stages()
         .iter()
@@ -334,12 +367,7 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
     let states: Vec<(&woodpile_pipeline::stage::Stage, State)> = pipeline
         .stages()
         .iter()
-        .map(|stage| {
-            (
-                stage,
-                state(&pipeline, &args.at.results, &args.at.figures, stage),
-            )
-        })
+        .map(|stage| (stage, state(&pipeline, &dirs.results, &dirs.figures, stage)))
         .collect();
     let not_fresh = states.iter().filter(|(_, st)| *st != State::Fresh).count();
     if args.json {
@@ -372,7 +400,7 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
             1,
             anyhow::anyhow!(
                 "{not_fresh} stage(s) not fresh in {}: run `make figures`",
-                args.at.results.display()
+                dirs.results.display()
             ),
         ));
     }

@@ -77,51 +77,101 @@ pub fn toml_to_json(value: &toml::Value) -> Value {
     }
 }
 
-/// Every leaf of `value` by dotted path (`scene.run.tolerance`, `axes.L[2]`), for saying which
-/// parameter changed between two versions of a stage.
-pub fn flatten(value: &Value) -> BTreeMap<String, String> {
-    fn walk(prefix: &str, value: &Value, out: &mut BTreeMap<String, String>) {
-        match value {
-            Value::Object(map) => {
-                for (k, v) in map {
-                    let path = if prefix.is_empty() {
-                        k.clone()
-                    } else {
-                        format!("{prefix}.{k}")
-                    };
-                    walk(&path, v, out);
-                }
-            }
-            Value::Array(items) => {
-                for (i, v) in items.iter().enumerate() {
-                    walk(&format!("{prefix}[{i}]"), v, out);
-                }
-            }
-            leaf => {
-                out.insert(prefix.to_string(), leaf.to_string());
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk("", value, &mut out);
+/// The dotted paths whose values differ between `old` and `new` (added, removed or changed),
+/// each as `path: old -> new`. A list of numbers or strings that changed in its length or in
+/// more than three places is summarised in one line (`axes.eps: 50 values -> 150 values, 100
+/// added`) rather than listed value by value.
+pub fn changed_paths(old: &Value, new: &Value) -> Vec<String> {
+    let mut out = Vec::new();
+    changes("", Some(old), Some(new), &mut out);
     out
 }
 
-/// The dotted paths whose values differ between `old` and `new` (added, removed or changed),
-/// each as `path: old -> new`.
-pub fn changed_paths(old: &Value, new: &Value) -> Vec<String> {
-    let (a, b) = (flatten(old), flatten(new));
-    let mut paths: Vec<&String> = a.keys().chain(b.keys()).collect();
-    paths.sort();
-    paths.dedup();
-    paths
-        .into_iter()
-        .filter(|p| a.get(*p) != b.get(*p))
-        .map(|p| {
-            let show = |v: Option<&String>| v.cloned().unwrap_or_else(|| "(absent)".into());
-            format!("{p}: {} -> {}", show(a.get(p)), show(b.get(p)))
-        })
-        .collect()
+fn changes(path: &str, a: Option<&Value>, b: Option<&Value>, out: &mut Vec<String>) {
+    let child = |key: &str| {
+        if path.is_empty() {
+            key.to_string()
+        } else {
+            format!("{path}.{key}")
+        }
+    };
+    match (a, b) {
+        (Some(Value::Object(x)), Some(Value::Object(y))) => {
+            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            for k in keys {
+                changes(&child(k), x.get(k), y.get(k), out);
+            }
+        }
+        (Some(Value::Array(x)), Some(Value::Array(y))) => {
+            let scalars = |v: &[Value]| v.iter().all(|e| !e.is_array() && !e.is_object());
+            let differing = (0..x.len().max(y.len()))
+                .filter(|&i| x.get(i) != y.get(i))
+                .count();
+            if scalars(x) && scalars(y) && (x.len() != y.len() || differing > 3) {
+                out.push(format!("{path}: {}", list_change(x, y)));
+            } else {
+                for i in 0..x.len().max(y.len()) {
+                    changes(&format!("{path}[{i}]"), x.get(i), y.get(i), out);
+                }
+            }
+        }
+        (a, b) if a != b => {
+            let show = |v: Option<&Value>| v.map_or_else(|| "(absent)".into(), Value::to_string);
+            out.push(format!("{path}: {} -> {}", show(a), show(b)));
+        }
+        _ => {}
+    }
+}
+
+/// `50 values -> 150 values, 100 added, 0 removed` for two lists of scalars.
+fn list_change(old: &[Value], new: &[Value]) -> String {
+    let count = |v: &[Value]| {
+        let mut m: BTreeMap<String, i64> = BTreeMap::new();
+        for e in v {
+            *m.entry(e.to_string()).or_default() += 1;
+        }
+        m
+    };
+    let (a, b) = (count(old), count(new));
+    let only = |x: &BTreeMap<String, i64>, y: &BTreeMap<String, i64>| -> i64 {
+        x.iter()
+            .map(|(k, n)| (n - y.get(k).copied().unwrap_or(0)).max(0))
+            .sum()
+    };
+    let (added, removed) = (only(&b, &a), only(&a, &b));
+    let mut text = format!("{} values -> {} values", old.len(), new.len());
+    if added > 0 {
+        text += &format!(", {added} added");
+    }
+    if removed > 0 {
+        text += &format!(", {removed} removed");
+    }
+    if added == 0 && removed == 0 {
+        text += ", reordered";
+    }
+    text
+}
+
+#[cfg(test)]
+mod change_tests {
+    use super::*;
+
+    #[test]
+    fn long_list_changes_are_summarised() {
+        let old = json!({"axes": {"eps": (1..=50).collect::<Vec<_>>()}, "at": 150.0});
+        let new = json!({"axes": {"eps": (1..=150).collect::<Vec<_>>()}, "at": 120.0});
+        assert_eq!(
+            changed_paths(&old, &new),
+            [
+                "at: 150.0 -> 120.0",
+                "axes.eps: 50 values -> 150 values, 100 added"
+            ]
+        );
+        let short = changed_paths(&json!({"L": [0, 2, 5]}), &json!({"L": [0, 3, 5]}));
+        assert_eq!(short, ["L[1]: 2 -> 3"]);
+    }
 }
 
 /// The resolved scene as canonical JSON: everything that determines the simulated numbers and

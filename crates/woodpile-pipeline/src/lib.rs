@@ -44,6 +44,7 @@ pub mod slurm;
 pub mod stage;
 pub mod status;
 pub mod table;
+pub mod variant;
 
 pub use error::{PipelineError, Result};
 pub use kinds::{

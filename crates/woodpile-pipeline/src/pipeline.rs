@@ -15,6 +15,7 @@ use crate::kind::Inputs;
 use crate::report::Report;
 use crate::stage::Stage;
 use crate::sweep::Sweep;
+pub use crate::variant::Set;
 
 /// A loaded, validated pipeline.
 #[derive(Debug, Clone)]
@@ -30,13 +31,28 @@ impl Pipeline {
     /// Loads every stage file in `dir` and its subdirectories (one folder per figure, say):
     /// a stage is named by its file's stem, wherever it lies, so names must be unique.
     pub fn load(dir: &Path) -> Result<Pipeline> {
+        Pipeline::load_with(dir, &[])
+    }
+
+    /// [`Pipeline::load`], plus a variant of a stage for each stage named in `sets`: its file
+    /// with those keys set, named `<stage>--<key>-<value>` ([`Set::variant_name`]), so that it
+    /// has its own key and its own output beside the original's.
+    pub fn load_with(dir: &Path, sets: &[Set]) -> Result<Pipeline> {
+        if !dir.is_dir() {
+            return Err(PipelineError::io(
+                dir,
+                "no stage folder here: a woodpile project has its stage files (*.toml) in `pipeline/` (or the folder that --pipeline, WOODPILE_PIPELINE or woodpile.toml names); `woodpile new study NAME` makes one",
+            ));
+        }
+        let root = project_root(dir);
         let mut files = Vec::new();
         stage_files(dir, &mut files)?;
         files.sort();
-        let stages = files
+        let mut stages = files
             .iter()
-            .map(|f| Stage::load(f))
+            .map(|f| Stage::load(f, &root))
             .collect::<Result<Vec<_>>>()?;
+        stages.extend(crate::variant::variants(&stages, sets, &root)?);
         let mut seen: HashMap<&str, &Path> = HashMap::new();
         for stage in &stages {
             if let Some(other) = seen.insert(&stage.name, &stage.file) {
@@ -194,6 +210,14 @@ fn check_names(stage: &Stage, by_name: &BTreeMap<&str, &Stage>) -> Result<()> {
 }
 
 /// Every input is of a kind the stage can read.
+/// The project root of a stage folder: its parent (scene files are named relative to it).
+pub fn project_root(dir: &Path) -> PathBuf {
+    match dir.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
 /// Every `*.toml` under `dir`, recursively.
 fn stage_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
     let entries = std::fs::read_dir(dir).map_err(|e| PipelineError::io(dir, e))?;

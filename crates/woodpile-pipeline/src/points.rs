@@ -69,6 +69,20 @@ pub enum Series {
     Kinetic,
 }
 
+/// Scenes simulated by this process, by every kind (sweeps, designs, optima, maps, surveys):
+/// what a run's summary line reports.
+static SIMULATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// How many scenes this process has simulated so far.
+pub fn simulations() -> u64 {
+    SIMULATIONS.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Counts one simulation (each kind calls it beside each run it makes).
+pub(crate) fn count_simulation() {
+    SIMULATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+}
+
 /// Simulates `scene`, recording its fractions at every sample.
 pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
     let s = &scene.scenario;
@@ -85,6 +99,7 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
             FractionSeries::kinetic(&s.model, s.region, impact_energy)
         }
     };
+    crate::points::count_simulation();
     let out = simulate(s, &mut series).map_err(|e| e.to_string())?;
     Ok(PointData {
         method: out.plan.method.name().to_string(),

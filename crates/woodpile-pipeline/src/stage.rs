@@ -40,23 +40,36 @@ pub struct Stage {
 }
 
 impl Stage {
-    /// Reads and parses the stage file at `file`.
-    pub fn load(file: &Path) -> Result<Stage> {
+    /// Reads and parses the stage file at `file` of the project rooted at `root` (where a
+    /// `scene = "scenes/x.toml"` reference is found).
+    pub fn load(file: &Path, root: &Path) -> Result<Stage> {
         let text = woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: format!("cannot read: {e}"),
             source: None,
         })?;
-        Stage::parse(&text, file)
+        Stage::parse_in(&text, file, root)
     }
 
-    /// Parses stage TOML `text`; `file` names it (and gives the stage its name).
+    /// Parses stage TOML `text`; `file` names it (and gives the stage its name); scene files
+    /// are found relative to the current directory.
     pub fn parse(text: &str, file: &Path) -> Result<Stage> {
-        let table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
+        Stage::parse_in(text, file, Path::new("."))
+    }
+
+    /// [`Stage::parse`] in the project rooted at `root`.
+    pub fn parse_in(text: &str, file: &Path, root: &Path) -> Result<Stage> {
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: e.to_string().trim_end().to_string(),
             source: Some(Box::new(e)),
         })?;
+        include_scene_file(&mut table, file, root)?;
+        Stage::from_table(table, file)
+    }
+
+    /// A stage from its parsed table (scene files already included).
+    pub fn from_table(table: toml::Table, file: &Path) -> Result<Stage> {
         let name = stage_name(file)?;
         let mut params = toml_to_json(&toml::Value::Table(table.clone()));
         if let Value::Object(map) = &mut params {
@@ -110,5 +123,66 @@ fn stage_name(file: &Path) -> Result<String> {
             reason: "a stage file's name must be lowercase letters, digits, `_` or `-`".into(),
             source: None,
         })
+    }
+}
+
+/// A stage's scene by reference: `scene = "scenes/x.toml"`, or `[scene]` with `file =
+/// "scenes/x.toml"` and keys that override the file's (tables merged key by key, anything else
+/// replaced: `[[scene.defect]]` with `eps = "$eps"` replaces the file's defects). The file is
+/// read relative to the project root and included by content, so the stage's key changes when
+/// the file does, and its manifest shows the scene it ran.
+fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Result<()> {
+    let (reference, key, overrides) = match table.get("scene") {
+        Some(toml::Value::String(path)) => (path.clone(), "scene", toml::Table::new()),
+        Some(toml::Value::Table(t)) => match t.get("file") {
+            Some(toml::Value::String(path)) => {
+                let mut rest = t.clone();
+                rest.remove("file");
+                (path.clone(), "scene.file", rest)
+            }
+            Some(_) => {
+                return Err(definition(
+                    file,
+                    "scene.file",
+                    "expected the path of a scene file",
+                ))
+            }
+            None => return Ok(()),
+        },
+        _ => return Ok(()),
+    };
+    let path = root.join(&reference);
+    let text = woodpile_scene::read_input(&path)
+        .map_err(|e| definition(file, key, &format!("{}: cannot read: {e}", path.display())))?;
+    let mut scene: toml::Table = toml::from_str(&text).map_err(|e| {
+        definition(
+            file,
+            key,
+            &format!("{}: {}", path.display(), e.to_string().trim_end()),
+        )
+    })?;
+    merge(&mut scene, overrides);
+    table.insert("scene".into(), toml::Value::Table(scene));
+    Ok(())
+}
+
+/// `overrides` laid over `base`: tables merge key by key, other values replace.
+fn merge(base: &mut toml::Table, overrides: toml::Table) {
+    for (key, value) in overrides {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(inner)), toml::Value::Table(over)) => merge(inner, over),
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
+}
+
+fn definition(file: &Path, key: &str, reason: &str) -> PipelineError {
+    PipelineError::Definition {
+        file: file.to_path_buf(),
+        key: key.to_string(),
+        reason: reason.to_string(),
+        source: None,
     }
 }

@@ -143,26 +143,70 @@ fn list(name: &str, items: Vec<toml::Value>) -> Result<Vec<AxisValue>, AxisError
 /// A `{ from, to, step }` table; error keys are relative to it.
 fn range(mut table: toml::Table) -> Result<Vec<AxisValue>, AxisError> {
     let error = |key: &str, reason: String| (key.to_string(), reason);
-    let raw: Vec<toml::Value> = ["from", "to", "step"]
-        .iter()
-        .map(|k| {
-            table
-                .remove(*k)
-                .ok_or_else(|| error(k, "missing (expected a value)".into()))
-        })
-        .collect::<Result<_, _>>()?;
+    let mut take = |key: &str| table.remove(key);
+    let (from, to) = (take("from"), take("to"));
+    let (step, count, log) = (take("step"), take("count"), take("log"));
     if let Some(key) = table.keys().next() {
-        return Err(error(key, "unknown key".into()));
+        return Err(error(
+            key,
+            "unknown key (a range has from, to, and step or count, log)".into(),
+        ));
     }
-    let all_int = raw.iter().all(|v| v.is_integer());
-    let num = |i: usize, key: &str| -> Result<f64, AxisError> {
-        match raw[i] {
+    let missing = |key: &str| error(key, "missing (expected a value)".into());
+    let (from, to) = (
+        from.ok_or_else(|| missing("from"))?,
+        to.ok_or_else(|| missing("to"))?,
+    );
+    let number = |value: &toml::Value, key: &str| -> Result<f64, AxisError> {
+        match *value {
             toml::Value::Integer(v) => Ok(v as f64),
             toml::Value::Float(v) if v.is_finite() => Ok(v),
             _ => Err(error(key, "expected a number".into())),
         }
     };
-    let (from, to, step) = (num(0, "from")?, num(1, "to")?, num(2, "step")?);
+    let log = match log {
+        None => false,
+        Some(toml::Value::Boolean(b)) => b,
+        Some(_) => return Err(error("log", "expected true or false".into())),
+    };
+    match (step, count) {
+        (Some(step), None) if !log => {
+            let all_int = from.is_integer() && to.is_integer() && step.is_integer();
+            let (from, to, step) = (
+                number(&from, "from")?,
+                number(&to, "to")?,
+                number(&step, "step")?,
+            );
+            stepped(from, to, step, all_int)
+        }
+        (Some(_), None) => Err(error(
+            "log",
+            "a log range is spaced by `count`, not `step`".into(),
+        )),
+        (None, Some(count)) => {
+            let (from, to) = (number(&from, "from")?, number(&to, "to")?);
+            let count = match count {
+                toml::Value::Integer(n) if (1..=MAX_POINTS as i64).contains(&n) => n as usize,
+                _ => {
+                    return Err(error(
+                        "count",
+                        format!("expected a whole number from 1 to {MAX_POINTS}"),
+                    ))
+                }
+            };
+            counted(from, to, count, log)
+        }
+        (Some(_), Some(_)) => Err(error("count", "give `step` or `count`, not both".into())),
+        (None, None) => Err(error(
+            "step",
+            "missing (expected `step`, or `count`)".into(),
+        )),
+    }
+}
+
+/// `from, from + step, ..., to`.
+fn stepped(from: f64, to: f64, step: f64, all_int: bool) -> Result<Vec<AxisValue>, AxisError> {
+    let error = |key: &str, reason: String| (key.to_string(), reason);
     if step <= 0.0 || to < from {
         return Err(error("step", "need step > 0 and to >= from".into()));
     }
@@ -185,6 +229,39 @@ fn range(mut table: toml::Table) -> Result<Vec<AxisValue>, AxisError> {
             }
         })
         .collect();
+    Ok(values)
+}
+
+/// `count` values from `from` to `to`, both included, evenly spaced or (with `log`) evenly
+/// spaced in the logarithm; rounded to 12 significant digits.
+fn counted(from: f64, to: f64, count: usize, log: bool) -> Result<Vec<AxisValue>, AxisError> {
+    let error = |key: &str, reason: &str| (key.to_string(), reason.to_string());
+    if to < from || (count == 1 && to != from) {
+        return Err(error("to", "need to >= from (and to = from for count = 1)"));
+    }
+    if log && from <= 0.0 {
+        return Err(error("from", "a log range needs from > 0"));
+    }
+    let at = |i: usize| {
+        if i + 1 == count {
+            return to;
+        }
+        let f = i as f64 / (count - 1).max(1) as f64;
+        if log {
+            (from.ln() + f * (to.ln() - from.ln())).exp()
+        } else {
+            from + f * (to - from)
+        }
+    };
+    let values: Vec<AxisValue> = (0..count)
+        .map(|i| AxisValue::Float(round_sig(at(i))))
+        .collect();
+    if values.windows(2).any(|w| w[0] == w[1]) {
+        return Err(error(
+            "count",
+            "values so close that they round to the same number",
+        ));
+    }
     Ok(values)
 }
 
@@ -222,6 +299,31 @@ mod tests {
 
     fn axes(text: &str) -> Result<Vec<Axis>, AxisError> {
         parse_axes(toml::from_str(text).unwrap())
+    }
+
+    #[test]
+    fn counted_ranges_are_linear_or_logarithmic() {
+        let a = axes("eps = { from = 0.1, to = 100.0, count = 31, log = true }").unwrap();
+        let v: Vec<f64> = a[0].values.iter().map(|v| v.as_f64()).collect();
+        assert_eq!(v.len(), 31);
+        assert_eq!((v[0], v[10], v[20], v[30]), (0.1, 1.0, 10.0, 100.0));
+        let b = axes("x = { from = 0, to = 1, count = 5 }").unwrap();
+        let w: Vec<f64> = b[0].values.iter().map(|v| v.as_f64()).collect();
+        assert_eq!(w, [0.0, 0.25, 0.5, 0.75, 1.0]);
+        let key = |t: &str| axes(t).unwrap_err().0;
+        assert_eq!(
+            key("x = { from = 0, to = 1, count = 5, log = true }"),
+            "x.from"
+        );
+        assert_eq!(
+            key("x = { from = 1, to = 2, step = 1, count = 2 }"),
+            "x.count"
+        );
+        assert_eq!(
+            key("x = { from = 1, to = 2, step = 1, log = true }"),
+            "x.log"
+        );
+        assert_eq!(key("x = { from = 1, to = 2, count = 0 }"), "x.count");
     }
 
     #[test]

@@ -139,6 +139,7 @@ impl Optimize {
                 values[k] = AxisValue::Float(x[slot].clamp(lo, hi));
             }
             let scene = sweep.scene_with(&values, Some(self.tolerance))?;
+            crate::points::count_simulation();
             let out = simulate(&scene.scenario, &mut ())
                 .map_err(|e| fail(format!("refinement scene failed: {e}")))?;
             let f = out.fractions;

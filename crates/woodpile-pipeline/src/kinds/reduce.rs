@@ -336,6 +336,15 @@ impl Kind for Reduce {
             .pipeline
             .sweep_axes(input)
             .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?;
-        self.run(ctx.name(), &frame, axes)
+        let mut output = self.run(ctx.name(), &frame, axes)?;
+        // The sweep's scene, grid and tolerance, so the table explains itself without its input.
+        let params = &ctx.pipeline.stage(input)?.params;
+        output.summary["input"] = json!({
+            "stage": input,
+            "scene": params.get("scene"),
+            "axes": params.get("axes"),
+            "tolerance": params.pointer("/scene/run/tolerance"),
+        });
+        Ok(output)
     }
 }

@@ -215,6 +215,8 @@ impl Render {
         let mut names = Vec::new();
         for spec in &self.panels {
             let (frame, _) = &inputs[&spec.input];
+            spec.check_columns(frame)
+                .map_err(|reason| PipelineError::stage(stage, reason))?;
             let title = spec.title.as_deref().map(quote).transpose()?;
             let drawn = spec.draw(frame, title).map_err(fail)?;
             names.extend(std::iter::repeat_n(spec.columns(), drawn.len()));
@@ -600,6 +602,66 @@ fn plotted(panels: &[Panel], names: &[PlottedColumns]) -> Columns {
 }
 
 impl PanelSpec {
+    /// Every column the spec names exists in `input`, or the error names the key, the input,
+    /// the columns there are and the nearest one.
+    fn check_columns(&self, input: &DataFrame) -> std::result::Result<(), String> {
+        let mut named: Vec<(String, &String)> = Vec::new();
+        match &self.plot {
+            Plot::Lines {
+                x,
+                y,
+                panels,
+                series,
+                series_label,
+                ..
+            } => {
+                named.push(("lines.x".into(), x));
+                named.extend(y.iter().map(|c| ("lines.y".to_string(), c)));
+                named.extend(panels.iter().map(|c| ("lines.panels".to_string(), c)));
+                named.extend(series.iter().map(|c| ("lines.series".to_string(), c)));
+                named.extend(
+                    series_label
+                        .iter()
+                        .map(|c| ("lines.series_label".to_string(), c)),
+                );
+            }
+            Plot::Heatmap {
+                x,
+                y,
+                z,
+                panels,
+                overlays,
+                ..
+            } => {
+                named.push(("heatmap.x".into(), x));
+                named.push(("heatmap.y".into(), y));
+                named.push(("heatmap.z".into(), z));
+                named.extend(panels.iter().map(|c| ("heatmap.panels".to_string(), c)));
+                named.extend(
+                    overlays
+                        .iter()
+                        .map(|(c, _)| ("heatmap.overlay".to_string(), c)),
+                );
+            }
+        }
+        named.extend(self.filter.iter().map(|(c, _)| ("where".to_string(), c)));
+        named.extend(
+            self.panel_label
+                .iter()
+                .map(|c| ("panel_label".to_string(), c)),
+        );
+        for (key, column) in named {
+            if input.column(column).is_err() {
+                return Err(format!(
+                    "key `{key}`: input `{}`: {}",
+                    self.input,
+                    crate::table::missing_column(input, column)
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The source columns this spec plots.
     fn columns(&self) -> PlottedColumns {
         match &self.plot {

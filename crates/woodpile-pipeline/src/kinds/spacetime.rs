@@ -160,6 +160,7 @@ impl SpaceTime {
             .map(|(i, (values, scene))| {
                 let model = &scene.scenario.model;
                 let mut field = SpaceTimeField::new(model, 1, 1);
+                crate::points::count_simulation();
                 let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;

@@ -170,6 +170,7 @@ impl Stability {
                     tolerance_explicit: true,
                     dt: None,
                 };
+                crate::points::count_simulation();
                 let e_ref = simulate(&reference, &mut ())
                     .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
                     .fractions
@@ -325,6 +326,7 @@ fn classify(
         sample_every: scenario.t_end,
         ..scenario.clone()
     };
+    crate::points::count_simulation();
     match run_with_plan(&one_interval, &plan, &mut (), true) {
         Err(e) => (2, None, Some(e.to_string())),
         Ok(o) if !(o.stats.max_energy_drift <= 1.0) => (

@@ -5,7 +5,7 @@
 //! kind = "sweep"
 //! [axes]                                   # optional: none means a single scene
 //! L = [0, 2, 5, 6]
-//! eps = { from = 0.1, to = 60.0, step = 0.1 }
+//! eps = { from = 0.1, to = 60.0, step = 0.1 }   # or { from = 0.1, to = 100.0, count = 31, log = true }
 //! [scene]                                  # a scene file, with "$axis" placeholders
 //! run = { t_end = 150.0, method = "auto", tolerance = 1e-6, sample_every = 1.0 }
 //! [[scene.defect]]

@@ -178,6 +178,7 @@ impl WorkPrecision {
                 let mut outcome: Option<std::result::Result<Outcome, String>> = None;
                 for _ in 0..self.repeats {
                     let t0 = Instant::now();
+                    crate::points::count_simulation();
                     let result = simulate(&scenario, &mut ()).map_err(|e| e.to_string());
                     best = best.min(t0.elapsed().as_secs_f64() * 1e3);
                     let failed = result.is_err();
@@ -232,6 +233,7 @@ fn reference(
     )
     .map_err(|e| e.to_string())?;
     plan.drift_limit = f64::INFINITY;
+    crate::points::count_simulation();
     let outcome = run_with_plan(scenario, &plan, &mut (), true).map_err(|e| e.to_string())?;
     let drift = (!scenario.model.is_time_dependent()).then_some(outcome.stats.max_energy_drift);
     Ok((outcome.fractions.trapped, drift))

@@ -1,0 +1,86 @@
+//! Where a project's folders are: `--pipeline`, `--results` and `--figures`, else the
+//! environment (`WOODPILE_PIPELINE`, `WOODPILE_RESULTS`, `WOODPILE_FIGURES`), else a
+//! `woodpile.toml` in the current folder or the nearest one above it (keys `pipeline`,
+//! `results`, `figures`, relative to that file's folder), else `pipeline/`, `results/` and
+//! `figures/` beside the `woodpile.toml` (or in the current folder). So a study in its own
+//! folder, or any folder inside it, needs no flags.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{anyhow, Context};
+
+/// The `woodpile.toml` file name.
+pub(crate) const PROJECT_FILE: &str = "woodpile.toml";
+
+/// A project's three folders, resolved.
+#[derive(Debug, Clone)]
+pub(crate) struct Dirs {
+    pub(crate) pipeline: PathBuf,
+    pub(crate) results: PathBuf,
+    pub(crate) figures: PathBuf,
+}
+
+/// The folders for the given flags (each `None` when not given).
+pub(crate) fn resolve(
+    pipeline: Option<&Path>,
+    results: Option<&Path>,
+    figures: Option<&Path>,
+) -> anyhow::Result<Dirs> {
+    let (root, file) = match find_project_file()? {
+        Some((root, table)) => (root, table),
+        None => (PathBuf::from("."), toml::Table::new()),
+    };
+    let pick = |flag: Option<&Path>, env: &str, key: &str| -> anyhow::Result<PathBuf> {
+        if let Some(path) = flag {
+            return Ok(path.to_path_buf());
+        }
+        if let Some(path) = std::env::var_os(env).filter(|v| !v.is_empty()) {
+            return Ok(PathBuf::from(path));
+        }
+        match file.get(key) {
+            None => Ok(root.join(key)),
+            Some(toml::Value::String(s)) => Ok(root.join(s)),
+            Some(_) => Err(anyhow!(
+                "{}: key `{key}`: expected a folder path (a string)",
+                root.join(PROJECT_FILE).display()
+            )),
+        }
+    };
+    Ok(Dirs {
+        pipeline: pick(pipeline, "WOODPILE_PIPELINE", "pipeline")?,
+        results: pick(results, "WOODPILE_RESULTS", "results")?,
+        figures: pick(figures, "WOODPILE_FIGURES", "figures")?,
+    })
+}
+
+/// The nearest `woodpile.toml` at or above the current folder: its folder and its table.
+fn find_project_file() -> anyhow::Result<Option<(PathBuf, toml::Table)>> {
+    let here = std::env::current_dir().context("the current folder")?;
+    for folder in here.ancestors() {
+        let path = folder.join(PROJECT_FILE);
+        if !path.is_file() {
+            continue;
+        }
+        let text = woodpile_scene::read_input(&path)
+            .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
+        let table: toml::Table = toml::from_str(&text)
+            .map_err(|e| anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        if let Some(key) = table
+            .keys()
+            .find(|k| !["pipeline", "results", "figures"].contains(&k.as_str()))
+        {
+            return Err(anyhow!(
+                "{}: key `{key}`: unknown (woodpile.toml has pipeline, results, figures)",
+                path.display()
+            ));
+        }
+        // Relative to the current folder when it is the project's own, else absolute.
+        let root = if folder == here {
+            PathBuf::from(".")
+        } else {
+            folder.to_path_buf()
+        };
+        return Ok(Some((root, table)));
+    }
+    Ok(None)
+}
