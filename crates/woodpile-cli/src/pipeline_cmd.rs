@@ -138,7 +138,19 @@ pub(crate) struct DiffArgs {
     /// A column's own tolerance: COLUMN=ABS or COLUMN=ABS,REL (repeatable).
     #[arg(long = "tol", value_name = "COLUMN=ABS[,REL]")]
     tolerances: Vec<String>,
+    /// A column not to compare (repeatable).
+    #[arg(long = "ignore", value_name = "COLUMN")]
+    ignore: Vec<String>,
+    /// Compare key columns (scene_key) too: content hashes, which differ after any parameter change.
+    #[arg(long)]
+    keys: bool,
+    /// List every differing column, within tolerance too, not only the first beyond it.
+    #[arg(long)]
+    all: bool,
 }
+
+/// How many beyond-tolerance differences `diff` lists without `--all`.
+const LISTED: usize = 20;
 
 fn load(at: &Locations) -> Result<(Pipeline, Dirs), Failure> {
     load_with(at, &[])
@@ -414,6 +426,8 @@ pub(crate) fn diff_command(args: &DiffArgs) -> Result<bool, Failure> {
             abs: args.abs,
             rel: args.rel,
         },
+        ignore: args.ignore.iter().cloned().collect(),
+        compare_keys: args.keys,
         ..Default::default()
     };
     for spec in &args.tolerances {
@@ -426,7 +440,7 @@ pub(crate) fn diff_command(args: &DiffArgs) -> Result<bool, Failure> {
         }
     }
     let report = diff(&args.a, &args.b, &options).map_err(Failure::input)?;
-    print_report(&report);
+    print_report(&report, args.all);
     Ok(report.agrees())
 }
 
@@ -454,11 +468,27 @@ fn parse_tolerance(spec: &str) -> Result<(String, Tolerance), String> {
     Ok((column.trim().to_string(), Tolerance { abs, rel }))
 }
 
-fn print_report(report: &DiffReport) {
+fn print_report(report: &DiffReport, all: bool) {
+    for p in &report.parameters {
+        say!("parameter: {p}");
+    }
     for p in &report.problems {
         say!("problem: {p}");
     }
-    if !report.worst.is_empty() {
+    if !report.skipped.is_empty() {
+        let names: Vec<&str> = report.skipped.iter().map(String::as_str).collect();
+        say!(
+            "not compared: {} (--keys, or drop --ignore, to compare)",
+            names.join(", ")
+        );
+    }
+    let beyond = report.worst.iter().filter(|d| d.excess > 1.0).count();
+    let shown: Vec<_> = if all {
+        report.worst.iter().collect()
+    } else {
+        report.worst.iter().take(beyond.min(LISTED)).collect()
+    };
+    if !shown.is_empty() {
         say!(
             "{:<28} {:<16} {:>8} {:>24} {:>24} {:>10} {:>10} {:>8}",
             "file",
@@ -470,7 +500,7 @@ fn print_report(report: &DiffReport) {
             "rel",
             "excess"
         );
-        for d in &report.worst {
+        for d in &shown {
             say!(
                 "{:<28} {:<16} {:>8} {:>24} {:>24} {:>10.3e} {:>10.3e} {:>8.2}",
                 d.file,
@@ -483,6 +513,17 @@ fn print_report(report: &DiffReport) {
                 d.excess
             );
         }
+    }
+    let hidden = report.worst.len() - shown.len();
+    if hidden > 0 {
+        say!(
+            "... {hidden} more differing column(s){} (--all lists them)",
+            if beyond > shown.len() {
+                ""
+            } else {
+                " within tolerance"
+            }
+        );
     }
     say!(
         "{} files, {} values compared: {} beyond tolerance, {} structural problems -> {}",

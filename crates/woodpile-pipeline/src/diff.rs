@@ -4,7 +4,13 @@
 //! are equal; one null is a difference). Strings must match exactly. Missing files, columns or
 //! manifests, damaged tables, changed column types and row-count mismatches are structural
 //! problems and always fail. A tolerance for a column no compared table has is an error: it is
-//! a typo that would otherwise silently compare that column at the default tolerance.
+//! a typo that would otherwise silently compare that column at the default tolerance; so is a
+//! tolerance for a text column (text compares exactly: ignore it instead).
+//!
+//! Key columns (`scene_key`) are content hashes of what was simulated, so they differ after
+//! any parameter change: they are ignored unless asked for, as are the columns named in
+//! `ignore`. The report also lists, first, which parameters differ between the two tables'
+//! manifests, so that a difference can be read against its cause.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -23,14 +29,21 @@ pub struct Tolerance {
     pub rel: f64,
 }
 
-/// Tolerances: a default and per-column overrides.
+/// Tolerances: a default and per-column overrides, and the columns not compared.
 #[derive(Debug, Clone, Default)]
 pub struct DiffOptions {
     /// For every column not named in `columns`.
     pub default: Tolerance,
     /// Per column name.
     pub columns: BTreeMap<String, Tolerance>,
+    /// Columns not compared.
+    pub ignore: BTreeSet<String>,
+    /// Compare the key columns ([`KEY_COLUMNS`]) too.
+    pub compare_keys: bool,
 }
+
+/// Columns that hold content hashes: they differ whenever the parameters do.
+pub const KEY_COLUMNS: &[&str] = &["scene_key"];
 
 /// One compared value pair.
 #[derive(Debug, Clone, PartialEq)]
@@ -67,8 +80,13 @@ pub struct DiffReport {
     pub problems: Vec<String>,
     /// Every column name seen in the compared tables.
     pub columns: BTreeSet<String>,
-    /// The largest differences, worst first (at most [`WORST`]), within tolerance or not.
+    /// The largest difference of every (file, column) that differs, those beyond tolerance
+    /// first, each group by the size of the difference.
     pub worst: Vec<Difference>,
+    /// Parameters that differ between the two tables' manifests, `file: path: a -> b`.
+    pub parameters: Vec<String>,
+    /// Columns that were not compared (ignored, or keys).
+    pub skipped: BTreeSet<String>,
 }
 
 impl DiffReport {
@@ -77,9 +95,6 @@ impl DiffReport {
         self.beyond == 0 && self.problems.is_empty()
     }
 }
-
-/// How many differences a report keeps.
-pub const WORST: usize = 10;
 
 /// Compares `a` and `b`: two parquet files, or two directories of them (the point cache
 /// under `points/` and shard parts under `parts/` are skipped: they are inputs to results, not
@@ -125,15 +140,21 @@ pub fn diff(a: &Path, b: &Path, options: &DiffOptions) -> Result<DiffReport> {
     if let Some(unknown) = options
         .columns
         .keys()
+        .chain(&options.ignore)
         .find(|c| !report.columns.contains(*c))
     {
         return Err(PipelineError::io(
             a,
-            format!("a tolerance is given for column `{unknown}`, which no compared table has"),
+            format!("a tolerance or --ignore is given for column `{unknown}`, which no compared table has"),
         ));
     }
-    report.worst.sort_by(|x, y| y.excess.total_cmp(&x.excess));
-    report.worst.truncate(WORST);
+    // Beyond tolerance first; within each group the largest differences first.
+    report.worst.sort_by(|x, y| {
+        (y.excess > 1.0)
+            .cmp(&(x.excess > 1.0))
+            .then(y.abs.total_cmp(&x.abs))
+            .then(y.rel.total_cmp(&x.rel))
+    });
     Ok(report)
 }
 
@@ -185,6 +206,11 @@ fn compare_files(
                 .push(format!("{name}: {} {DAMAGED}", path.display()));
         }
     }
+    if let (Some(ma), Some(mb)) = (&ca.manifest, &cb.manifest) {
+        for change in crate::canonical::changed_paths(&ma.params, &mb.params) {
+            report.parameters.push(format!("{name}: {change}"));
+        }
+    }
     let (fa, fb) = (ca.frame, cb.frame);
     report.files += 1;
     for column in fa.columns() {
@@ -219,6 +245,11 @@ fn compare_files(
         return Ok(());
     }
     for column in ca.iter().filter(|c| cb.contains(c)) {
+        let key = KEY_COLUMNS.contains(&column.as_str()) && !options.compare_keys;
+        if key || options.ignore.contains(column) {
+            report.skipped.insert(column.clone());
+            continue;
+        }
         let dtype = |f: &DataFrame| f.column(column).map(|c| c.dtype().clone()).ok();
         let (ta, tb) = (dtype(&fa), dtype(&fb));
         if ta != tb {
@@ -247,7 +278,9 @@ fn compare_files(
             if d.excess > 1.0 {
                 report.beyond += 1;
             }
-            if worst.as_ref().is_none_or(|w| d.excess > w.excess) {
+            let larger =
+                |w: &Difference| (d.excess > 1.0, d.abs, d.rel) > (w.excess > 1.0, w.abs, w.rel);
+            if worst.as_ref().is_none_or(larger) {
                 worst = Some(d);
             }
         };
@@ -268,6 +301,12 @@ fn compare_files(
                 }
             }
         } else {
+            if options.columns.contains_key(column) {
+                return Err(PipelineError::io(
+                    name,
+                    format!("column `{column}` holds text, which compares exactly: drop its --tol (or --ignore it)"),
+                ));
+            }
             let as_text = |f: &DataFrame| -> Result<Vec<Option<String>>> {
                 let c = f
                     .column(column)

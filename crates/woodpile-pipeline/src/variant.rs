@@ -46,6 +46,7 @@ impl Set {
     fn slug(&self) -> String {
         let value = match &self.value {
             toml::Value::String(s) => s.clone(),
+            toml::Value::Float(x) => format!("{x:?}"),
             other => other.to_string(),
         };
         format!("{}-{value}", self.key)
@@ -161,6 +162,8 @@ mod tests {
             variant_name("f4_fractions", &[set]),
             "f4_fractions--at-120_0"
         );
+        let tight = Set::parse("s.scene.run.tolerance=1e-7").unwrap();
+        assert_eq!(variant_name("s", &[tight]), "s--scene_run_tolerance-1e-7");
         let set = Set::parse("s.scene.run.method=rk4").unwrap();
         assert_eq!(set.value, toml::Value::String("rk4".into()));
         assert!(Set::parse("nokey=1").is_err());
