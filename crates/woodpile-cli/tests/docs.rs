@@ -15,7 +15,11 @@ fn woodpile(args: &[&str]) -> String {
         .args(args)
         .output()
         .unwrap();
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8(out.stdout).unwrap()
 }
 
@@ -41,7 +45,10 @@ fn the_simulate_example_is_a_real_run() {
     for v in [&mut shown, &mut actual] {
         v.as_object_mut().unwrap().remove("wall_s");
     }
-    assert_eq!(shown, actual, "docs/scene.md's example is stale: run `make docs`");
+    assert_eq!(
+        shown, actual,
+        "docs/scene.md's example is stale: run `make docs`"
+    );
 }
 
 /// Every `docs/....md` a `--help` text names exists, and no help text sends the reader to a
@@ -57,10 +64,16 @@ fn help_texts_point_to_documents_that_exist() {
             let rest = &text[i..];
             let end = rest.find(".md").expect("a docs/ reference ends in .md") + 3;
             let doc = &rest[..end];
-            assert!(repo().join(doc).is_file(), "help names {doc}, which does not exist");
+            assert!(
+                repo().join(doc).is_file(),
+                "help names {doc}, which does not exist"
+            );
             named += 1;
         }
-        assert!(!text.contains("README \""), "help points into the README: {text}");
+        assert!(
+            !text.contains("README \""),
+            "help points into the README: {text}"
+        );
     }
     assert!(named > 0, "the simulate help names docs/scene.md");
 }

@@ -20,7 +20,9 @@
 //! [space]
 //! resonators = [1, 4]                 # how many, inclusive
 //! sites = [0, 20]                     # paper sites they may occupy (one resonator per site)
-//! eps = { min = 0.1, max = 100.0, log = true }
+//! # sites = [0, 10, 20]               # or: only these sites (also { among = [0, 10] })
+//! # sites = { fixed = [0, 10, 20] }   # or: one resonator on each of these (then `resonators` may go)
+//! eps = { min = 0.1, max = 100.0, log = true }   # or a list of the values allowed: [0.5, 1.0, 2.0]
 //! kappa = { min = 0.1, max = 10.0, log = true }
 //! p = [1]                             # allowed coupling exponents
 //! max_total_eps = 200.0               # optional: a bound on the added mass, sum of eps
@@ -29,7 +31,10 @@
 //! The optimiser is differential evolution (DE/rand/1/bin, population 20, F = 0.6, CR = 0.9)
 //! on a genome in [0, 1]^(1 + 4 K) (the count, then site, eps, kappa, p for K slots), decoded
 //! to a scene with its defects sorted by site, so equal designs share one cached point. Random
-//! search of the same budget is the baseline it must beat. Every evaluation is a scene through
+//! search of the same budget is the baseline it must beat. The best candidate of each search
+//! is refined by Nelder–Mead, and the best design any search found is verified and written:
+//! when the baseline's beats the optimiser's, the summary says so (`best_search`,
+//! `baseline_beat_optimiser`). Every evaluation is a scene through
 //! the point cache: an interrupted or extended search repeats no simulation. A generation's
 //! scenes are simulated in parallel and used in a fixed order, so the result depends on the
 //! seed alone.
@@ -120,17 +125,62 @@ impl Range {
     }
 }
 
+/// A parameter's values: a range, or a list to choose from (rods come in a few lengths).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// Any value of the range.
+    Range(Range),
+    /// One of these.
+    List(Vec<f64>),
+}
+
+impl Values {
+    fn at(&self, u: f64) -> f64 {
+        match self {
+            Values::Range(r) => r.at(u),
+            Values::List(values) => values[pick(u, values.len())],
+        }
+    }
+}
+
+/// Where resonators may go.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Sites {
+    /// Any paper site first..=last (`sites = [first, last]`).
+    Range(i64, i64),
+    /// Any of these sites (`sites = { among = [...] }`, or a list of three or more).
+    Among(Vec<i64>),
+    /// One resonator on each of these sites (`sites = { fixed = [...] }`): only the
+    /// parameters are searched.
+    Fixed(Vec<i64>),
+}
+
+impl Sites {
+    /// How many sites there are to choose from.
+    fn count(&self) -> usize {
+        match self {
+            Sites::Range(a, b) => (b - a + 1).max(0) as usize,
+            Sites::Among(list) | Sites::Fixed(list) => list.len(),
+        }
+    }
+}
+
+/// The index `u` in [0, 1] picks among `n` choices.
+fn pick(u: f64, n: usize) -> usize {
+    ((u.clamp(0.0, 1.0) * n as f64) as usize).min(n.saturating_sub(1))
+}
+
 /// What may vary.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Space {
     /// Fewest and most resonators.
     pub resonators: (usize, usize),
-    /// First and last paper site.
-    pub sites: (i64, i64),
+    /// Where they may go.
+    pub sites: Sites,
     /// Mass ratio.
-    pub eps: Range,
+    pub eps: Values,
     /// Coupling.
-    pub kappa: Range,
+    pub kappa: Values,
     /// Allowed exponents.
     pub p: Vec<i64>,
     /// Bound on the sum of eps.
@@ -173,14 +223,16 @@ impl Space {
     /// The layout a genome in [0, 1]^d stands for: a resonator on a site already taken is
     /// dropped, so every layout is valid and equal layouts come out equal.
     fn decode(&self, genome: &[f64]) -> Layout {
-        let pick = |u: f64, n: usize| ((u.clamp(0.0, 1.0) * n as f64) as usize).min(n - 1);
         let (lo, hi) = self.resonators;
         let count = lo + pick(genome[0], hi - lo + 1);
-        let span = (self.sites.1 - self.sites.0 + 1) as usize;
         let mut resonators: Vec<(i64, f64, f64, i64)> = Vec::with_capacity(count);
         for slot in 0..count {
             let g = &genome[1 + GENES * slot..1 + GENES * (slot + 1)];
-            let site = self.sites.0 + pick(g[0], span) as i64;
+            let site = match &self.sites {
+                Sites::Range(first, last) => first + pick(g[0], (last - first + 1) as usize) as i64,
+                Sites::Among(list) => list[pick(g[0], list.len())],
+                Sites::Fixed(list) => list[slot],
+            };
             if resonators.iter().any(|r| r.0 == site) {
                 continue;
             }
@@ -507,69 +559,36 @@ impl Design {
 
         // Random search of the same budget: the baseline.
         let mut rng = Rng(self.seed ^ 0x5eed);
-        let layouts = (0..self.budget)
-            .map(|_| self.space.decode(&genome(&mut rng)))
+        let random_genomes: Vec<Vec<f64>> = (0..self.budget).map(|_| genome(&mut rng)).collect();
+        let layouts = random_genomes
+            .iter()
+            .map(|g| self.space.decode(g))
             .collect();
-        rows.extend(self.evaluate("random", layouts, None, store, events)?);
+        let random_rows = self.evaluate("random", layouts, None, store, events)?;
+        let random_best = (0..random_rows.len())
+            .max_by(|&a, &b| random_rows[a].score.total_cmp(&random_rows[b].score));
+        rows.extend(random_rows.iter().cloned());
 
-        // Refinement: Nelder–Mead on the best candidate's eps and kappa genes, its count and
-        // sites fixed.
-        let best_index = (0..POPULATION)
+        // Refinement: Nelder–Mead on the eps and kappa genes of each search's best candidate,
+        // its count and sites fixed.
+        let de_best = (0..POPULATION)
             .max_by(|&a, &b| scores[a].total_cmp(&scores[b]))
             .unwrap_or(0);
-        let best_genome = population[best_index].clone();
-        let best_score = scores[best_index];
-        if self.refine > 0 && best_score.is_finite() {
-            let layout = self.space.decode(&best_genome);
-            let slots: Vec<usize> = (1..d)
-                .filter(|j| {
-                    let gene = (j - 1) % GENES;
-                    let slot = (j - 1) / GENES;
-                    (gene == 1 || gene == 2) && slot < layout.resonators.len()
-                })
-                .collect();
-            let mut refined: Vec<Evaluated> = Vec::new();
-            let mut failure: Option<PipelineError> = None;
-            let mut objective = |x: &[f64]| -> Result<f64> {
-                let mut g = best_genome.clone();
-                for (k, &j) in slots.iter().enumerate() {
-                    g[j] = x[k].clamp(0.0, 1.0);
-                }
-                let layout = self.space.decode(&g);
-                match self.evaluate("refinement", vec![layout], None, store, events) {
-                    Ok(mut e) => {
-                        let e = e.remove(0);
-                        let score = e.score;
-                        refined.push(e);
-                        Ok(score)
-                    }
-                    Err(err) => {
-                        failure = Some(PipelineError::stage(stage, err.to_string()));
-                        Ok(f64::NEG_INFINITY)
-                    }
-                }
-            };
-            let start: Vec<f64> = slots.iter().map(|&j| best_genome[j]).collect();
-            let steps = vec![0.05; start.len()];
-            if !start.is_empty() {
-                woodpile_analysis::nelder_mead::maximise(
-                    &mut objective,
-                    &start,
-                    &steps,
-                    best_score,
-                    self.refine,
-                )?;
-            }
-            if let Some(e) = failure {
-                return Err(e);
-            }
-            rows.extend(refined);
+        let mut starts = vec![("refinement", population[de_best].clone(), scores[de_best])];
+        if let Some(i) = random_best {
+            starts.push((
+                "refinement of random",
+                random_genomes[i].clone(),
+                random_rows[i].score,
+            ));
+        }
+        for (label, start, score) in starts {
+            rows.extend(self.refine_from(stage, label, &start, score, store, events)?);
         }
 
-        // The best design of all, verified at the tight tolerance.
+        // The best design any search found, verified at the tight tolerance.
         let best = rows
             .iter()
-            .filter(|e| e.search != "random")
             .max_by(|a, b| a.score.total_cmp(&b.score))
             .cloned()
             .ok_or_else(|| PipelineError::stage(stage, "no design was evaluated"))?;
@@ -633,6 +652,8 @@ impl Design {
 
         let de_best = self.best_of(&rows, "differential evolution");
         let random_best = self.best_of(&rows, "random");
+        let refined = self.best_of(&rows, "refinement");
+        let refined_random = self.best_of(&rows, "refinement of random");
         let frame = self.frame(&rows)?;
         Ok(Output {
             frame,
@@ -647,11 +668,75 @@ impl Design {
                 "best_kappa": verified.layout.list(|r| r.2),
                 "differential_evolution_best": self.shown(de_best),
                 "random_best": self.shown(random_best),
+                "refined_best": self.shown(refined.max(de_best)),
+                "refined_random_best": self.shown(refined_random.max(random_best)),
+                "best_search": best.search,
+                "baseline_beat_optimiser": refined_random.max(random_best) > refined.max(de_best),
                 "verify_tolerance": self.verify_tolerance,
                 "best_file": best_file.file_name().map(|n| n.to_string_lossy().into_owned()),
             }),
             failures: Vec::new(),
         })
+    }
+
+    /// Nelder–Mead from `start` (score `score`) on the eps and kappa genes of its resonators,
+    /// within the `refine` budget; every trial a row labelled `label`.
+    fn refine_from(
+        &self,
+        stage: &str,
+        label: &'static str,
+        start: &[f64],
+        score: f64,
+        store: &PointStore,
+        events: &dyn Events,
+    ) -> Result<Vec<Evaluated>> {
+        if self.refine == 0 || !score.is_finite() {
+            return Ok(Vec::new());
+        }
+        let layout = self.space.decode(start);
+        let slots: Vec<usize> = (1..self.space.dimension())
+            .filter(|j| {
+                let gene = (j - 1) % GENES;
+                let slot = (j - 1) / GENES;
+                (gene == 1 || gene == 2) && slot < layout.resonators.len()
+            })
+            .collect();
+        let mut refined: Vec<Evaluated> = Vec::new();
+        let mut failure: Option<PipelineError> = None;
+        let mut objective = |x: &[f64]| -> Result<f64> {
+            let mut g = start.to_vec();
+            for (k, &j) in slots.iter().enumerate() {
+                g[j] = x[k].clamp(0.0, 1.0);
+            }
+            let layout = self.space.decode(&g);
+            match self.evaluate(label, vec![layout], None, store, events) {
+                Ok(mut e) => {
+                    let e = e.remove(0);
+                    let score = e.score;
+                    refined.push(e);
+                    Ok(score)
+                }
+                Err(err) => {
+                    failure = Some(PipelineError::stage(stage, err.to_string()));
+                    Ok(f64::NEG_INFINITY)
+                }
+            }
+        };
+        let x0: Vec<f64> = slots.iter().map(|&j| start[j]).collect();
+        if !x0.is_empty() {
+            let steps = vec![0.05; x0.len()];
+            woodpile_analysis::nelder_mead::maximise(
+                &mut objective,
+                &x0,
+                &steps,
+                score,
+                self.refine,
+            )?;
+        }
+        match failure {
+            Some(e) => Err(e),
+            None => Ok(refined),
+        }
     }
 
     fn objective_name(&self) -> &'static str {
@@ -717,13 +802,14 @@ impl Design {
 }
 
 /// The searches a design table holds, in `search_index` order.
-const SEARCHES: [&str; 7] = [
+const SEARCHES: [&str; 8] = [
     "differential evolution",
     "random",
     "refinement",
     "verification",
     "robustness ±1%",
     "robustness ±5%",
+    "refinement of random",
     "robustness",
 ];
 
@@ -779,46 +865,43 @@ pub fn best_path(results: &Path, name: &str) -> PathBuf {
 }
 
 fn parse_space(mut f: Fields<'_>) -> Result<Space> {
-    let pair = |f: &mut Fields<'_>, key: &str| -> Result<(i64, i64)> {
-        match f.required::<toml::Value>(key)? {
-            toml::Value::Array(items) => match items.as_slice() {
-                [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => Ok((*a, *b)),
-                _ => Err(f.error(key, "expected [first, last], integers with first <= last")),
-            },
-            _ => Err(f.error(key, "expected [first, last]")),
-        }
+    let sites = parse_sites(&mut f)?;
+    let (lo, hi) = match (&sites, f.optional::<toml::Value>("resonators")?) {
+        (Sites::Fixed(list), None) => (list.len() as i64, list.len() as i64),
+        (_, None) => return Err(f.error("resonators", "is required: [fewest, most]")),
+        (_, Some(toml::Value::Array(items))) => match items.as_slice() {
+            [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => (*a, *b),
+            _ => {
+                return Err(f.error(
+                    "resonators",
+                    "expected [fewest, most], integers with fewest <= most",
+                ))
+            }
+        },
+        (_, Some(_)) => return Err(f.error("resonators", "expected [fewest, most]")),
     };
-    let (lo, hi) = pair(&mut f, "resonators")?;
     if lo < 0 || !(1..=64).contains(&hi) {
         return Err(f.error(
             "resonators",
             "expected counts from 0 to 64, at least one resonator possible",
         ));
     }
-    let sites = pair(&mut f, "sites")?;
-    if (hi - lo) < 0 || sites.1 - sites.0 + 1 < lo {
+    if let Sites::Fixed(list) = &sites {
+        if (lo, hi) != (list.len() as i64, list.len() as i64) {
+            return Err(f.error(
+                "resonators",
+                format!(
+                    "with fixed sites there is one resonator per site: [{0}, {0}] (or leave it out)",
+                    list.len()
+                ),
+            ));
+        }
+    }
+    if (sites.count() as i64) < lo {
         return Err(f.error("sites", "fewer sites than the fewest resonators"));
     }
-    let range = |f: &mut Fields<'_>, key: &str| -> Result<Range> {
-        let Some(table) = f.optional::<toml::Table>(key)? else {
-            return Err(f.error(key, "is required: { min, max, log }"));
-        };
-        let mut r = f.nested(key, table);
-        let min: f64 = r.required("min")?;
-        let max: f64 = r.required("max")?;
-        let log = match r.take("log") {
-            None => false,
-            Some(toml::Value::Boolean(b)) => b,
-            Some(_) => return Err(r.error("log", "expected true or false")),
-        };
-        if !(min.is_finite() && max.is_finite() && min > 0.0 && min <= max) {
-            return Err(r.error("min", "expected 0 < min <= max"));
-        }
-        r.finish()?;
-        Ok(Range { min, max, log })
-    };
-    let eps = range(&mut f, "eps")?;
-    let kappa = range(&mut f, "kappa")?;
+    let eps = parse_values(&mut f, "eps")?;
+    let kappa = parse_values(&mut f, "kappa")?;
     let p: Vec<i64> = match f.optional::<toml::Value>("p")? {
         None => vec![1],
         Some(toml::Value::Array(items)) if !items.is_empty() => items
@@ -840,6 +923,85 @@ fn parse_space(mut f: Fields<'_>) -> Result<Space> {
         p,
         max_total_eps,
     })
+}
+
+/// `sites`: `[first, last]`, a list of three or more sites, `{ among = [...] }` or
+/// `{ fixed = [...] }` (paper sites, distinct).
+fn parse_sites(f: &mut Fields<'_>) -> Result<Sites> {
+    const FORMS: &str =
+        "expected [first, last], a list of sites, { among = [...] } or { fixed = [...] }";
+    let integers = |f: &Fields<'_>, key: &str, items: &[toml::Value]| -> Result<Vec<i64>> {
+        let list: Vec<i64> = items
+            .iter()
+            .map(toml::Value::as_integer)
+            .collect::<Option<_>>()
+            .ok_or_else(|| f.error(key, "expected integer paper sites"))?;
+        let mut sorted = list.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        if sorted.len() != list.len() || list.is_empty() || list.len() > 64 {
+            return Err(f.error(key, "expected 1 to 64 distinct sites"));
+        }
+        Ok(sorted)
+    };
+    match f.required::<toml::Value>("sites")? {
+        toml::Value::Array(items) => match items.as_slice() {
+            [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => Ok(Sites::Range(*a, *b)),
+            [_, _] => Err(f.error("sites", "expected [first, last] with first <= last (for two separate sites: { among = [a, b] })")),
+            _ => Ok(Sites::Among(integers(f, "sites", &items)?)),
+        },
+        toml::Value::Table(table) => {
+            let mut t = f.nested("sites", table);
+            let form = match (t.take("among"), t.take("fixed")) {
+                (Some(toml::Value::Array(items)), None) => Sites::Among(integers(&t, "among", &items)?),
+                (None, Some(toml::Value::Array(items))) => Sites::Fixed(integers(&t, "fixed", &items)?),
+                _ => return Err(f.error("sites", FORMS)),
+            };
+            t.finish()?;
+            Ok(form)
+        }
+        _ => Err(f.error("sites", FORMS)),
+    }
+}
+
+/// `eps` or `kappa`: `{ min, max, log }`, or a list of the values allowed.
+fn parse_values(f: &mut Fields<'_>, key: &str) -> Result<Values> {
+    match f.optional::<toml::Value>(key)? {
+        Some(toml::Value::Array(items)) => {
+            let list: Option<Vec<f64>> = items
+                .iter()
+                .map(|v| match v {
+                    toml::Value::Float(x) if x.is_finite() && *x > 0.0 => Some(*x),
+                    toml::Value::Integer(i) if *i > 0 => Some(*i as f64),
+                    _ => None,
+                })
+                .collect();
+            match list {
+                Some(list) if !list.is_empty() => Ok(Values::List(list)),
+                _ => Err(f.error(
+                    key,
+                    "expected a list of positive numbers, or { min, max, log }",
+                )),
+            }
+        }
+        Some(toml::Value::Table(table)) => {
+            let mut r = f.nested(key, table);
+            let min: f64 = r.required("min")?;
+            let max: f64 = r.required("max")?;
+            let log = match r.take("log") {
+                None => false,
+                Some(toml::Value::Boolean(b)) => b,
+                Some(_) => return Err(r.error("log", "expected true or false")),
+            };
+            if !(min.is_finite() && max.is_finite() && min > 0.0 && min <= max) {
+                return Err(r.error("min", "expected 0 < min <= max"));
+            }
+            r.finish()?;
+            Ok(Values::Range(Range { min, max, log }))
+        }
+        Some(_) => Err(f.error(key, "expected { min, max, log } or a list of values")),
+        None => Err(f.error(key, "is required: { min, max, log } or a list of values")),
+    }
 }
 
 impl Kind for Design {
@@ -867,17 +1029,17 @@ mod tests {
     fn space() -> Space {
         Space {
             resonators: (1, 3),
-            sites: (0, 4),
-            eps: Range {
+            sites: Sites::Range(0, 4),
+            eps: Values::Range(Range {
                 min: 0.1,
                 max: 100.0,
                 log: true,
-            },
-            kappa: Range {
+            }),
+            kappa: Values::Range(Range {
                 min: 1.0,
                 max: 2.0,
                 log: false,
-            },
+            }),
             p: vec![1, 3],
             max_total_eps: None,
         }
@@ -901,5 +1063,39 @@ mod tests {
         }
         assert_eq!((s.eps.at(0.0), s.eps.at(1.0)), (0.1, 100.0));
         assert!((s.eps.at(0.5) - 10f64.powf(0.5)).abs() < 1e-12);
+    }
+
+    /// Fixed sites get one resonator each, whatever the genome; listed sites and listed eps
+    /// values are the only ones chosen.
+    #[test]
+    fn fixed_and_listed_sites_and_listed_eps_are_respected() {
+        let mut rng = Rng(11);
+        let fixed = Space {
+            resonators: (3, 3),
+            sites: Sites::Fixed(vec![0, 10, 20]),
+            eps: Values::List(vec![0.5, 2.0, 8.0]),
+            ..space()
+        };
+        let among = Space {
+            resonators: (1, 2),
+            sites: Sites::Among(vec![-3, 7, 9]),
+            ..space()
+        };
+        for _ in 0..300 {
+            let g: Vec<f64> = (0..fixed.dimension()).map(|_| rng.uniform()).collect();
+            let layout = fixed.decode(&g);
+            let sites: Vec<i64> = layout.resonators.iter().map(|r| r.0).collect();
+            assert_eq!(sites, [0, 10, 20]);
+            assert!(layout
+                .resonators
+                .iter()
+                .all(|r| [0.5, 2.0, 8.0].contains(&r.1)));
+            let g: Vec<f64> = (0..among.dimension()).map(|_| rng.uniform()).collect();
+            assert!(among
+                .decode(&g)
+                .resonators
+                .iter()
+                .all(|r| [-3, 7, 9].contains(&r.0)));
+        }
     }
 }

@@ -1,0 +1,171 @@
+//! A researcher's own study: designs at fixed sites with listed values, the best design being
+//! the best any search found, scene files by reference, variants and log-spaced axes.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+
+use woodpile_pipeline::events::Silent;
+use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::status::{output_path, state, State};
+use woodpile_pipeline::variant::Set;
+use woodpile_pipeline::{table, Pipeline};
+
+struct Project {
+    dir: tempfile::TempDir,
+}
+
+impl Project {
+    fn new(stages: &[(&str, &str)]) -> Project {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("pipeline")).unwrap();
+        for (name, text) in stages {
+            std::fs::write(dir.path().join(format!("pipeline/{name}.toml")), text).unwrap();
+        }
+        Project { dir }
+    }
+    fn root(&self) -> &Path {
+        self.dir.path()
+    }
+    fn results(&self) -> PathBuf {
+        self.root().join("results")
+    }
+    fn run_with(&self, sets: &[Set], targets: &[&str]) -> Pipeline {
+        let pipeline = Pipeline::load_with(&self.root().join("pipeline"), sets).unwrap();
+        let options = RunOptions {
+            targets: targets.iter().map(|s| s.to_string()).collect(),
+            force: false,
+            dry_run: false,
+            results: self.results(),
+            figures: self.root().join("figures"),
+        };
+        run(&pipeline, &options, &Silent).unwrap();
+        pipeline
+    }
+}
+
+const DESIGN: &str = r#"
+kind = "design"
+seed = 3
+budget = 30
+refine = 6
+objective = "E_tr"
+verify_tolerance = 1e-7
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "auto", tolerance = 1e-5 }
+fractions = { region = [-1, 6] }
+[space]
+sites = { fixed = [0, 2, 5] }
+eps = [0.5, 2.0, 8.0]
+kappa = { min = 0.5, max = 2.0 }
+"#;
+
+/// A design at fixed sites with listed eps values: every row uses exactly those sites and
+/// values, the best file holds the best design of any search, and the verification row
+/// carries the error estimate the summary states.
+#[test]
+fn a_design_at_fixed_sites_writes_the_best_design_any_search_found() {
+    let p = Project::new(&[("trap", DESIGN)]);
+    p.run_with(&[], &[]);
+    let (frame, manifest) = table::read_with_manifest(&output_path(&p.results(), "trap")).unwrap();
+    let text = |c: &str| table::str_column(&frame, c).unwrap();
+    let search = text("search");
+    assert!(text("sites").iter().flatten().all(|s| s == "0, 2, 5"));
+    for eps in text("eps").iter().flatten() {
+        assert!(
+            eps.split(", ").all(|e| ["0.5", "2", "8"].contains(&e)),
+            "{eps}"
+        );
+    }
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    let best_any = (0..frame.height())
+        .filter(|&i| search[i].as_deref().is_some_and(|s| s != "verification"))
+        .filter_map(|i| e_tr[i])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let summary = &manifest.summary;
+    let verified = (0..frame.height())
+        .find(|&i| search[i].as_deref() == Some("verification"))
+        .unwrap();
+    // The verified design is the best found, simulated again at the tighter tolerance.
+    assert!((e_tr[verified].unwrap() - best_any).abs() < 1e-4);
+    let estimate = table::f64_column(&frame, "error_estimate").unwrap()[verified];
+    assert_eq!(estimate, summary["best_error_estimate"].as_f64());
+    assert!(summary["best_search"].is_string());
+    assert!(summary["baseline_beat_optimiser"].is_boolean());
+    // The best file is that design and runs as it is.
+    let best = woodpile_scene::load(&p.results().join("trap.best.toml")).unwrap();
+    let out = woodpile_sim::run::simulate(&best.scenario, &mut ()).unwrap();
+    assert_eq!(out.fractions.trapped, e_tr[verified].unwrap());
+}
+
+/// A sweep names its scene file and overrides what it varies, on a log-spaced axis; editing
+/// the file makes it stale; a variant runs beside it with its own key and output.
+#[test]
+fn scene_files_by_reference_variants_and_log_axes() {
+    let sweep = r#"
+kind = "sweep"
+[axes]
+eps = { from = 0.1, to = 10.0, count = 5, log = true }
+[scene]
+file = "scenes/base.toml"
+[[scene.defect]]
+site = 0
+eps = "$eps"
+"#;
+    let reduce = "kind = \"reduce\"\ninputs = [\"sweep\"]\nat = 10.0\n";
+    let p = Project::new(&[("sweep", sweep), ("at_end", reduce)]);
+    std::fs::create_dir_all(p.root().join("scenes")).unwrap();
+    let base = "[chain]\nn = 10\n[impulse]\nsite = -5\n[[defect]]\nsite = 3\neps = 1.0\n[run]\nt_end = 10.0\nmethod = \"rk4\"\ndt = 0.02\n";
+    std::fs::write(p.root().join("scenes/base.toml"), base).unwrap();
+    let pipeline = p.run_with(&[], &[]);
+    let table = table::read(&output_path(&p.results(), "at_end")).unwrap();
+    let eps = table::f64_column(&table, "eps").unwrap();
+    assert_eq!(
+        eps,
+        [
+            Some(0.1),
+            Some(0.316227766017),
+            Some(1.0),
+            Some(3.16227766017),
+            Some(10.0)
+        ]
+    );
+    // The override replaced the file's defects: one defect at 0.
+    let params = &pipeline.stage("sweep").unwrap().params;
+    assert_eq!(params["scene"]["defect"].as_array().unwrap().len(), 1);
+    assert_eq!(params["scene"]["chain"]["n"], 10);
+
+    std::fs::write(
+        p.root().join("scenes/base.toml"),
+        base.replace("t_end = 10.0", "t_end = 12.0"),
+    )
+    .unwrap();
+    let pipeline = Pipeline::load(&p.root().join("pipeline")).unwrap();
+    let st = state(
+        &pipeline,
+        &p.results(),
+        &p.root().join("figures"),
+        pipeline.stage("sweep").unwrap(),
+    );
+    assert!(
+        matches!(st, State::Stale(ref why) if why.iter().any(|w| w.contains("scene.run.t_end"))),
+        "{st:?}"
+    );
+    std::fs::write(p.root().join("scenes/base.toml"), base).unwrap();
+
+    let set = Set::parse("at_end.at=6.0").unwrap();
+    let name = woodpile_pipeline::variant::variant_name("at_end", std::slice::from_ref(&set));
+    assert_eq!(name, "at_end--at-6_0");
+    p.run_with(std::slice::from_ref(&set), &[&name]);
+    let variant = table::read(&output_path(&p.results(), &name)).unwrap();
+    assert!(table::f64_column(&variant, "t")
+        .unwrap()
+        .iter()
+        .all(|t| *t == Some(6.0)));
+    let original = table::read(&output_path(&p.results(), "at_end")).unwrap();
+    assert!(table::f64_column(&original, "t")
+        .unwrap()
+        .iter()
+        .all(|t| *t == Some(10.0)));
+}
