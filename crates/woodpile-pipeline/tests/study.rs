@@ -169,3 +169,58 @@ eps = "$eps"
         .iter()
         .all(|t| *t == Some(10.0)));
 }
+
+/// Optimize within explicit bounds from several starts: R, T and the error estimate on every
+/// row, a sensitivity and an edge flag per axis, whether the starts agree, and the optimum as a
+/// scene file that gives its number.
+#[test]
+fn optimize_with_bounds_and_starts_reports_what_a_user_needs() {
+    let sweep = r#"
+kind = "sweep"
+[axes]
+eps = [0.5, 1.0, 2.0, 4.0]
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "auto", tolerance = 1e-5 }
+[[scene.defect]]
+site = 0
+eps = "$eps"
+"#;
+    let reduce = "kind = \"reduce\"\ninputs = [\"sweep\"]\nat = 12.0\n";
+    let optimize = r#"
+kind = "optimize"
+inputs = ["at_end"]
+over = ["eps"]
+tolerance = 1e-7
+bounds = { eps = [0.5, 3.0] }
+starts = 2
+"#;
+    let p = Project::new(&[("sweep", sweep), ("at_end", reduce), ("best", optimize)]);
+    p.run_with(&[], &[]);
+    let (frame, manifest) = table::read_with_manifest(&output_path(&p.results(), "best")).unwrap();
+    assert_eq!(frame.height(), 4);
+    for column in [
+        "start",
+        "R",
+        "T",
+        "E_tr",
+        "error_estimate",
+        "sensitivity_eps",
+        "edge_eps",
+    ] {
+        assert!(frame.column(column).is_ok(), "{column}");
+    }
+    let eps = table::f64_column(&frame, "eps").unwrap();
+    assert!(
+        eps.iter().flatten().all(|e| (0.5..=3.0).contains(e)),
+        "{eps:?}"
+    );
+    let summary = &manifest.summary;
+    assert_eq!(summary["starts"], 2);
+    assert!(summary["starts_agree"].is_boolean() && summary["sharp"].is_boolean());
+    assert_eq!(summary["box"][0]["hi"], 3.0);
+    let best = woodpile_scene::load(&p.results().join("best.best.toml")).unwrap();
+    let out = woodpile_sim::run::simulate(&best.scenario, &mut ()).unwrap();
+    assert_eq!(out.fractions.trapped, summary["refined"].as_f64().unwrap());
+}

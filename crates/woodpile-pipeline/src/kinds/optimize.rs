@@ -1,6 +1,6 @@
-//! `kind = "optimize"`: beyond the grid. Starting from the best grid point of a reduced sweep,
-//! Nelder–Mead searches the continuous parameter box for the true maximum, simulating each
-//! trial scene (at a tighter tolerance) with the sweep's own scene template.
+//! `kind = "optimize"`: beyond the grid. Starting from the best grid points of a reduced
+//! sweep, Nelder–Mead searches a continuous box of the parameters for the true maximum,
+//! simulating each trial scene (at a tighter tolerance) with the sweep's own scene template.
 //!
 //! ```toml
 //! kind = "optimize"
@@ -8,14 +8,27 @@
 //! column = "E_tr"               # E_tr, R or T
 //! over = ["eps1", "eps2"]       # float axes of the sweep; the others stay at the grid optimum
 //! tolerance = 1e-8              # scene tolerance of the refinement runs
+//! bounds = { eps1 = [1.0, 100.0] }   # optional: the box; an axis not named spans its grid values
+//! starts = 3                    # optional: refine from the 3 best grid points (default 1)
 //! ```
 //!
-//! Output: two rows, `grid` (the grid maximum, re-simulated at the refinement tolerance so the
-//! two are comparable) and `refined`, with the axis values, the column's value and the number
-//! of simulations.
+//! **The box.** Each searched axis ranges over `bounds`, or else from its smallest to its
+//! largest grid value; trials outside are clamped to it. Nelder–Mead's first steps are one grid
+//! spacing.
+//!
+//! Output: two rows per start, `grid` (the grid point, re-simulated at the refinement
+//! tolerance so the two are comparable) and `refined`, with `start`, the axis values, `R`,
+//! `T`, `E_tr`, `error_estimate`, the grid table's value and the simulations spent; and for a
+//! refined optimum, `sensitivity_<axis>` (the largest change of the column when that axis
+//! alone moves by ±1%: a knife-edge optimum shows a large one) and `edge_<axis>` (1 when the
+//! optimum lies on the box's edge). The summary says whether the starts agree and flags a
+//! sharp optimum; `results/<stage>.best.toml` is the best optimum as a scene file.
+
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
 
 use serde_json::json;
-use woodpile_sim::run::simulate;
+use woodpile_sim::run::{simulate, Outcome};
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
@@ -37,7 +50,18 @@ pub struct Optimize {
     pub over: Vec<String>,
     /// Scene tolerance of the refinement runs.
     pub tolerance: f64,
+    /// Explicit `[lo, hi]` per searched axis (others span their grid values).
+    pub bounds: Vec<(String, f64, f64)>,
+    /// How many of the best grid points to refine from.
+    pub starts: usize,
 }
+
+/// Relative move of one coordinate in the sensitivity check.
+const NUDGE: f64 = 0.01;
+/// A change of the column this large under a ±1% move flags the optimum as sharp.
+const SHARP: f64 = 0.01;
+/// Starts agree when their optima's values are this close.
+const AGREE: f64 = 1e-3;
 
 /// Most simulations one search may spend.
 const MAX_EVALUATIONS: usize = 120;
@@ -56,10 +80,47 @@ impl Optimize {
         if !(tolerance > 0.0 && tolerance < 1.0) {
             return Err(fields.error("tolerance", "expected a number in (0, 1)"));
         }
+        let mut bounds = Vec::new();
+        if let Some(table) = fields.optional::<toml::Table>("bounds")? {
+            for (name, value) in table {
+                let pair = match &value {
+                    toml::Value::Array(items) => match items.as_slice() {
+                        [a, b] => a
+                            .as_float()
+                            .or(a.as_integer().map(|i| i as f64))
+                            .zip(b.as_float().or(b.as_integer().map(|i| i as f64))),
+                        _ => None,
+                    },
+                    _ => None,
+                };
+                match pair {
+                    Some((lo, hi)) if lo.is_finite() && hi.is_finite() && lo < hi => {
+                        if !over.contains(&name) {
+                            return Err(fields.error(
+                                &format!("bounds.{name}"),
+                                "bounds only axes named in `over`",
+                            ));
+                        }
+                        bounds.push((name, lo, hi));
+                    }
+                    _ => {
+                        return Err(fields
+                            .error(&format!("bounds.{name}"), "expected [lo, hi] with lo < hi"))
+                    }
+                }
+            }
+        }
+        let starts = match fields.optional::<i64>("starts")? {
+            None => 1,
+            Some(n) if (1..=20).contains(&n) => n as usize,
+            Some(_) => return Err(fields.error("starts", "expected 1 to 20")),
+        };
         Ok(Optimize {
             column,
             over,
             tolerance,
+            bounds,
+            starts,
         })
     }
 
@@ -84,30 +145,23 @@ impl Optimize {
         stage: &str,
         input: &polars::prelude::DataFrame,
         sweep: &Sweep,
+        results: &Path,
     ) -> Result<Output> {
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let col = |name: &str| f64_column(input, name).map_err(|e| fail(e.to_string()));
         let target = col(&self.column)?;
-        let best_row = (0..input.height())
+        let mut ranked: Vec<usize> = (0..input.height())
             .filter(|&r| target[r].is_some_and(f64::is_finite))
-            .max_by(|&a, &b| {
-                target[a]
-                    .unwrap_or(f64::MIN)
-                    .total_cmp(&target[b].unwrap_or(f64::MIN))
-            })
-            .ok_or_else(|| fail("no finite values to maximise".into()))?;
-        let grid_values: Vec<AxisValue> = sweep
-            .axes
-            .iter()
-            .map(|a| {
-                let v = col(&a.name)?[best_row].unwrap_or(f64::NAN);
-                Ok(if a.is_integer() {
-                    AxisValue::Int(v as i64)
-                } else {
-                    AxisValue::Float(v)
-                })
-            })
-            .collect::<Result<_>>()?;
+            .collect();
+        ranked.sort_by(|&a, &b| {
+            target[b]
+                .unwrap_or(f64::MIN)
+                .total_cmp(&target[a].unwrap_or(f64::MIN))
+                .then(a.cmp(&b))
+        });
+        if ranked.is_empty() {
+            return Err(fail("no finite values to maximise".into()));
+        }
         let searched: Vec<usize> = self
             .over
             .iter()
@@ -116,7 +170,8 @@ impl Optimize {
         let bounds: Vec<(f64, f64, f64)> = searched
             .iter()
             .map(|&k| {
-                let values: Vec<f64> = sweep.axes[k].values.iter().map(|v| v.as_f64()).collect();
+                let axis = &sweep.axes[k];
+                let values: Vec<f64> = axis.values.iter().map(|v| v.as_f64()).collect();
                 let (lo, hi) = values
                     .iter()
                     .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| {
@@ -127,60 +182,248 @@ impl Optimize {
                 } else {
                     1.0
                 };
-                (lo, hi, spacing)
+                match self.bounds.iter().find(|b| b.0 == axis.name) {
+                    Some(&(_, l, h)) => (l, h, spacing.min(h - l)),
+                    None => (lo, hi, spacing),
+                }
             })
             .collect();
-        let mut evaluations = 0;
-        let mut objective = |x: &[f64]| -> Result<f64> {
-            evaluations += 1;
-            let mut values = grid_values.clone();
+        // Every simulation: the point and what it gave (for the rows and the best file).
+        let evaluated: RefCell<Vec<(Vec<AxisValue>, Outcome)>> = RefCell::new(Vec::new());
+        let simulate_at = |values: &[AxisValue]| -> Result<Outcome> {
+            if let Some((_, out)) = evaluated.borrow().iter().find(|(v, _)| v == values) {
+                return Ok(out.clone());
+            }
+            let scene = sweep.scene_with(values, Some(self.tolerance))?;
+            crate::points::count_simulation();
+            let out = simulate(&scene.scenario, &mut ())
+                .map_err(|e| fail(format!("refinement scene failed: {e}")))?;
+            evaluated.borrow_mut().push((values.to_vec(), out.clone()));
+            Ok(out)
+        };
+        let value_of = |out: &Outcome| match self.column.as_str() {
+            "R" => out.fractions.reflected,
+            "T" => out.fractions.transmitted,
+            _ => out.fractions.trapped,
+        };
+        let grid_values_of = |row: usize| -> Result<Vec<AxisValue>> {
+            sweep
+                .axes
+                .iter()
+                .map(|a| {
+                    let v = col(&a.name)?[row].unwrap_or(f64::NAN);
+                    Ok(if a.is_integer() {
+                        AxisValue::Int(v as i64)
+                    } else {
+                        AxisValue::Float(v)
+                    })
+                })
+                .collect()
+        };
+        let at = |base: &[AxisValue], x: &[f64]| -> Vec<AxisValue> {
+            let mut values = base.to_vec();
             for (slot, &k) in searched.iter().enumerate() {
                 let (lo, hi, _) = bounds[slot];
                 values[k] = AxisValue::Float(x[slot].clamp(lo, hi));
             }
-            let scene = sweep.scene_with(&values, Some(self.tolerance))?;
-            crate::points::count_simulation();
-            let out = simulate(&scene.scenario, &mut ())
-                .map_err(|e| fail(format!("refinement scene failed: {e}")))?;
-            let f = out.fractions;
-            Ok(match self.column.as_str() {
-                "R" => f.reflected,
-                "T" => f.transmitted,
-                _ => f.trapped,
-            })
+            values
         };
-        let start: Vec<f64> = searched.iter().map(|&k| grid_values[k].as_f64()).collect();
-        let grid_value = objective(&start)?;
-        let steps: Vec<f64> = bounds.iter().map(|b| b.2).collect();
-        let (best_x, best_value) = woodpile_analysis::nelder_mead::maximise(
-            &mut objective,
-            &start,
-            &steps,
-            grid_value,
-            MAX_EVALUATIONS,
-        )?;
-        let clamped: Vec<f64> = best_x
-            .iter()
-            .zip(&bounds)
-            .map(|(x, b)| x.clamp(b.0, b.1))
-            .collect();
-        let mut columns = Columns::new();
-        columns.str("point", vec![Some("grid".into()), Some("refined".into())]);
-        for (slot, &k) in searched.iter().enumerate() {
-            columns.f64(
-                &sweep.axes[k].name,
-                vec![Some(start[slot]), Some(clamped[slot])],
-            );
+        let mut rows: Vec<OptimumRow> = Vec::new();
+        let mut simulations_total = 0;
+        for (start_index, &row) in ranked.iter().take(self.starts).enumerate() {
+            let base = grid_values_of(row)?;
+            let start: Vec<f64> = searched.iter().map(|&k| base[k].as_f64()).collect();
+            let before = evaluated.borrow().len();
+            let grid_out = simulate_at(&at(&base, &start))?;
+            let grid_value = value_of(&grid_out);
+            let mut objective =
+                |x: &[f64]| -> Result<f64> { simulate_at(&at(&base, x)).map(|out| value_of(&out)) };
+            let steps: Vec<f64> = bounds.iter().map(|b| b.2).collect();
+            let (best_x, _) = woodpile_analysis::nelder_mead::maximise(
+                &mut objective,
+                &start,
+                &steps,
+                grid_value,
+                MAX_EVALUATIONS,
+            )?;
+            let best_values = at(&base, &best_x);
+            let best_out = simulate_at(&best_values)?;
+            let best_value = value_of(&best_out);
+            // Sensitivity: each coordinate alone nudged by ±1%.
+            let mut sensitivity = Vec::with_capacity(searched.len());
+            for slot in 0..searched.len() {
+                let mut spread: f64 = 0.0;
+                for sign in [-1.0, 1.0] {
+                    let mut x: Vec<f64> = best_values_of(&best_values, &searched);
+                    x[slot] *= 1.0 + sign * NUDGE;
+                    let out = simulate_at(&at(&base, &x))?;
+                    spread = spread.max((value_of(&out) - best_value).abs());
+                }
+                sensitivity.push(spread);
+            }
+            let simulations = evaluated.borrow().len() - before;
+            simulations_total += simulations;
+            let on_edge: Vec<bool> = searched
+                .iter()
+                .enumerate()
+                .map(|(slot, &k)| {
+                    let x = best_values[k].as_f64();
+                    let (lo, hi, _) = bounds[slot];
+                    (x - lo).abs() <= 1e-9 * lo.abs().max(1.0)
+                        || (x - hi).abs() <= 1e-9 * hi.abs().max(1.0)
+                })
+                .collect();
+            rows.push(OptimumRow {
+                start: start_index,
+                point: "grid",
+                values: at(&base, &start),
+                outcome: grid_out,
+                grid_table_value: target[row],
+                simulations: 1,
+                sensitivity: None,
+                on_edge: None,
+            });
+            rows.push(OptimumRow {
+                start: start_index,
+                point: "refined",
+                values: best_values,
+                outcome: best_out,
+                grid_table_value: None,
+                simulations,
+                sensitivity: Some(sensitivity),
+                on_edge: Some(on_edge),
+            });
         }
-        columns.f64(&self.column, vec![Some(grid_value), Some(best_value)]);
-        columns.f64("grid_table_value", vec![target[best_row], None]);
-        columns.i64("simulations", vec![Some(1), Some(evaluations as i64)]);
+        let refined: Vec<&OptimumRow> = rows.iter().filter(|r| r.point == "refined").collect();
+        let best = refined
+            .iter()
+            .max_by(|a, b| value_of(&a.outcome).total_cmp(&value_of(&b.outcome)))
+            .copied()
+            .ok_or_else(|| fail("no start".into()))?;
+        let best_value = value_of(&best.outcome);
+        let agree = refined
+            .iter()
+            .all(|r| (value_of(&r.outcome) - best_value).abs() <= AGREE);
+        let sharp = best
+            .sensitivity
+            .as_ref()
+            .is_some_and(|s| s.iter().any(|&d| d > SHARP));
+        let edge: Vec<&str> = searched
+            .iter()
+            .enumerate()
+            .filter(|(slot, _)| best.on_edge.as_ref().is_some_and(|e| e[*slot]))
+            .map(|(_, &k)| sweep.axes[k].name.as_str())
+            .collect();
+        // The best optimum as a scene file.
+        let scene = sweep.scene_with(&best.values, Some(self.tolerance))?;
+        let path = best_path(results, stage);
+        let table = sweep
+            .table_with(&best.values, Some(self.tolerance))
+            .map_err(|e| fail(e.to_string()))?;
+        let text = toml::to_string(&table).map_err(|e| fail(e.to_string()))?;
+        let header = format!(
+            "# The optimum stage `{stage}` found: {} = {best_value} at t_end = {}, tolerance {:e}.\n# Run it with: woodpile simulate {}\n",
+            self.column,
+            scene.scenario.t_end,
+            self.tolerance,
+            path.display()
+        );
+        crate::atomic::write(&path, (header + &text).as_bytes())?;
+
+        let grid_first = rows
+            .first()
+            .map(|r| value_of(&r.outcome))
+            .unwrap_or(f64::NAN);
+        let frame = self.frame(&rows, sweep, &searched)?;
         Ok(Output {
             failures: Vec::new(),
-            frame: columns.into_frame()?,
-            summary: json!({"grid": grid_value, "refined": best_value, "gain": best_value - grid_value, "simulations": evaluations}),
+            frame,
+            summary: json!({
+                "grid": grid_first,
+                "refined": best_value,
+                "gain": best_value - grid_first,
+                "simulations": simulations_total,
+                "starts": self.starts,
+                "starts_agree": agree,
+                "sharp": sharp,
+                "on_edge": edge,
+                "box": searched.iter().enumerate().map(|(slot, &k)| json!({
+                    "axis": sweep.axes[k].name, "lo": bounds[slot].0, "hi": bounds[slot].1
+                })).collect::<Vec<_>>(),
+                "best_error_estimate": best.outcome.error_estimate,
+                "best_file": path.file_name().map(|n| n.to_string_lossy().into_owned()),
+            }),
         })
     }
+
+    fn frame(
+        &self,
+        rows: &[OptimumRow],
+        sweep: &Sweep,
+        searched: &[usize],
+    ) -> Result<polars::prelude::DataFrame> {
+        let mut columns = Columns::new();
+        columns.i64("start", rows.iter().map(|r| Some(r.start as i64)).collect());
+        columns.str(
+            "point",
+            rows.iter().map(|r| Some(r.point.to_string())).collect(),
+        );
+        for &k in searched {
+            columns.f64(
+                &sweep.axes[k].name,
+                rows.iter().map(|r| Some(r.values[k].as_f64())).collect(),
+            );
+        }
+        let f = |pick: fn(&OptimumRow) -> Option<f64>| rows.iter().map(pick).collect::<Vec<_>>();
+        columns
+            .f64("R", f(|r| Some(r.outcome.fractions.reflected)))
+            .f64("T", f(|r| Some(r.outcome.fractions.transmitted)))
+            .f64("E_tr", f(|r| Some(r.outcome.fractions.trapped)))
+            .f64("error_estimate", f(|r| r.outcome.error_estimate))
+            .f64("grid_table_value", f(|r| r.grid_table_value));
+        columns.i64(
+            "simulations",
+            rows.iter().map(|r| Some(r.simulations as i64)).collect(),
+        );
+        for (slot, &k) in searched.iter().enumerate() {
+            let name = &sweep.axes[k].name;
+            columns.f64(
+                &format!("sensitivity_{name}"),
+                rows.iter()
+                    .map(|r| r.sensitivity.as_ref().map(|s| s[slot]))
+                    .collect(),
+            );
+            columns.i64(
+                &format!("edge_{name}"),
+                rows.iter()
+                    .map(|r| r.on_edge.as_ref().map(|e| i64::from(e[slot])))
+                    .collect(),
+            );
+        }
+        columns.into_frame()
+    }
+}
+
+/// One row of an optimize table.
+struct OptimumRow {
+    start: usize,
+    point: &'static str,
+    values: Vec<AxisValue>,
+    outcome: Outcome,
+    grid_table_value: Option<f64>,
+    simulations: usize,
+    sensitivity: Option<Vec<f64>>,
+    on_edge: Option<Vec<bool>>,
+}
+
+/// The searched coordinates of `values`.
+fn best_values_of(values: &[AxisValue], searched: &[usize]) -> Vec<f64> {
+    searched.iter().map(|&k| values[k].as_f64()).collect()
+}
+
+/// Where stage `name` writes its best optimum: beside its table.
+pub fn best_path(results: &Path, name: &str) -> PathBuf {
+    results.join(format!("{name}.best.toml"))
 }
 
 impl Kind for Optimize {
@@ -231,6 +474,10 @@ impl Kind for Optimize {
             .ok_or_else(|| {
                 PipelineError::stage(ctx.name(), format!("`{input}` does not read a sweep"))
             })?;
-        self.run(ctx.name(), &frame, sweep)
+        self.run(ctx.name(), &frame, sweep, ctx.results)
+    }
+
+    fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
+        vec![best_path(results, stage)]
     }
 }

@@ -119,6 +119,28 @@ impl Sweep {
     /// The validated scene at arbitrary axis `values` (one per axis, in order), optionally with
     /// `run.tolerance` replaced (an optimiser's refinement runs between grid points, tighter).
     pub fn scene_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<Scene> {
+        let table = self.table_with(values, tolerance)?;
+        woodpile_scene::from_table(table, &self.file)
+            .map_err(|e| PipelineError::scene(&self.file, "scene", e, &self.at(values)))
+    }
+
+    /// ` (at eps = 1, L = 2)` for messages about the point at `values`.
+    fn at(&self, values: &[AxisValue]) -> String {
+        let parts: Vec<String> = self
+            .axes
+            .iter()
+            .zip(values)
+            .map(|(a, v)| format!("{} = {v}", a.name))
+            .collect();
+        if parts.is_empty() {
+            String::new()
+        } else {
+            format!(" (at {})", parts.join(", "))
+        }
+    }
+
+    /// The scene table at `values` (a scene file's content), before validation.
+    pub fn table_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<toml::Table> {
         let at = || {
             let parts: Vec<String> = self
                 .axes
@@ -144,8 +166,7 @@ impl Sweep {
                 run.insert("tolerance".into(), toml::Value::Float(tol));
             }
         }
-        woodpile_scene::from_table(table, &self.file)
-            .map_err(|e| PipelineError::scene(&self.file, "scene", e, &at()))
+        Ok(table)
     }
 
     fn error(&self, key: String, reason: String) -> PipelineError {
