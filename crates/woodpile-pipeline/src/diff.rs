@@ -308,9 +308,15 @@ fn compare_files(
                 ));
             }
             let as_text = |f: &DataFrame| -> Result<Vec<Option<String>>> {
-                let c = f
-                    .column(column)
-                    .and_then(|c| c.cast(&polars::prelude::DataType::String))
+                let c = f.column(column).map_err(|e| PipelineError::io(name, e))?;
+                if matches!(c.dtype(), polars::prelude::DataType::List(_)) {
+                    // A list compares as its values' text, row by row.
+                    return Ok((0..c.len())
+                        .map(|i| c.get(i).ok().map(|v| v.to_string()))
+                        .collect());
+                }
+                let c = c
+                    .cast(&polars::prelude::DataType::String)
                     .map_err(|e| PipelineError::io(name, e))?;
                 str_column(
                     &DataFrame::new_infer_height(vec![c])

@@ -40,6 +40,27 @@ impl Columns {
         self
     }
 
+    /// Appends a column of float lists (one list per row: pandas and polars read them as
+    /// lists).
+    pub fn f64_list(&mut self, name: &str, values: Vec<Vec<f64>>) -> &mut Self {
+        let rows: Vec<Series> = values
+            .into_iter()
+            .map(|v| Series::new(PlSmallStr::EMPTY, v))
+            .collect();
+        self.0.push(Series::new(name.into(), rows).into());
+        self
+    }
+
+    /// Appends a column of integer lists.
+    pub fn i64_list(&mut self, name: &str, values: Vec<Vec<i64>>) -> &mut Self {
+        let rows: Vec<Series> = values
+            .into_iter()
+            .map(|v| Series::new(PlSmallStr::EMPTY, v))
+            .collect();
+        self.0.push(Series::new(name.into(), rows).into());
+        self
+    }
+
     /// The finished frame.
     pub fn into_frame(self) -> Result<DataFrame> {
         DataFrame::new_infer_height(self.0)
@@ -56,6 +77,10 @@ pub enum Cell {
     I64(Option<i64>),
     /// A string (or null).
     Str(Option<String>),
+    /// A list of floats.
+    F64List(Vec<f64>),
+    /// A list of integers.
+    I64List(Vec<i64>),
 }
 
 impl From<f64> for Cell {
@@ -176,6 +201,34 @@ pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
                     },
                     mismatch,
                 )?,
+            ),
+            Some(Cell::F64List(_)) => out.f64_list(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::F64List(x) => Some(Some(x)),
+                        _ => None,
+                    },
+                    mismatch,
+                )?
+                .into_iter()
+                .flatten()
+                .collect(),
+            ),
+            Some(Cell::I64List(_)) => out.i64_list(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::I64List(x) => Some(Some(x)),
+                        _ => None,
+                    },
+                    mismatch,
+                )?
+                .into_iter()
+                .flatten()
+                .collect(),
             ),
         };
     }

@@ -40,8 +40,8 @@
 //! seed alone.
 //!
 //! Output: one row per evaluation (`search`: differential evolution, random, refinement,
-//! verification, robustness ±s), with the design (`resonators`, `sites`, `eps`, `kappa`, `p`,
-//! `total_eps`), the fractions, the error estimate, `best_so_far` within its search,
+//! verification, robustness ±s), with the design (`resonators`, and `sites`, `eps`, `kappa`
+//! and `p` as list columns, `total_eps`), the fractions, the error estimate, `best_so_far` within its search,
 //! `quantile` (a robustness sample's rank among its spread's samples) and `failure`; and `results/<stage>.best.toml`, the best design as a scene file that
 //! `woodpile simulate` runs as it is.
 
@@ -839,10 +839,22 @@ impl Row for TrialRow<'_> {
             ("search_index", Cell::from(self.search_index as i64)),
             ("evaluation", Cell::from(self.evaluation)),
             ("resonators", Cell::from(e.layout.resonators.len() as i64)),
-            ("sites", e.layout.list(|r| r.0).into()),
-            ("eps", e.layout.list(|r| r.1).into()),
-            ("kappa", e.layout.list(|r| r.2).into()),
-            ("p", e.layout.list(|r| r.3).into()),
+            (
+                "sites",
+                Cell::I64List(e.layout.resonators.iter().map(|r| r.0).collect()),
+            ),
+            (
+                "eps",
+                Cell::F64List(e.layout.resonators.iter().map(|r| r.1).collect()),
+            ),
+            (
+                "kappa",
+                Cell::F64List(e.layout.resonators.iter().map(|r| r.2).collect()),
+            ),
+            (
+                "p",
+                Cell::I64List(e.layout.resonators.iter().map(|r| r.3).collect()),
+            ),
             ("total_eps", Cell::from(e.layout.total_eps())),
             ("R", last(|p| &p.reflected).into()),
             ("T", last(|p| &p.transmitted).into()),
