@@ -397,3 +397,50 @@ fn a_killed_render_followed_by_a_revert_is_never_fresh_with_the_wrong_figure() {
         assert_eq!(std::fs::read(&png).unwrap(), original, "trial {trial}");
     }
 }
+
+/// `woodpile new study` makes a folder that runs as written, from itself or any folder inside
+/// it, with no directory flags; a variant runs beside the stage; the environment moves a tree.
+#[test]
+fn a_new_study_runs_as_written_without_directory_flags() {
+    let dir = tempfile::tempdir().unwrap();
+    let made = woodpile(dir.path(), &["new", "study", "mine"]);
+    assert!(made.status.success(), "{}", text(&made.stderr));
+    assert_eq!(
+        woodpile(dir.path(), &["new", "study", "mine"])
+            .status
+            .code(),
+        Some(2)
+    );
+    let study = dir.path().join("mine");
+    let ran = woodpile(&study, &["run"]);
+    assert!(ran.status.success(), "{}", text(&ran.stderr));
+    assert!(
+        text(&ran.stderr).contains("25 scene(s) simulated"),
+        "{}",
+        text(&ran.stderr)
+    );
+    assert!(study.join("figures/figure.png").exists());
+    let inside = woodpile(&study.join("pipeline"), &["status", "--check"]);
+    assert_eq!(inside.status.code(), Some(0), "{}", text(&inside.stdout));
+    let variant = woodpile(&study, &["run", "--set", "fractions.at=40.0"]);
+    assert!(variant.status.success(), "{}", text(&variant.stderr));
+    assert!(study.join("results/fractions--at-40_0.parquet").exists());
+    assert_eq!(
+        woodpile(&study, &["status", "--check"]).status.code(),
+        Some(0)
+    );
+    let moved = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+        .current_dir(&study)
+        .args(["status", "--check"])
+        .env("WOODPILE_RESULTS", "elsewhere")
+        .output()
+        .unwrap();
+    assert_eq!(moved.status.code(), Some(1), "{}", text(&moved.stdout));
+    let nowhere = woodpile(dir.path(), &["status"]);
+    assert_eq!(nowhere.status.code(), Some(2));
+    assert!(
+        text(&nowhere.stderr).contains("woodpile new study"),
+        "{}",
+        text(&nowhere.stderr)
+    );
+}
