@@ -30,6 +30,14 @@ pub(crate) fn resolve(
         Some((root, table)) => (root, table),
         None => (PathBuf::from("."), toml::Table::new()),
     };
+    // `results`, not `./results`: paths are shown in messages and written into files.
+    let under = |rel: &str| {
+        if root == Path::new(".") {
+            PathBuf::from(rel)
+        } else {
+            root.join(rel)
+        }
+    };
     let pick = |flag: Option<&Path>, env: &str, key: &str| -> anyhow::Result<PathBuf> {
         if let Some(path) = flag {
             return Ok(path.to_path_buf());
@@ -38,8 +46,8 @@ pub(crate) fn resolve(
             return Ok(PathBuf::from(path));
         }
         match file.get(key) {
-            None => Ok(root.join(key)),
-            Some(toml::Value::String(s)) => Ok(root.join(s)),
+            None => Ok(under(key)),
+            Some(toml::Value::String(s)) => Ok(under(s)),
             Some(_) => Err(anyhow!(
                 "{}: key `{key}`: expected a folder path (a string)",
                 root.join(PROJECT_FILE).display()
