@@ -69,14 +69,26 @@ fn a_design_at_fixed_sites_writes_the_best_design_any_search_found() {
     let p = Project::new(&[("trap", DESIGN)]);
     p.run_with(&[], &[]);
     let (frame, manifest) = table::read_with_manifest(&output_path(&p.results(), "trap")).unwrap();
-    let text = |c: &str| table::str_column(&frame, c).unwrap();
-    let search = text("search");
-    assert!(text("sites").iter().flatten().all(|s| s == "0, 2, 5"));
-    for eps in text("eps").iter().flatten() {
-        assert!(
-            eps.split(", ").all(|e| ["0.5", "2", "8"].contains(&e)),
-            "{eps}"
-        );
+    let search = table::str_column(&frame, "search").unwrap();
+    // Sites and eps are list columns: one list per design.
+    let list = |name: &str| -> Vec<Vec<f64>> {
+        let column = frame.column(name).unwrap();
+        (0..frame.height())
+            .map(|i| match column.get(i).unwrap() {
+                polars::prelude::AnyValue::List(s) => s
+                    .cast(&polars::prelude::DataType::Float64)
+                    .unwrap()
+                    .f64()
+                    .unwrap()
+                    .into_no_null_iter()
+                    .collect(),
+                other => panic!("{name} row {i}: {other:?}"),
+            })
+            .collect()
+    };
+    assert!(list("sites").iter().all(|s| s == &[0.0, 2.0, 5.0]));
+    for eps in list("eps") {
+        assert!(eps.iter().all(|e| [0.5, 2.0, 8.0].contains(e)), "{eps:?}");
     }
     let e_tr = table::f64_column(&frame, "E_tr").unwrap();
     let best_any = (0..frame.height())
