@@ -113,7 +113,7 @@ pub enum SimError {
         max_steps: u64,
     },
     /// `auto` could not verify the tolerance by step halving.
-    #[error("method auto could not reach tolerance {tolerance:.1e}: estimated error still {estimate:.2e} at dt = {dt:.3e}")]
+    #[error("method auto could not verify tolerance {tolerance:.1e}: at its finest step, dt = {dt:.3e}, {why}; use a looser tolerance, or a named method with a step of your choosing (method = \"rkn6-contact\", dt = ...), whose result is not verified")]
     NotConverged {
         /// Requested tolerance.
         tolerance: f64,
@@ -121,6 +121,9 @@ pub enum SimError {
         estimate: f64,
         /// Last (finest) step tried.
         dt: f64,
+        /// What failed at that step: the estimate, the energy drift, or the pair not being in
+        /// its asymptotic regime.
+        why: String,
     },
     /// The observer asked for the run to stop (see `Observer::cancelled`).
     #[error("cancelled at t = {t:.6}")]

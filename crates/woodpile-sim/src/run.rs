@@ -116,12 +116,14 @@ fn verified<O: Observer + ?Sized>(
     // The change between the two runs before `coarse` (4 dt and 2 dt), once the ladder has
     // made them: the asymptotic-regime check below.
     let mut previous_change: Option<f64> = None;
+    let mut why = String::from("no run kept its energy");
     for _ in 0..=MAX_HALVINGS {
         observer.reset();
         let fine = match run_plan(scenario, &guarded.with_dt(dt), observer) {
             Ok(out) => out,
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
-            Err(SimError::NonFinite { .. } | SimError::EnergyDrift { .. }) => {
+            Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
+                why = format!("the run blew up or lost energy ({e})");
                 coarse = None;
                 previous_change = None;
                 dt *= 0.5;
@@ -134,16 +136,15 @@ fn verified<O: Observer + ?Sized>(
             .as_ref()
             .map(|c| c.fractions.largest_difference(&fine.fractions));
         estimate = change.map_or(f64::INFINITY, |c| c / richardson);
-        let drift_ok = fine.stats.max_energy_drift <= (DRIFT_PER_TOL * tol).max(1e-12);
-        if estimate <= 0.5 * tol
-            && drift_ok
-            && asymptotic(
-                previous_change,
-                change.unwrap_or(f64::INFINITY),
-                (order, f64::from(plan.method.order())),
-                tol,
-            )
-        {
+        let drift_limit = (DRIFT_PER_TOL * tol).max(1e-12);
+        let drift_ok = fine.stats.max_energy_drift <= drift_limit;
+        let regular = asymptotic(
+            previous_change,
+            change.unwrap_or(f64::INFINITY),
+            (order, f64::from(plan.method.order())),
+            tol,
+        );
+        if estimate <= 0.5 * tol && drift_ok && regular {
             return Ok(Outcome {
                 plan: Plan {
                     drift_limit: plan.drift_limit,
@@ -154,6 +155,25 @@ fn verified<O: Observer + ?Sized>(
                 ..fine
             });
         }
+        why = if change.is_none() {
+            "the run at twice the step blew up, so there is no pair to compare".to_string()
+        } else if estimate > 0.5 * tol {
+            format!(
+                "the error estimate {estimate:.2e} is above the half tolerance {:.1e} it must meet",
+                0.5 * tol
+            )
+        } else if !drift_ok {
+            format!(
+                "the energy drifts by {:.2e}, more than the {drift_limit:.1e} the tolerance allows",
+                fine.stats.max_energy_drift
+            )
+        } else {
+            format!(
+                "the error estimate {estimate:.2e} would pass, but the runs are not in their asymptotic regime (the change between runs went from {:.2e} to {:.2e} when the step halved, not by the factor the method's order gives), so the estimate cannot be trusted",
+                previous_change.unwrap_or(f64::NAN),
+                change.unwrap_or(f64::NAN)
+            )
+        };
         previous_change = change;
         coarse = Some(fine);
         dt *= 0.5;
@@ -162,6 +182,7 @@ fn verified<O: Observer + ?Sized>(
         tolerance: tol,
         estimate,
         dt: 2.0 * dt,
+        why,
     })
 }
 

@@ -1,0 +1,220 @@
+//! The audit of `auto`'s promise: random scenes drawn wider than any stage file, each run by
+//! `auto` at several tolerances and compared with an independent reference. A scene is
+//! `ok` (within tolerance plus the reference's own error), `refused` (exit-3 material: `auto`
+//! said it could not verify), or `MISS` (a number presented as verified that is not).
+//!
+//! Scenes: chains with n from 50 to 150 (101 to 301 sites), fixed or free ends; an impulse of
+//! velocity 0.5 to 2 somewhere left of centre; 1 to 5 defects near the centre with eps from 0.05
+//! to 100, kappa from 0.1 to 10, p in {1, 3, 5, 7}, a fifth of them switched on by a tanh ramp;
+//! t_end from 100 to 200.
+//!
+//! Reference: `rk4-contact` at dt = 2.5e-4, checked against `rkn6-contact` at the same step
+//! (a second method of another order and quadrature); their difference is the reference's
+//! error bound, reported per scene.
+//!
+//! ```text
+//! cargo run --release -p woodpile-bench --example auto_audit [-- SCENES [SEED [TOLERANCES]]]
+//! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
+//! ```
+#![allow(clippy::print_stdout, clippy::unwrap_used)]
+
+use woodpile_bench::on_two_cores;
+use woodpile_sim::energy::{Fractions, Region};
+use woodpile_sim::integrate::{Method, MethodChoice};
+use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::testing::{fixed_dt, tolerance, Lcg};
+use woodpile_sim::SimError;
+
+/// The reference step: ten times finer than `auto`'s finest steps at 1e-8 on these chains.
+const REFERENCE_DT: f64 = 2.5e-4;
+
+fn random_scene(rng: &mut Lcg) -> Scenario {
+    let half = 50 + (rng.uniform() * 101.0) as usize;
+    let n_sites = 2 * half + 1;
+    let boundary = if rng.uniform() < 0.5 {
+        Boundary::Fixed
+    } else {
+        Boundary::Free
+    };
+    let count = 1 + (rng.uniform() * 5.0) as usize;
+    let mut resonators: Vec<Resonator> = (0..count)
+        .map(|_| {
+            let site = half - 5 + (rng.uniform() * 26.0) as usize;
+            let p = [1, 3, 5, 7][(rng.uniform() * 4.0) as usize % 4];
+            let kappa = rng.log_uniform(0.1, 10.0);
+            let coupling = if rng.uniform() < 0.2 {
+                Coupling::Ramp {
+                    k1: 0.0,
+                    k2: kappa,
+                    t0: rng.uniform() * 60.0,
+                    tau: rng.log_uniform(0.1, 5.0),
+                }
+            } else {
+                Coupling::Constant(kappa)
+            };
+            Resonator {
+                site,
+                eps: rng.log_uniform(0.05, 100.0),
+                coupling,
+                p,
+            }
+        })
+        .collect();
+    resonators.sort_by_key(|r| r.site);
+    resonators.dedup_by_key(|r| r.site);
+    let lo = resonators[0].site as i64 - 1;
+    let hi = resonators[resonators.len() - 1].site as i64 + 1;
+    let impulse_site = half - 10 - (rng.uniform() * 30.0) as usize;
+    Scenario {
+        model: Model::new(n_sites, boundary, resonators).unwrap(),
+        impulse_site,
+        impulse_velocity: rng.uniform() * 1.5 + 0.5,
+        t_end: 100.0 + rng.uniform() * 100.0,
+        region: Region::new(lo, hi, n_sites).unwrap(),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(1e-8),
+        sample_every: 1.0,
+    }
+}
+
+fn fixed(scene: &Scenario, method: Method) -> Fractions {
+    let s = Scenario {
+        method: MethodChoice::Named(method),
+        accuracy: fixed_dt(REFERENCE_DT),
+        ..scene.clone()
+    };
+    simulate(&s, &mut ()).unwrap().fractions
+}
+
+/// What `auto` did at one tolerance.
+enum Verdict {
+    Ok { error: f64 },
+    Miss { error: f64, estimate: f64 },
+    Refused(String),
+}
+
+struct Audit {
+    line: String,
+    verdicts: Vec<Verdict>,
+    evals: Vec<u64>,
+}
+
+fn audit(k: usize, scene: &Scenario, tolerances: &[f64]) -> Audit {
+    let reference = fixed(scene, Method::Rk4Contact);
+    let reference_error = reference.largest_difference(&fixed(scene, Method::Rkn6Contact));
+    let mut verdicts = Vec::new();
+    let mut evals = Vec::new();
+    let mut cells = Vec::new();
+    for &tol in tolerances {
+        let s = Scenario {
+            accuracy: tolerance(tol),
+            ..scene.clone()
+        };
+        match simulate(&s, &mut ()) {
+            Ok(out) => {
+                let error = out.fractions.largest_difference(&reference);
+                let estimate = out.error_estimate.unwrap_or(f64::NAN);
+                evals.push(out.total_rhs_evals);
+                cells.push(format!("{tol:.0e}: err {error:.1e} est {estimate:.1e}"));
+                if error > tol + reference_error {
+                    verdicts.push(Verdict::Miss { error, estimate });
+                } else {
+                    verdicts.push(Verdict::Ok { error });
+                }
+            }
+            Err(
+                e @ (SimError::NotConverged { .. }
+                | SimError::StepUnderflow { .. }
+                | SimError::TooManySteps { .. }
+                | SimError::OverBudget(_)),
+            ) => {
+                evals.push(0);
+                cells.push(format!("{tol:.0e}: refused"));
+                verdicts.push(Verdict::Refused(e.to_string()));
+            }
+            Err(e) => panic!("scene {k} at {tol:e}: {e}"),
+        }
+    }
+    let m = &scene.model;
+    let resonators: Vec<String> = m
+        .resonators()
+        .iter()
+        .map(|r| {
+            let ramp = matches!(r.coupling, Coupling::Ramp { .. });
+            format!(
+                "eps {:.2} p {}{}",
+                r.eps,
+                r.p,
+                if ramp { " ramp" } else { "" }
+            )
+        })
+        .collect();
+    let flag = if verdicts.iter().any(|v| matches!(v, Verdict::Miss { .. })) {
+        "MISS"
+    } else {
+        "    "
+    };
+    let line = format!(
+        "{k:3} {flag} n {} {:?} v {:.2} t_end {:.0} ref_err {reference_error:.1e} | {} | {}",
+        m.n_sites() / 2,
+        m.boundary(),
+        scene.impulse_velocity,
+        scene.t_end,
+        cells.join("; "),
+        resonators.join(", ")
+    );
+    Audit {
+        line,
+        verdicts,
+        evals,
+    }
+}
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let n: usize = args.next().map_or(200, |s| s.parse().unwrap());
+    let seed: u64 = args.next().map_or(2026, |s| s.parse().unwrap());
+    let tolerances: Vec<f64> = args.next().map_or(vec![1e-5, 1e-6, 1e-7, 1e-8], |s| {
+        s.split(',').map(|t| t.parse().unwrap()).collect()
+    });
+    let mut rng = Lcg(seed);
+    let scenes: Vec<(usize, Scenario)> = (0..n).map(|k| (k, random_scene(&mut rng))).collect();
+    let audits = on_two_cores(&scenes, |(k, scene)| audit(*k, scene, &tolerances));
+    for a in &audits {
+        println!("{}", a.line);
+    }
+    println!();
+    println!("| tolerance | scenes | within | refused | silent misses | worst error / tolerance among the accepted | force evaluations |");
+    println!("|---|---|---|---|---|---|---|");
+    for (i, tol) in tolerances.iter().enumerate() {
+        let (mut ok, mut refused, mut missed, mut worst) = (0, 0, 0, 0.0f64);
+        for a in &audits {
+            match &a.verdicts[i] {
+                Verdict::Ok { error, .. } => {
+                    ok += 1;
+                    worst = worst.max(error / tol);
+                }
+                Verdict::Miss { error, .. } => {
+                    missed += 1;
+                    worst = worst.max(error / tol);
+                }
+                Verdict::Refused(_) => refused += 1,
+            }
+        }
+        let evals: u64 = audits.iter().map(|a| a.evals[i]).sum();
+        println!("| {tol:.0e} | {n} | {ok} | {refused} | {missed} | {worst:.2} | {evals} |");
+    }
+    for (a, (k, _)) in audits.iter().zip(&scenes) {
+        for (v, tol) in a.verdicts.iter().zip(&tolerances) {
+            match v {
+                Verdict::Refused(why) => println!("scene {k} at {tol:.0e} refused: {why}"),
+                Verdict::Miss { error, estimate } => println!(
+                    "scene {k} at {tol:.0e} MISSED: error {error:.2e}, estimate {estimate:.2e} ({:.1}x low)",
+                    error / estimate
+                ),
+                Verdict::Ok { .. } => {}
+            }
+        }
+    }
+}
