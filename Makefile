@@ -6,7 +6,7 @@ SCRATCH := scratch/check
 # Wall times (work-precision stages) belong to the machine that measured them: not compared.
 CHECK_TOL := --abs 1e-9 --rel 1e-9 --tol wall_ms=inf --tol log10_wall_ms=inf
 
-.PHONY: help build install test rust-test python python-test python-bench docs figures stage status check read-check bench work-precision lint slurm-test
+.PHONY: help build install audit test rust-test python python-test python-bench docs figures stage status check read-check bench work-precision lint slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -68,6 +68,9 @@ bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, then
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
 	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py
 	$(CARGO) bench -p woodpile-bench
+
+audit: ## auto against an independent reference on 200 random scenes at 1e-5..1e-8 (about 15 min)
+	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 
 work-precision: ## Error in E_tr against wall time for every method and step (README table)
 	$(CARGO) run --release -p woodpile-sim --example work_precision

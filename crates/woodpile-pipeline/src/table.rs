@@ -43,16 +43,18 @@ impl Columns {
     /// Appends a column of float lists (one list per row: pandas and polars read them as
     /// lists).
     pub fn f64_list(&mut self, name: &str, values: Vec<Vec<f64>>) -> &mut Self {
-        let rows: Vec<Series> = values
-            .into_iter()
-            .map(|v| Series::new(PlSmallStr::EMPTY, v))
-            .collect();
-        self.0.push(Series::new(name.into(), rows).into());
-        self
+        self.list(name, values)
     }
 
     /// Appends a column of integer lists.
     pub fn i64_list(&mut self, name: &str, values: Vec<Vec<i64>>) -> &mut Self {
+        self.list(name, values)
+    }
+
+    fn list<T>(&mut self, name: &str, values: Vec<Vec<T>>) -> &mut Self
+    where
+        Series: NamedFrom<Vec<T>, [T]>,
+    {
         let rows: Vec<Series> = values
             .into_iter()
             .map(|v| Series::new(PlSmallStr::EMPTY, v))

@@ -141,23 +141,10 @@ impl Sweep {
 
     /// The scene table at `values` (a scene file's content), before validation.
     pub fn table_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<toml::Table> {
-        let at = || {
-            let parts: Vec<String> = self
-                .axes
-                .iter()
-                .zip(values)
-                .map(|(a, v)| format!("{} = {v}", a.name))
-                .collect();
-            if parts.is_empty() {
-                String::new()
-            } else {
-                format!(" (at {})", parts.join(", "))
-            }
-        };
         let mut table = self
             .template
             .instantiate(&self.axes, values)
-            .map_err(|(key, reason)| self.error(key, reason + &at()))?;
+            .map_err(|(key, reason)| self.error(key, reason + &self.at(values)))?;
         if let Some(tol) = tolerance {
             let run = table
                 .entry("run")
