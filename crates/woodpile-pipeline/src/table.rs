@@ -59,7 +59,8 @@ impl Columns {
             .into_iter()
             .map(|v| Series::new(PlSmallStr::EMPTY, v))
             .collect();
-        self.0.push(Series::new(name.into(), rows).into());
+        let column = <Series as NamedFrom<Vec<Series>, [Series]>>::new(name.into(), rows);
+        self.0.push(column.into());
         self
     }
 
