@@ -59,7 +59,7 @@ impl Columns {
             .into_iter()
             .map(|v| Series::new(PlSmallStr::EMPTY, v))
             .collect();
-        let column = <Series as NamedFrom<Vec<Series>, [Series]>>::new(name.into(), rows);
+        let column = <Series as NamedFrom<Vec<Series>, ListType>>::new(name.into(), rows);
         self.0.push(column.into());
         self
     }
