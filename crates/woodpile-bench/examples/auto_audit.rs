@@ -19,64 +19,14 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_bench::on_two_cores;
-use woodpile_sim::energy::{Fractions, Region};
+use woodpile_sim::energy::Fractions;
 use woodpile_sim::integrate::{Method, MethodChoice};
-use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+use woodpile_sim::model::Coupling;
 use woodpile_sim::run::{simulate, Scenario};
-use woodpile_sim::testing::{fixed_dt, tolerance, Lcg};
+use woodpile_sim::testing::{
+    audit_scene as random_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT as REFERENCE_DT,
+};
 use woodpile_sim::SimError;
-
-/// The reference step: ten times finer than `auto`'s finest steps at 1e-8 on these chains.
-const REFERENCE_DT: f64 = 2.5e-4;
-
-fn random_scene(rng: &mut Lcg) -> Scenario {
-    let half = 50 + (rng.uniform() * 101.0) as usize;
-    let n_sites = 2 * half + 1;
-    let boundary = if rng.uniform() < 0.5 {
-        Boundary::Fixed
-    } else {
-        Boundary::Free
-    };
-    let count = 1 + (rng.uniform() * 5.0) as usize;
-    let mut resonators: Vec<Resonator> = (0..count)
-        .map(|_| {
-            let site = half - 5 + (rng.uniform() * 26.0) as usize;
-            let p = [1, 3, 5, 7][(rng.uniform() * 4.0) as usize % 4];
-            let kappa = rng.log_uniform(0.1, 10.0);
-            let coupling = if rng.uniform() < 0.2 {
-                Coupling::Ramp {
-                    k1: 0.0,
-                    k2: kappa,
-                    t0: rng.uniform() * 60.0,
-                    tau: rng.log_uniform(0.1, 5.0),
-                }
-            } else {
-                Coupling::Constant(kappa)
-            };
-            Resonator {
-                site,
-                eps: rng.log_uniform(0.05, 100.0),
-                coupling,
-                p,
-            }
-        })
-        .collect();
-    resonators.sort_by_key(|r| r.site);
-    resonators.dedup_by_key(|r| r.site);
-    let lo = resonators[0].site as i64 - 1;
-    let hi = resonators[resonators.len() - 1].site as i64 + 1;
-    let impulse_site = half - 10 - (rng.uniform() * 30.0) as usize;
-    Scenario {
-        model: Model::new(n_sites, boundary, resonators).unwrap(),
-        impulse_site,
-        impulse_velocity: rng.uniform() * 1.5 + 0.5,
-        t_end: 100.0 + rng.uniform() * 100.0,
-        region: Region::new(lo, hi, n_sites).unwrap(),
-        method: MethodChoice::Auto,
-        accuracy: tolerance(1e-8),
-        sample_every: 1.0,
-    }
-}
 
 fn fixed(scene: &Scenario, method: Method) -> Fractions {
     let s = Scenario {

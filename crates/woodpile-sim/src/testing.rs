@@ -190,3 +190,69 @@ pub fn reference_fractions(scenario: &Scenario, dt: f64) -> Result<Fractions, Si
     };
     Ok(simulate(&reference, &mut ())?.fractions)
 }
+
+/// The step of the audit's reference (`rk4-contact`, checked by `rkn6-contact`): ten times
+/// finer than `auto`'s finest steps at 1e-8 on the audit's chains.
+pub const AUDIT_REFERENCE_DT: f64 = 2.5e-4;
+
+/// One scene of `auto`'s audit (`woodpile-bench`'s `auto_audit`), drawn wider than any stage
+/// file: n from 50 to 150, fixed or free ends, an impulse of velocity 0.5 to 2 left of centre,
+/// 1 to 5 defects near the centre (eps 0.05 to 100, kappa 0.1 to 10, p in {1, 3, 5, 7}, a fifth
+/// switched on by a tanh ramp), t_end from 100 to 200; `auto` at tolerance 1e-8.
+pub fn audit_scene(rng: &mut Lcg) -> Scenario {
+    let half = 50 + (rng.uniform() * 101.0) as usize;
+    let n_sites = 2 * half + 1;
+    let boundary = if rng.uniform() < 0.5 {
+        Boundary::Fixed
+    } else {
+        Boundary::Free
+    };
+    let count = 1 + (rng.uniform() * 5.0) as usize;
+    let mut resonators: Vec<Resonator> = (0..count)
+        .map(|_| {
+            let site = half - 5 + (rng.uniform() * 26.0) as usize;
+            let p = [1, 3, 5, 7][(rng.uniform() * 4.0) as usize % 4];
+            let kappa = rng.log_uniform(0.1, 10.0);
+            let coupling = if rng.uniform() < 0.2 {
+                Coupling::Ramp {
+                    k1: 0.0,
+                    k2: kappa,
+                    t0: rng.uniform() * 60.0,
+                    tau: rng.log_uniform(0.1, 5.0),
+                }
+            } else {
+                Coupling::Constant(kappa)
+            };
+            Resonator {
+                site,
+                eps: rng.log_uniform(0.05, 100.0),
+                coupling,
+                p,
+            }
+        })
+        .collect();
+    resonators.sort_by_key(|r| r.site);
+    resonators.dedup_by_key(|r| r.site);
+    let lo = resonators[0].site as i64 - 1;
+    let hi = resonators[resonators.len() - 1].site as i64 + 1;
+    let impulse_site = half - 10 - (rng.uniform() * 30.0) as usize;
+    Scenario {
+        model: Model::new(n_sites, boundary, resonators).expect("a valid audit model"),
+        impulse_site,
+        impulse_velocity: rng.uniform() * 1.5 + 0.5,
+        t_end: 100.0 + rng.uniform() * 100.0,
+        region: Region::new(lo, hi, n_sites).expect("a valid audit region"),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(1e-8),
+        sample_every: 1.0,
+    }
+}
+
+/// Scene `k` of the audit drawn with `seed` (the scenes before it are drawn and dropped).
+pub fn audit_scene_at(seed: u64, k: usize) -> Scenario {
+    let mut rng = Lcg(seed);
+    for _ in 0..k {
+        audit_scene(&mut rng);
+    }
+    audit_scene(&mut rng)
+}
