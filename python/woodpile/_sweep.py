@@ -18,8 +18,9 @@ def sweep(scene: Scene, axes: Mapping[str, Axis], *, series: bool = False) -> pd
 
     The grid is a sweep stage's: ``scene`` holds ``"$name"`` placeholders (and may repeat a
     defect over sites with ``"through": "$L"``), and each axis is a list of numbers (or a
-    NumPy array) or a range ``{"from": 0.1, "to": 10.0, "step": 0.1}`` whose values are
-    rounded to 12 significant digits. Axes vary in name order, the last fastest.
+    NumPy array) or a range, ``{"from": 0.1, "to": 10.0, "step": 0.1}`` or ``{"from": 0.1,
+    "to": 100.0, "count": 31, "log": True}``, whose values are rounded to 12 significant
+    digits. Axes vary in name order, the last fastest.
 
     Args:
         scene: the scene template: a dict, a TOML string or a path.
