@@ -3,11 +3,13 @@
 //! refused or bounded instead of hanging, aborting or writing outside the tree.
 #![allow(clippy::unwrap_used)]
 
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::path::Path;
+
+use common::Project;
 use woodpile_pipeline::events::Silent;
-use woodpile_pipeline::run::{run, RunOptions};
-use woodpile_pipeline::status::{output_path, state, State};
+use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, Pipeline};
 
 const SWEEP: &str = r#"
@@ -53,54 +55,6 @@ agree = 1.0
 as_run = "t = 12"
 ours = { stage = "at_end", column = "E_tr", where = { eps = 1.0 } }
 "#;
-
-struct Project {
-    dir: tempfile::TempDir,
-}
-
-impl Project {
-    fn new(stages: &[(&str, &str)]) -> Project {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::create_dir_all(dir.path().join("pipeline")).unwrap();
-        let p = Project { dir };
-        for (name, text) in stages {
-            p.write(name, text);
-        }
-        p
-    }
-    fn root(&self) -> &Path {
-        self.dir.path()
-    }
-    fn pipeline(&self) -> PathBuf {
-        self.root().join("pipeline")
-    }
-    fn results(&self) -> PathBuf {
-        self.root().join("results")
-    }
-    fn figures(&self) -> PathBuf {
-        self.root().join("figures")
-    }
-    fn write(&self, name: &str, text: &str) {
-        std::fs::write(self.pipeline().join(format!("{name}.toml")), text).unwrap();
-    }
-    fn run(&self, targets: &[&str]) -> woodpile_pipeline::Result<()> {
-        let options = RunOptions {
-            targets: targets.iter().map(|s| s.to_string()).collect(),
-            force: false,
-            dry_run: false,
-            results: self.results(),
-            figures: self.figures(),
-        };
-        run(&Pipeline::load(&self.pipeline())?, &options, &Silent).map(|_| ())
-    }
-    fn state(&self, name: &str) -> State {
-        let p = Pipeline::load(&self.pipeline()).unwrap();
-        state(&p, &self.results(), &self.figures(), p.stage(name).unwrap())
-    }
-    fn output(&self, name: &str) -> PathBuf {
-        output_path(&self.results(), name)
-    }
-}
 
 /// A figure written by a run whose table never followed (killed, or a full disk), after which
 /// the user reverted the stage file: the table's key says fresh, but the figure is the edited

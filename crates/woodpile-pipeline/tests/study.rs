@@ -2,46 +2,12 @@
 //! the best any search found, scene files by reference, variants and log-spaced axes.
 #![allow(clippy::unwrap_used)]
 
-use std::path::{Path, PathBuf};
+mod common;
 
-use woodpile_pipeline::events::Silent;
-use woodpile_pipeline::run::{run, RunOptions};
+use common::Project;
 use woodpile_pipeline::status::{output_path, state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::{table, Pipeline};
-
-struct Project {
-    dir: tempfile::TempDir,
-}
-
-impl Project {
-    fn new(stages: &[(&str, &str)]) -> Project {
-        let dir = tempfile::tempdir().unwrap();
-        std::fs::create_dir_all(dir.path().join("pipeline")).unwrap();
-        for (name, text) in stages {
-            std::fs::write(dir.path().join(format!("pipeline/{name}.toml")), text).unwrap();
-        }
-        Project { dir }
-    }
-    fn root(&self) -> &Path {
-        self.dir.path()
-    }
-    fn results(&self) -> PathBuf {
-        self.root().join("results")
-    }
-    fn run_with(&self, sets: &[Set], targets: &[&str]) -> Pipeline {
-        let pipeline = Pipeline::load_with(&self.root().join("pipeline"), sets).unwrap();
-        let options = RunOptions {
-            targets: targets.iter().map(|s| s.to_string()).collect(),
-            force: false,
-            dry_run: false,
-            results: self.results(),
-            figures: self.root().join("figures"),
-        };
-        run(&pipeline, &options, &Silent).unwrap();
-        pipeline
-    }
-}
 
 const DESIGN: &str = r#"
 kind = "design"
@@ -67,7 +33,7 @@ kappa = { min = 0.5, max = 2.0 }
 #[test]
 fn a_design_at_fixed_sites_writes_the_best_design_any_search_found() {
     let p = Project::new(&[("trap", DESIGN)]);
-    p.run_with(&[], &[]);
+    p.run_with(&[], &[]).unwrap();
     let (frame, manifest) = table::read_with_manifest(&output_path(&p.results(), "trap")).unwrap();
     let search = table::str_column(&frame, "search").unwrap();
     // Sites and eps are list columns: one list per design.
@@ -130,7 +96,7 @@ eps = "$eps"
     std::fs::create_dir_all(p.root().join("scenes")).unwrap();
     let base = "[chain]\nn = 10\n[impulse]\nsite = -5\n[[defect]]\nsite = 3\neps = 1.0\n[run]\nt_end = 10.0\nmethod = \"rk4\"\ndt = 0.02\n";
     std::fs::write(p.root().join("scenes/base.toml"), base).unwrap();
-    let pipeline = p.run_with(&[], &[]);
+    let pipeline = p.run_with(&[], &[]).unwrap();
     let table = table::read(&output_path(&p.results(), "at_end")).unwrap();
     let eps = table::f64_column(&table, "eps").unwrap();
     assert_eq!(
@@ -169,7 +135,7 @@ eps = "$eps"
     let set = Set::parse("at_end.at=6.0").unwrap();
     let name = woodpile_pipeline::variant::variant_name("at_end", std::slice::from_ref(&set));
     assert_eq!(name, "at_end--at-6_0");
-    p.run_with(std::slice::from_ref(&set), &[&name]);
+    p.run_with(std::slice::from_ref(&set), &[&name]).unwrap();
     let variant = table::read(&output_path(&p.results(), &name)).unwrap();
     assert!(table::f64_column(&variant, "t")
         .unwrap()
@@ -209,7 +175,7 @@ bounds = { eps = [0.5, 3.0] }
 starts = 2
 "#;
     let p = Project::new(&[("sweep", sweep), ("at_end", reduce), ("best", optimize)]);
-    p.run_with(&[], &[]);
+    p.run_with(&[], &[]).unwrap();
     let (frame, manifest) = table::read_with_manifest(&output_path(&p.results(), "best")).unwrap();
     assert_eq!(frame.height(), 4);
     for column in [
