@@ -87,13 +87,9 @@ pub(crate) fn simulate<'py>(
 
 /// Paper sites `(lo, hi)` as internal indices, or a `SceneError` naming the chain's range.
 fn internal_sites(scene: &Scene, (lo, hi): (i64, i64)) -> PyResult<(usize, usize)> {
-    let (first, last) = (scene.first_site, scene.last_site);
-    if lo > hi || lo < first || hi > last {
-        return Err(SceneError::new_err(format!(
-            "field_sites ({lo}, {hi}): need {first} <= lo <= hi <= {last} (the chain's paper sites)"
-        )));
-    }
-    Ok(((lo - first) as usize, (hi - first) as usize))
+    scene
+        .site_range(lo, hi)
+        .map_err(|reason| SceneError::new_err(format!("field_sites ({lo}, {hi}): {reason}")))
 }
 
 fn add_field(

@@ -12,16 +12,12 @@ use rayon::prelude::*;
 use woodpile_scene::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::intervals;
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::run::{simulate, Outcome};
 
 use crate::interrupt::{internal_message, interruptible, Watch};
 use crate::scene_input::{self, shown, Source};
 use crate::SceneError;
-
-/// The most memory a sweep's series may take, as for a sweep stage.
-const MAX_SWEEP_BYTES: f64 = 4e9;
 
 /// One simulated point: its outcome and, when asked for, its series.
 struct Point {
@@ -67,17 +63,8 @@ pub(crate) fn sweep<'py>(
     grid.scene_at(0).map_err(SceneError::new_err)?;
     let last = grid.scene_at(count - 1).map_err(SceneError::new_err)?;
     if series {
-        let s = &last.scenario;
-        let samples = intervals(s.t_end, s.sample_every) + 1;
-        let bytes = count as f64 * (1400.0 + (samples * 5 * 8 * 2) as f64);
-        if bytes > MAX_SWEEP_BYTES {
-            return Err(SceneError::new_err(format!(
-                "{}: {count} points of {samples} samples would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
-                grid.label,
-                bytes / 1e9,
-                MAX_SWEEP_BYTES / 1e9
-            )));
-        }
+        woodpile_scene::grid::check_sweep_memory(count, &last)
+            .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
     }
     let points: Vec<Result<Point, String>> = interruptible(py, |cancel| {
         (0..count)

@@ -95,12 +95,9 @@ fn field_sites(scene: &Scene, spec: Option<&str>) -> anyhow::Result<(usize, usiz
             "--sites `{spec}`: expected LO,HI (two paper site numbers)"
         ));
     };
-    if lo > hi || lo < first || hi > last {
-        return Err(anyhow!(
-            "--sites {lo},{hi}: need {first} <= LO <= HI <= {last} (the chain's paper sites)"
-        ));
-    }
-    Ok(((lo - first) as usize, (hi - first) as usize))
+    scene
+        .site_range(lo, hi)
+        .map_err(|reason| anyhow!("--sites {lo},{hi}: {reason}"))
 }
 
 /// A table's manifest: what was simulated (the resolved scene, which the key hashes) and what

@@ -15,7 +15,7 @@ use crate::kind::Inputs;
 use crate::report::Report;
 use crate::stage::Stage;
 use crate::sweep::Sweep;
-pub use crate::variant::Set;
+use crate::variant::Set;
 
 /// A loaded, validated pipeline.
 #[derive(Debug, Clone)]

@@ -62,6 +62,27 @@ impl Axis {
 /// in `step`). The pipeline's sweep also bounds the memory of the series themselves.
 pub const MAX_POINTS: usize = 1_000_000;
 
+/// Most memory a sweep may need for its points: their planned scenes and their series.
+pub const MAX_SWEEP_BYTES: f64 = 4e9;
+
+/// Refuses, before anything runs, a sweep of `points` scenes like `scene` (its largest) that
+/// would hold more than [`MAX_SWEEP_BYTES`]: each point's planned scene (measured at about
+/// 1.4 KB on the paper's chain) and its series (five numbers a sample, in the point and again
+/// in the output table). The error is the reason.
+pub fn check_sweep_memory(points: usize, scene: &crate::Scene) -> Result<(), String> {
+    let s = &scene.scenario;
+    let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1;
+    let bytes = points as f64 * (1400.0 + (samples * 5 * 8 * 2) as f64);
+    if bytes > MAX_SWEEP_BYTES {
+        return Err(format!(
+            "{points} points of {samples} samples would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
+            bytes / 1e9,
+            MAX_SWEEP_BYTES / 1e9
+        ));
+    }
+    Ok(())
+}
+
 /// Column names an axis may not take (the sweep's own output columns).
 pub const RESERVED: &[&str] = &[
     "point",

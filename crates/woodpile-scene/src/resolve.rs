@@ -41,6 +41,20 @@ pub struct Scene {
     pub physical: Option<Physical>,
 }
 
+impl Scene {
+    /// The internal indices of the paper sites `lo..=hi`, or why they are not a range of the
+    /// chain's sites.
+    pub fn site_range(&self, lo: i64, hi: i64) -> Result<(usize, usize), String> {
+        let (first, last) = (self.first_site, self.last_site);
+        if lo > hi || lo < first || hi > last {
+            return Err(format!(
+                "need {first} <= lo <= hi <= {last} (the chain's paper sites)"
+            ));
+        }
+        Ok(((lo - first) as usize, (hi - first) as usize))
+    }
+}
+
 /// What a physical scene derived from its SI parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Physical {

@@ -85,19 +85,8 @@ impl Sweep {
         // the grid exercise the extremes of every axis.
         sweep.scene_at(0)?;
         let last = sweep.scene_at(sweep.count() - 1)?;
-        let bytes = sweep.count() as f64 * point_bytes(&last);
-        if bytes > MAX_SWEEP_BYTES {
-            return Err(fields.error(
-                "axes",
-                format!(
-                "{} points of {} samples would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
-                sweep.count(),
-                samples(&last),
-                bytes / 1e9,
-                MAX_SWEEP_BYTES / 1e9
-            ),
-            ));
-        }
+        woodpile_scene::grid::check_sweep_memory(sweep.count(), &last)
+            .map_err(|reason| fields.error("axes", reason))?;
         Ok(sweep)
     }
 
@@ -311,22 +300,6 @@ impl Sweep {
             "max_energy_drift": stats.max_energy_drift,
         }))
     }
-}
-
-/// Most memory a sweep's run may need for its points (planned scenes and their series).
-const MAX_SWEEP_BYTES: f64 = 4e9;
-
-/// Samples a point of `scene` records.
-fn samples(scene: &Scene) -> u64 {
-    let s = &scene.scenario;
-    woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1
-}
-
-/// What one point of a sweep like `scene` holds in memory during a run: its planned scene
-/// (measured at about 1.4 KB on the paper's chain) and its series (five numbers a sample,
-/// in the point and again in the output table).
-fn point_bytes(scene: &Scene) -> f64 {
-    1400.0 + (samples(scene) * 5 * 8 * 2) as f64
 }
 
 /// Facts about a set of simulated points that combine exactly across shards (counts, sums of
