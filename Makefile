@@ -34,7 +34,7 @@ python-bench: python ## woodpile.simulate and woodpile.sweep against the Rust ca
 	$(PY) python/benches/bench.py
 
 docs: ## Regenerate docs/stage-kinds.md and the README's accuracy captions
-	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-pipeline -p woodpile-cli --test docs
+	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-stages -p woodpile-cli --test docs
 
 test: rust-test python-test ## Run the whole test suite: Rust, then Python (what CI runs)
 

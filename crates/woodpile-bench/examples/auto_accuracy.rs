@@ -1,6 +1,6 @@
 //! `method = "auto"` against a tight reference, on one scene of each of the paper's kinds or,
 //! with `--survey N`, on N scenes of each sweep kind drawn from the stage files' grids
-//! (`woodpile_pipeline::sampling`, run from the repository's root): the step auto accepted, its Richardson estimate, the true error
+//! (`woodpile_stages::sampling`, run from the repository's root): the step auto accepted, its Richardson estimate, the true error
 //! (largest over R, T and E_tr), whether it met the tolerance, the force evaluations of the whole
 //! verification ladder, and the wall time. The reference is `rk4-contact` at dt = 0.001
 //! (0.00025 for nonlinear resonators), which agrees with RK4 at 0.001 and Yoshida-6 at 5e-4 to
@@ -13,7 +13,6 @@
 
 use std::time::Instant;
 use woodpile_bench::on_two_cores;
-use woodpile_pipeline::sampling::sampled_sweep_scenes;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::run::simulate;
@@ -21,6 +20,8 @@ use woodpile_sim::run::Scenario;
 use woodpile_sim::testing::{
     paper_scene, reference_dt, reference_fractions, tolerance, PaperDefect,
 };
+use woodpile_stages::sampling::sampled_sweep_scenes;
+use woodpile_stages::KINDS;
 
 fn hand_picked() -> Vec<(String, Scenario)> {
     let pd = |site, eps, p| PaperDefect {
@@ -117,7 +118,9 @@ fn main() {
         tols.push(1e-6);
     }
     let scenes = match survey {
-        Some(n) => sampled_sweep_scenes(&Pipeline::load("pipeline".as_ref()).unwrap(), n).unwrap(),
+        Some(n) => {
+            sampled_sweep_scenes(&Pipeline::load("pipeline".as_ref(), KINDS).unwrap(), n).unwrap()
+        }
         None => hand_picked(),
     };
     let results: Vec<Vec<Verdict>> =

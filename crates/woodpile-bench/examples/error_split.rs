@@ -17,7 +17,6 @@
 
 use std::time::Instant;
 use woodpile_bench::{on_two_cores, standard_scene};
-use woodpile_pipeline::sampling::sampled_sweep_scenes;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{
@@ -26,6 +25,8 @@ use woodpile_sim::integrate::{
 };
 use woodpile_sim::run::{simulate, Scenario};
 use woodpile_sim::testing::{fitted_order, fixed_dt, tolerance};
+use woodpile_stages::sampling::sampled_sweep_scenes;
+use woodpile_stages::KINDS;
 
 const STEPS: [f64; 6] = [0.2, 0.1, 0.07, 0.05, 0.025, 0.0125];
 
@@ -191,7 +192,7 @@ fn main() {
         "standard".into(),
         standard_scene(MethodChoice::Auto, tolerance(1e-6)),
     )];
-    let pipeline = Pipeline::load("pipeline".as_ref()).unwrap();
+    let pipeline = Pipeline::load("pipeline".as_ref(), KINDS).unwrap();
     scenes.extend(
         sampled_sweep_scenes(&pipeline, per_sweep)
             .unwrap()

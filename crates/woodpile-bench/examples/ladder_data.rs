@@ -1,5 +1,5 @@
 //! Raw data for designing `auto`'s verification ladder: the fractions of sampled sweep scenes
-//! (`woodpile_pipeline::sampling`, run from the repository's root) at a geometric ladder of fixed steps (ratio 0.85) for
+//! (`woodpile_stages::sampling`, run from the repository's root) at a geometric ladder of fixed steps (ratio 0.85) for
 //! `rk4-contact` and `rkn4-contact`, with the reference (`rk4-contact` at dt = 0.001). CSV on
 //! stdout, the label quoted.
 //!
@@ -9,12 +9,13 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_bench::on_two_cores;
-use woodpile_pipeline::sampling::sampled_sweep_scenes;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::run::simulate;
 use woodpile_sim::run::Scenario;
 use woodpile_sim::testing::fixed_dt;
+use woodpile_stages::sampling::sampled_sweep_scenes;
+use woodpile_stages::KINDS;
 
 fn scene_rows(i: usize, label: &str, scenario: &Scenario) -> Vec<String> {
     let nonlinear = scenario.model.resonators().iter().any(|r| r.p > 1);
@@ -54,7 +55,7 @@ fn scene_rows(i: usize, label: &str, scenario: &Scenario) -> Vec<String> {
 
 fn main() {
     let per_kind = std::env::args().nth(1).map_or(10, |s| s.parse().unwrap());
-    let pipeline = Pipeline::load("pipeline".as_ref()).unwrap();
+    let pipeline = Pipeline::load("pipeline".as_ref(), KINDS).unwrap();
     let scenes = sampled_sweep_scenes(&pipeline, per_kind).unwrap();
     println!("scene,label,method,dt,R,T,E_tr,evals");
     let indexed: Vec<(usize, &(String, Scenario))> = scenes.iter().enumerate().collect();

@@ -8,14 +8,15 @@
 use std::io::Write;
 use std::process::{Command, Stdio};
 use std::time::Instant;
+use woodpile_stages::KINDS;
 
 use serde_json::{json, Value};
-use woodpile_pipeline::sampling::sampled_scenes;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::Fractions;
 use woodpile_sim::model::{Boundary, Coupling};
 use woodpile_sim::run::{simulate, Scenario};
 use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance};
+use woodpile_stages::sampling::sampled_scenes;
 
 /// The sweeps the sample is drawn from, with their labels.
 pub const PAPER_SWEEPS: &[(&str, &str)] = &[
@@ -56,7 +57,7 @@ pub fn paper_sample(
     per_sweep: usize,
     seed: u64,
 ) -> Result<Vec<(String, Scenario)>, String> {
-    let pipeline = Pipeline::load(pipeline_dir.as_ref()).map_err(|e| e.to_string())?;
+    let pipeline = Pipeline::load(pipeline_dir.as_ref(), KINDS).map_err(|e| e.to_string())?;
     sampled_scenes(&pipeline, PAPER_SWEEPS, per_sweep, seed).map_err(|e| e.to_string())
 }
 

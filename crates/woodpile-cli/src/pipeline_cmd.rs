@@ -1,13 +1,14 @@
 //! `woodpile run`, `woodpile status` and `woodpile diff`: the figure pipeline's commands.
 
 use std::path::PathBuf;
+use woodpile_stages::KINDS;
 
 use woodpile_pipeline::atomic;
 use woodpile_pipeline::diff::{diff, DiffOptions, DiffReport, Tolerance};
+use woodpile_pipeline::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::shard::{merge, run_shard, Shard};
 use woodpile_pipeline::slurm::SlurmJob;
-use woodpile_pipeline::status::output_path;
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::{variant_name, Set};
 use woodpile_pipeline::{Pipeline, PipelineError};
@@ -166,7 +167,7 @@ fn load_with(at: &Locations, sets: &[Set]) -> Result<(Pipeline, Dirs), Failure> 
             )));
         }
     }
-    let pipeline = Pipeline::load_with(&dirs.pipeline, sets).map_err(Failure::input)?;
+    let pipeline = Pipeline::load_with(&dirs.pipeline, KINDS, sets).map_err(Failure::input)?;
     Ok((pipeline, dirs))
 }
 
@@ -310,14 +311,14 @@ pub(crate) fn merge_command(args: &MergeArgs) -> Result<(), Failure> {
 pub(crate) fn slurm_command(args: &SlurmArgs) -> Result<(), Failure> {
     let (pipeline, dirs) = load(&args.at)?;
     let stage = pipeline.stage(&args.stage).map_err(Failure::input)?;
-    let Some(axes) = pipeline.sweep_axes(&stage.name) else {
+    let Some(grid) = stage.spec.points() else {
         return Err(Failure::input(anyhow::anyhow!(
             "`{}` is a {} stage: only sweeps are sharded",
             stage.name,
             stage.kind
         )));
     };
-    let points = woodpile_pipeline::grid::point_count(axes);
+    let points = grid.count();
     if args.tasks == 0 || args.cpus == 0 {
         return Err(Failure::input(anyhow::anyhow!(
             "--tasks and --cpus must be at least 1"

@@ -7,7 +7,7 @@ use std::path::Path;
 use crate::error::PipelineError;
 
 /// The keys of one TOML table not yet consumed.
-pub(crate) struct Fields<'a> {
+pub struct Fields<'a> {
     file: &'a Path,
     prefix: String,
     table: toml::Table,
@@ -15,7 +15,7 @@ pub(crate) struct Fields<'a> {
 
 impl<'a> Fields<'a> {
     /// `table`, found at dotted path `prefix` ("" for the file's top level) of `file`.
-    pub(crate) fn new(file: &'a Path, prefix: &str, table: toml::Table) -> Self {
+    pub fn new(file: &'a Path, prefix: &str, table: toml::Table) -> Self {
         Self {
             file,
             prefix: prefix.to_string(),
@@ -24,7 +24,7 @@ impl<'a> Fields<'a> {
     }
 
     /// The dotted path of `key` in this table.
-    pub(crate) fn path(&self, key: &str) -> String {
+    pub fn path(&self, key: &str) -> String {
         if self.prefix.is_empty() {
             key.to_string()
         } else {
@@ -33,7 +33,7 @@ impl<'a> Fields<'a> {
     }
 
     /// An error about `key` of this table.
-    pub(crate) fn error(&self, key: &str, reason: impl Into<String>) -> PipelineError {
+    pub fn error(&self, key: &str, reason: impl Into<String>) -> PipelineError {
         PipelineError::Definition {
             file: self.file.to_path_buf(),
             key: self.path(key),
@@ -43,7 +43,7 @@ impl<'a> Fields<'a> {
     }
 
     /// An error about this table as a whole.
-    pub(crate) fn error_here(&self, reason: impl Into<String>) -> PipelineError {
+    pub fn error_here(&self, reason: impl Into<String>) -> PipelineError {
         PipelineError::Definition {
             file: self.file.to_path_buf(),
             key: self.prefix.clone(),
@@ -53,33 +53,33 @@ impl<'a> Fields<'a> {
     }
 
     /// `table`, found at `key` of this table, as its own [`Fields`].
-    pub(crate) fn nested(&self, key: &str, table: toml::Table) -> Fields<'a> {
+    pub fn nested(&self, key: &str, table: toml::Table) -> Fields<'a> {
         Fields::new(self.file, &self.path(key), table)
     }
 
     /// The keys not yet consumed, sorted.
-    pub(crate) fn keys(&self) -> Vec<String> {
+    pub fn keys(&self) -> Vec<String> {
         self.table.keys().cloned().collect()
     }
 
     /// The file these fields come from.
-    pub(crate) fn file(&self) -> &'a Path {
+    pub fn file(&self) -> &'a Path {
         self.file
     }
 
     /// Removes and returns `key`'s raw value.
-    pub(crate) fn take(&mut self, key: &str) -> Option<toml::Value> {
+    pub fn take(&mut self, key: &str) -> Option<toml::Value> {
         self.table.remove(key)
     }
 
     /// A required value of type `T`.
-    pub(crate) fn required<T: FromToml>(&mut self, key: &str) -> Result<T, PipelineError> {
+    pub fn required<T: FromToml>(&mut self, key: &str) -> Result<T, PipelineError> {
         self.optional(key)?
             .ok_or_else(|| self.error(key, format!("missing (expected {})", T::EXPECTED)))
     }
 
     /// An optional value of type `T`.
-    pub(crate) fn optional<T: FromToml>(&mut self, key: &str) -> Result<Option<T>, PipelineError> {
+    pub fn optional<T: FromToml>(&mut self, key: &str) -> Result<Option<T>, PipelineError> {
         match self.table.remove(key) {
             None => Ok(None),
             Some(value) => T::from_toml(value)
@@ -89,10 +89,7 @@ impl<'a> Fields<'a> {
     }
 
     /// An optional `key = { column = value, ... }` row filter (numeric equality).
-    pub(crate) fn equality_filter(
-        &mut self,
-        key: &str,
-    ) -> Result<Vec<(String, f64)>, PipelineError> {
+    pub fn equality_filter(&mut self, key: &str) -> Result<Vec<(String, f64)>, PipelineError> {
         let Some(table) = self.optional::<toml::Table>(key)? else {
             return Ok(Vec::new());
         };
@@ -105,7 +102,7 @@ impl<'a> Fields<'a> {
 
     /// `key = [{ ... }, ...]`: each table as its own [`Fields`] (keys `key[i].…`), none when
     /// the key is absent; anything else is an error saying what was `expected`.
-    pub(crate) fn table_array(
+    pub fn table_array(
         &mut self,
         key: &str,
         expected: &str,
@@ -130,7 +127,7 @@ impl<'a> Fields<'a> {
     }
 
     /// Rejects every key left unconsumed.
-    pub(crate) fn finish(self) -> Result<(), PipelineError> {
+    pub fn finish(self) -> Result<(), PipelineError> {
         match self.table.keys().next() {
             None => Ok(()),
             Some(key) => Err(self.error(key, "unknown key")),
@@ -139,7 +136,7 @@ impl<'a> Fields<'a> {
 }
 
 /// A Rust type a TOML value converts to.
-pub(crate) trait FromToml: Sized {
+pub trait FromToml: Sized {
     /// What the error says was expected.
     const EXPECTED: &'static str;
     /// The conversion, or `None` for a value of the wrong type.

@@ -8,7 +8,7 @@ use crate::error::PipelineError;
 use crate::fields::Fields;
 
 /// Parses the `[axes]` table.
-pub(crate) fn parse_axes(mut fields: Fields<'_>) -> Result<Vec<Axis>, PipelineError> {
+pub fn parse_axes(mut fields: Fields<'_>) -> Result<Vec<Axis>, PipelineError> {
     let mut table = toml::Table::new();
     for key in fields.keys() {
         if let Some(value) = fields.take(&key) {

@@ -1,7 +1,6 @@
-//! What a stage kind is: the [`Kind`] trait every kind implements, and [`KINDS`], the one list
-//! of them. A new kind is one module (its parameters, `parse`, and `impl Kind`) plus one line
-//! in [`KINDS`]: parsing, the unknown-kind error, the DAG's input checks, running, freshness
-//! and the generated reference (`docs/stage-kinds.md`) all go through these two.
+//! What a stage kind is to the engine: the [`Kind`] trait, and the [`Registry`] of kinds a
+//! pipeline is loaded with. The engine names no kind: parsing, the unknown-kind error, the
+//! DAG's input checks, running, freshness, dry-run counts and shards all go through these.
 
 use std::any::Any;
 use std::collections::BTreeMap;
@@ -13,11 +12,11 @@ use polars::prelude::DataFrame;
 use crate::error::Result;
 use crate::events::Events;
 use crate::fields::Fields;
+use crate::layout::output_path;
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
-use crate::points::PointStore;
+use crate::points::{PointStats, PointStore};
 use crate::stage::Stage;
-use crate::status::output_path;
 use crate::{table, Output};
 
 /// A stage kind: its parameters, and what it does with them.
@@ -34,10 +33,45 @@ pub trait Kind: std::fmt::Debug + Send + Sync + Any {
         Vec::new()
     }
 
+    /// Files under the project that the stage alone may write, as (key, path relative to the
+    /// project): loading refuses two stages that claim the same one.
+    fn claims(&self) -> Vec<(&'static str, String)> {
+        Vec::new()
+    }
+
     /// How the stage shares the machine with the other stages of a run ([`Sharing`]).
     fn sharing(&self) -> Sharing {
         Sharing::Shared
     }
+
+    /// The stage as a grid of independent points, if it is one: what a dry run counts and what
+    /// `--shard` splits across machines.
+    fn points(&self) -> Option<&dyn PointGrid> {
+        None
+    }
+}
+
+/// A kind whose table is a block of rows per point of a grid, each point computed on its own
+/// and cached in the [`PointStore`].
+pub trait PointGrid {
+    /// How many points.
+    fn count(&self) -> usize;
+
+    /// How many of them `store` already holds.
+    fn cached(&self, store: &PointStore) -> Result<usize>;
+
+    /// Computes what `store` lacks among the points `indices` (increasing) and returns their
+    /// rows (with a `point` column) and statistics: the whole table, or one shard's part.
+    fn run_points(
+        &self,
+        stage: &str,
+        store: &PointStore,
+        events: &dyn Events,
+        indices: &[usize],
+    ) -> Result<(DataFrame, PointStats)>;
+
+    /// The manifest summary of the whole grid, given the statistics of all its points.
+    fn summary(&self, stats: &PointStats) -> Result<serde_json::Value>;
 }
 
 /// How a stage shares the machine with the other stages a run has ready at the same time.
@@ -57,46 +91,12 @@ pub enum Sharing {
 pub type KindCheck = std::result::Result<(), (String, String)>;
 
 /// Parses a kind's keys; `inputs` are the stage's inputs.
-pub(crate) type Parse = fn(&mut Fields<'_>, &[String]) -> Result<Arc<dyn Kind>>;
+pub type Parse = fn(&mut Fields<'_>, &[String]) -> Result<Arc<dyn Kind>>;
 
-/// Every kind, in pipeline order: its name in stage files, and its parser. Each kind is
-/// documented by its module (`src/kinds/<name>.rs`), from which `docs/stage-kinds.md` is generated.
-pub(crate) const KINDS: &[(&str, Parse)] = &[
-    ("sweep", |f, _| Ok(Arc::new(crate::sweep::Sweep::parse(f)?))),
-    ("spacetime", |f, _| {
-        Ok(Arc::new(crate::spacetime::SpaceTime::parse(f)?))
-    }),
-    ("reduce", |f, _| {
-        Ok(Arc::new(crate::reduce::Reduce::parse(f)?))
-    }),
-    ("optimize", |f, _| {
-        Ok(Arc::new(crate::optimize::Optimize::parse(f)?))
-    }),
-    ("fit", |f, _| Ok(Arc::new(crate::fit::FitStage::parse(f)?))),
-    ("approximate", |f, _| {
-        Ok(Arc::new(crate::approximate::Approximate::parse(f)?))
-    }),
-    ("render", |f, i| {
-        Ok(Arc::new(crate::render::Render::parse(f, i)?))
-    }),
-    ("report", |f, _| {
-        Ok(Arc::new(crate::report::Report::parse(f)?))
-    }),
-    ("workprecision", |f, _| {
-        Ok(Arc::new(crate::workprecision::WorkPrecision::parse(f)?))
-    }),
-    ("stability", |f, _| {
-        Ok(Arc::new(crate::stability::Stability::parse(f)?))
-    }),
-    ("design", |f, _| {
-        Ok(Arc::new(crate::design::Design::parse(f)?))
-    }),
-];
-
-/// The name of every kind, in pipeline order.
-pub fn names() -> impl Iterator<Item = &'static str> {
-    KINDS.iter().map(|(name, _)| *name)
-}
+/// The kinds a pipeline may use, in pipeline order: each one's name in stage files and its
+/// parser. The engine is given one ([`crate::Pipeline::load`]); `woodpile_stages::KINDS` is
+/// the paper's.
+pub type Registry = [(&'static str, Parse)];
 
 /// The other stages of a pipeline, as a stage's input check sees them.
 pub struct Inputs<'a> {
@@ -135,8 +135,8 @@ pub fn no_inputs(stage: &Stage) -> KindCheck {
 pub struct Context<'a> {
     /// The stage.
     pub stage: &'a Stage,
-    /// The pipeline it belongs to.
-    pub pipeline: &'a Pipeline,
+    /// The pipeline it belongs to (reached through [`Context::upstream`]).
+    pub(crate) pipeline: &'a Pipeline,
     /// The results tree.
     pub results: &'a Path,
     /// Where figures go.
@@ -151,6 +151,24 @@ impl Context<'_> {
     /// The stage's name.
     pub fn name(&self) -> &str {
         &self.stage.name
+    }
+
+    /// The definition of stage `name`, which must be upstream of this one (an input, or an
+    /// input's input): a stage reads the parameters of what it depends on, nothing else.
+    pub fn upstream(&self, name: &str) -> Result<&Stage> {
+        let upstream = self
+            .pipeline
+            .selection(std::slice::from_ref(&self.stage.name))?;
+        match upstream
+            .into_iter()
+            .find(|s| s.name == name && s.name != self.stage.name)
+        {
+            Some(stage) => Ok(stage),
+            None => Err(crate::error::PipelineError::stage(
+                &self.stage.name,
+                format!("`{name}` is not upstream of this stage"),
+            )),
+        }
     }
 
     /// The table of input `name`, checked against its seal.

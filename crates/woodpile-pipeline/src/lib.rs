@@ -26,18 +26,16 @@ pub mod canonical;
 pub mod diff;
 pub mod error;
 pub mod events;
-mod fields;
+pub mod fields;
 pub mod grid;
 pub mod kind;
-pub mod kinds;
+pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod pipeline;
 pub mod points;
 pub mod regular;
 pub mod run;
-#[cfg(feature = "testing")]
-pub mod sampling;
 pub mod sealed_files;
 pub mod shard;
 pub mod slurm;
@@ -47,10 +45,6 @@ pub mod table;
 pub mod variant;
 
 pub use error::{PipelineError, Result};
-pub use kinds::{
-    approximate, design, fit, optimize, reduce, render, report, spacetime, stability, sweep,
-    workprecision,
-};
 pub use pipeline::Pipeline;
 pub use woodpile_scene::template;
 

@@ -10,10 +10,11 @@
 
 use std::fs::{self, File, OpenOptions, TryLockError};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
+use crate::layout::lock_path;
 use crate::regular;
 
 /// The lock file's name inside the results tree.
@@ -88,11 +89,6 @@ pub fn lock_results(results: &Path, events: &dyn Events) -> Result<ResultsLock> 
             .and_then(|()| write!(file, "pid {}", std::process::id()));
     }
     Ok(ResultsLock { _file: Some(file) })
-}
-
-/// Where the lock of `results` lives.
-pub fn lock_path(results: &Path) -> PathBuf {
-    results.join(LOCK_FILE)
 }
 
 #[cfg(test)]

@@ -10,11 +10,8 @@ use serde_json::json;
 
 use crate::canonical::{code_version, Key};
 use crate::error::{PipelineError, Result};
-use crate::grid::Axis;
-use crate::kind::Inputs;
-use crate::report::Report;
+use crate::kind::{Inputs, Registry};
 use crate::stage::Stage;
-use crate::sweep::Sweep;
 use crate::variant::Set;
 
 /// A loaded, validated pipeline.
@@ -30,14 +27,16 @@ pub struct Pipeline {
 impl Pipeline {
     /// Loads every stage file in `dir` and its subdirectories (one folder per figure, say):
     /// a stage is named by its file's stem, wherever it lies, so names must be unique.
-    pub fn load(dir: &Path) -> Result<Pipeline> {
-        Pipeline::load_with(dir, &[])
+    /// The kinds a stage may name are `kinds` (`woodpile_stages::KINDS`): the engine itself
+    /// knows none.
+    pub fn load(dir: &Path, kinds: &'static Registry) -> Result<Pipeline> {
+        Pipeline::load_with(dir, kinds, &[])
     }
 
     /// [`Pipeline::load`], plus a variant of a stage for each stage named in `sets`: its file
     /// with those keys set, named `<stage>--<key>-<value>` ([`Set::variant_name`]), so that it
     /// has its own key and its own output beside the original's.
-    pub fn load_with(dir: &Path, sets: &[Set]) -> Result<Pipeline> {
+    pub fn load_with(dir: &Path, kinds: &'static Registry, sets: &[Set]) -> Result<Pipeline> {
         if !dir.is_dir() {
             return Err(PipelineError::io(
                 dir,
@@ -50,9 +49,9 @@ impl Pipeline {
         files.sort();
         let mut stages = files
             .iter()
-            .map(|f| Stage::load(f, &root))
+            .map(|f| Stage::load(f, &root, kinds))
             .collect::<Result<Vec<_>>>()?;
-        stages.extend(crate::variant::variants(&stages, sets, &root)?);
+        stages.extend(crate::variant::variants(&stages, sets, &root, kinds)?);
         let mut seen: HashMap<&str, &Path> = HashMap::new();
         for stage in &stages {
             if let Some(other) = seen.insert(&stage.name, &stage.file) {
@@ -80,7 +79,7 @@ impl Pipeline {
         for stage in &stages {
             check_kinds(stage, &by_name)?;
         }
-        check_markdown_distinct(&stages)?;
+        check_claims_distinct(&stages)?;
         let mut stages: Vec<Option<Stage>> = stages.into_iter().map(Some).collect();
         let stages: Vec<Stage> = order.into_iter().filter_map(|i| stages[i].take()).collect();
         let index: HashMap<String, usize> = stages
@@ -139,16 +138,6 @@ impl Pipeline {
     /// The current cache key of `name` (which must exist).
     pub fn key(&self, name: &str) -> &Key {
         &self.keys[self.index[name]]
-    }
-
-    /// The sweep definition of stage `name`, if it is one.
-    pub fn sweep(&self, name: &str) -> Option<&Sweep> {
-        self.stages[*self.index.get(name)?].get::<Sweep>()
-    }
-
-    /// The grid axes of sweep `name`, if it is one.
-    pub fn sweep_axes(&self, name: &str) -> Option<&[Axis]> {
-        Some(&self.sweep(name)?.axes)
     }
 
     /// `targets` and everything upstream of them, upstream first; every stage if `targets` is
@@ -234,16 +223,17 @@ fn stage_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
     Ok(())
 }
 
-/// Two reports may not write the same Markdown file: each would overwrite the other's.
-fn check_markdown_distinct(stages: &[Stage]) -> Result<()> {
-    let mut owner: BTreeMap<&str, &str> = BTreeMap::new();
+/// No two stages may claim the same file ([`crate::kind::Kind::claims`]): each would
+/// overwrite the other's.
+fn check_claims_distinct(stages: &[Stage]) -> Result<()> {
+    let mut owner: BTreeMap<String, &str> = BTreeMap::new();
     for stage in stages {
-        if let Some(report) = stage.get::<Report>() {
-            if let Some(other) = owner.insert(report.markdown.as_str(), stage.name.as_str()) {
+        for (key, file) in stage.spec.claims() {
+            if let Some(other) = owner.insert(file.clone(), stage.name.as_str()) {
                 return Err(definition_error(
                     stage,
-                    "markdown",
-                    format!("`{}` is written by stage `{other}` too", report.markdown),
+                    key,
+                    format!("`{file}` is written by stage `{other}` too"),
                 ));
             }
         }

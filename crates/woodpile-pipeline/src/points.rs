@@ -18,8 +18,9 @@ use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::run::simulate;
 
 use crate::atomic;
-use crate::canonical::Key;
+use crate::canonical::{code_version, scene_json, Key};
 use crate::error::Result;
+use serde_json::json;
 
 const MAGIC: &[u8; 4] = b"WPPT";
 /// The largest point file read: far beyond a series of the sample budget's length.
@@ -79,7 +80,7 @@ pub fn simulations() -> u64 {
 }
 
 /// Counts one simulation (each kind calls it beside each run it makes).
-pub(crate) fn count_simulation() {
+pub fn count_simulation() {
     SIMULATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
 }
 
@@ -121,6 +122,62 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
     })
 }
 
+/// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
+/// that energy points keep their keys), the series.
+pub fn point_key(scene: &Scene, series: Series) -> Key {
+    let mut key = json!({"scene": scene_json(scene), "code": code_version()});
+    if series == Series::Kinetic {
+        key["series"] = json!("kinetic");
+    }
+    Key::of(&key)
+}
+
+/// Facts about a set of simulated points that combine exactly across shards (counts, sums of
+/// integers, maxima), so a merged sweep reports what a single run would.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PointStats {
+    /// Points.
+    pub points: usize,
+    /// Of which failed.
+    pub failed: usize,
+    /// Right-hand-side evaluations of all successful points.
+    pub rhs_evals: u64,
+    /// Largest `auto` error estimate.
+    pub max_error_estimate: Option<f64>,
+    /// Largest relative energy drift.
+    pub max_energy_drift: Option<f64>,
+}
+
+impl PointStats {
+    /// The statistics of `results`.
+    pub fn of(results: &[PointResult]) -> Self {
+        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
+        let max = |f: fn(&PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
+        Self {
+            points: results.len(),
+            failed: results.iter().filter(|r| r.is_err()).count(),
+            rhs_evals: ok().map(|p| p.rhs_evals).sum(),
+            max_error_estimate: max(|p| p.error_estimate),
+            max_energy_drift: max(|p| p.energy_drift),
+        }
+    }
+
+    /// The statistics of the union of two disjoint point sets.
+    pub fn merge(self, other: PointStats) -> PointStats {
+        let max = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(x), Some(y)) => Some(x.max(y)),
+            (x, y) => x.or(y),
+        };
+        PointStats {
+            points: self.points + other.points,
+            failed: self.failed + other.failed,
+            rhs_evals: self.rhs_evals + other.rhs_evals,
+            max_error_estimate: max(self.max_error_estimate, other.max_error_estimate),
+            max_energy_drift: max(self.max_energy_drift, other.max_energy_drift),
+        }
+    }
+}
+
 /// The directory of point files.
 #[derive(Debug, Clone)]
 pub struct PointStore {
@@ -151,6 +208,18 @@ impl PointStore {
         // reads as absent (and is recomputed), never blocks or fills the memory.
         let bytes = crate::regular::read(&self.path(key), MAX_POINT_BYTES).ok()?;
         decode(&bytes, key)
+    }
+
+    /// The result of `scene` (whose key is `key`, from [`point_key`]): from the cache, or
+    /// simulated and saved. Every kind that simulates scenes goes through here, so a scene is
+    /// simulated once whichever stage asks for it first.
+    pub fn get_or_simulate(&self, key: &Key, scene: &Scene, series: Series) -> Result<PointResult> {
+        if let Some(cached) = self.load(key) {
+            return Ok(cached);
+        }
+        let result = simulate_point(scene, series);
+        self.save(key, &result)?;
+        Ok(result)
     }
 
     /// Stores `result` under `key`, atomically.

@@ -10,14 +10,13 @@ use crate::canonical::code_version;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::kind::{Context, Sharing};
+use crate::layout::{output_path, points_dir};
 use crate::lock::lock_results;
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
 use crate::points::PointStore;
 use crate::stage::Stage;
-use crate::status::{output_path, state, State};
-use crate::sweep::points_dir;
-use crate::sweep::Sweep;
+use crate::status::{state, State};
 use crate::{sealed_files, table};
 
 /// How to run.
@@ -169,8 +168,8 @@ fn decide(
         }
         (other, _) => format!("{}: {}", other.label(), other.why()),
     };
-    let points = match stage.get::<Sweep>() {
-        Some(sweep) => Some((sweep.count(), sweep.cached(store)?)),
+    let points = match stage.spec.points() {
+        Some(grid) => Some((grid.count(), grid.cached(store)?)),
         None => None,
     };
     let step = Step {

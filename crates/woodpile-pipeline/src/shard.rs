@@ -15,13 +15,13 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
+use crate::kind::PointGrid;
+use crate::layout::{output_path, parts_dir, points_dir};
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
-use crate::points::PointStore;
+use crate::points::{PointStats, PointStore};
 use crate::run::manifest_for;
 use crate::stage::Stage;
-use crate::status::output_path;
-use crate::sweep::{points_dir, Sweep, SweepStats};
 use crate::table::{self, f64_column};
 
 /// Shard `index` of `count` (0 <= index < count).
@@ -92,16 +92,8 @@ impl std::fmt::Display for Shard {
     }
 }
 
-/// The directory of `stage`'s parts.
-pub fn parts_dir(results: &Path, stage: &str) -> PathBuf {
-    results.join("parts").join(stage)
-}
-
 fn part_path(results: &Path, stage: &str, key: &str, shard: Shard) -> PathBuf {
-    parts_dir(results, stage).join(format!(
-        "{key}.shard-{}-of-{}.parquet",
-        shard.index, shard.count
-    ))
+    crate::layout::part_path(results, stage, key, shard.index, shard.count)
 }
 
 /// `(key, shard)` from a part file name.
@@ -115,9 +107,9 @@ fn parse_part_name(name: &str) -> Option<(String, Shard)> {
     ))
 }
 
-fn sweep_of<'p>(pipeline: &'p Pipeline, name: &str) -> Result<(&'p Stage, &'p Sweep)> {
+fn sweep_of<'p>(pipeline: &'p Pipeline, name: &str) -> Result<(&'p Stage, &'p dyn PointGrid)> {
     let stage = pipeline.stage(name)?;
-    match stage.get::<Sweep>() {
+    match stage.spec.points() {
         Some(sweep) => Ok((stage, sweep)),
         None => Err(PipelineError::stage(
             name,
@@ -257,7 +249,7 @@ pub fn merge(
         ));
     }
     let mut frame: Option<DataFrame> = None;
-    let mut stats = SweepStats::default();
+    let mut stats = PointStats::default();
     for (shard, path) in &current {
         let manifest: Manifest = table::read_manifest(path)?
             .ok_or_else(|| PipelineError::io(path, "part vanished while merging"))?;
@@ -267,7 +259,7 @@ pub fn merge(
                 path.display()
             ));
         }
-        let part_stats: SweepStats = serde_json::from_value(manifest.summary["stats"].clone())
+        let part_stats: PointStats = serde_json::from_value(manifest.summary["stats"].clone())
             .map_err(|e| PipelineError::io(path, format!("bad shard statistics: {e}")))?;
         if part_stats.points != shard.points(sweep.count()).len() {
             return fail(format!(

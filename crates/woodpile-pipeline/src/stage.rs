@@ -18,7 +18,7 @@ use serde_json::Value;
 use crate::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::kind::{Kind, KINDS};
+use crate::kind::{Kind, Registry};
 
 /// A parsed stage file.
 #[derive(Debug, Clone)]
@@ -31,7 +31,7 @@ pub struct Stage {
     pub description: String,
     /// Upstream stages, in the order given.
     pub inputs: Vec<String>,
-    /// Its kind's name (one of [`crate::kind::names`]).
+    /// Its kind's name (one of the registry's).
     pub kind: &'static str,
     /// What it does: the kind's parameters and behaviour.
     pub spec: Arc<dyn Kind>,
@@ -41,35 +41,40 @@ pub struct Stage {
 
 impl Stage {
     /// Reads and parses the stage file at `file` of the project rooted at `root` (where a
-    /// `scene = "scenes/x.toml"` reference is found).
-    pub fn load(file: &Path, root: &Path) -> Result<Stage> {
+    /// `scene = "scenes/x.toml"` reference is found), with the kinds of `kinds`.
+    pub fn load(file: &Path, root: &Path, kinds: &'static Registry) -> Result<Stage> {
         let text = woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: format!("cannot read: {e}"),
             source: None,
         })?;
-        Stage::parse_in(&text, file, root)
+        Stage::parse_in(&text, file, root, kinds)
     }
 
     /// Parses stage TOML `text`; `file` names it (and gives the stage its name); scene files
     /// are found relative to the current directory.
-    pub fn parse(text: &str, file: &Path) -> Result<Stage> {
-        Stage::parse_in(text, file, Path::new("."))
+    pub fn parse(text: &str, file: &Path, kinds: &'static Registry) -> Result<Stage> {
+        Stage::parse_in(text, file, Path::new("."), kinds)
     }
 
     /// [`Stage::parse`] in the project rooted at `root`.
-    pub fn parse_in(text: &str, file: &Path, root: &Path) -> Result<Stage> {
+    pub fn parse_in(
+        text: &str,
+        file: &Path,
+        root: &Path,
+        kinds: &'static Registry,
+    ) -> Result<Stage> {
         let mut table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: e.to_string().trim_end().to_string(),
             source: Some(Box::new(e)),
         })?;
         include_scene_file(&mut table, file, root)?;
-        Stage::from_table(table, file)
+        Stage::from_table(table, file, kinds)
     }
 
     /// A stage from its parsed table (scene files already included).
-    pub fn from_table(table: toml::Table, file: &Path) -> Result<Stage> {
+    pub fn from_table(table: toml::Table, file: &Path, kinds: &'static Registry) -> Result<Stage> {
         let name = stage_name(file)?;
         let mut params = toml_to_json(&toml::Value::Table(table.clone()));
         if let Value::Object(map) = &mut params {
@@ -79,8 +84,8 @@ impl Stage {
         let kind: String = fields.required("kind")?;
         let description: String = fields.optional("description")?.unwrap_or_default();
         let inputs: Vec<String> = fields.optional("inputs")?.unwrap_or_default();
-        let Some(&(kind, parse)) = KINDS.iter().find(|(name, _)| *name == kind) else {
-            let names: Vec<&str> = crate::kind::names().collect();
+        let Some(&(kind, parse)) = kinds.iter().find(|(name, _)| *name == kind) else {
+            let names: Vec<&str> = kinds.iter().map(|(name, _)| *name).collect();
             return Err(fields.error(
                 "kind",
                 format!("unknown kind `{kind}` (kinds: {})", names.join(", ")),

@@ -1,9 +1,10 @@
 //! Is a stage's output fresh, stale or missing, and why: the stored manifest against the
 //! stage's current definition.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use crate::canonical::{changed_paths, code_version};
+use crate::layout::output_path;
 use crate::pipeline::Pipeline;
 use crate::stage::Stage;
 use crate::table::{self, Integrity};
@@ -42,11 +43,6 @@ impl State {
             State::Damaged(reason) => reason.clone(),
         }
     }
-}
-
-/// Where stage `name`'s table lives in the results tree `results`.
-pub fn output_path(results: &Path, name: &str) -> PathBuf {
-    results.join(format!("{name}.parquet"))
 }
 
 /// The state of `stage` given the outputs under `results` (and, for render stages, the figure

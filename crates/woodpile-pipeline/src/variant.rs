@@ -7,6 +7,7 @@
 use std::path::Path;
 
 use crate::error::{PipelineError, Result};
+use crate::kind::Registry;
 use crate::stage::Stage;
 
 /// One `STAGE.key=value`.
@@ -71,7 +72,12 @@ pub fn variant_name(stage: &str, sets: &[Set]) -> String {
 }
 
 /// The variants `sets` make of `stages`, one per stage named.
-pub fn variants(stages: &[Stage], sets: &[Set], root: &Path) -> Result<Vec<Stage>> {
+pub fn variants(
+    stages: &[Stage],
+    sets: &[Set],
+    root: &Path,
+    kinds: &'static Registry,
+) -> Result<Vec<Stage>> {
     let mut names: Vec<&str> = sets.iter().map(|s| s.stage.as_str()).collect();
     names.sort_unstable();
     names.dedup();
@@ -118,7 +124,7 @@ pub fn variants(stages: &[Stage], sets: &[Set], root: &Path) -> Result<Vec<Stage
                 reason: e.to_string(),
                 source: None,
             })?;
-            Stage::parse_in(&text, &file, root)
+            Stage::parse_in(&text, &file, root, kinds)
         })
         .collect()
 }

@@ -9,6 +9,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use woodpile_stages::KINDS;
 
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::PipelineError;
@@ -228,7 +229,7 @@ fn mutated_stage_files_load_or_are_refused_naming_file_and_key() {
     for case in 0..2000 {
         let (path, text) = &seeds[case % seeds.len()];
         let mutant = mutate(text, &mut rng);
-        let result = catch_unwind(AssertUnwindSafe(|| Stage::parse(&mutant, path)));
+        let result = catch_unwind(AssertUnwindSafe(|| Stage::parse(&mutant, path, KINDS)));
         let Ok(result) = result else {
             panic!(
                 "case {case}: parsing panicked on {}:\n{mutant}",

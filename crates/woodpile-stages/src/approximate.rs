@@ -21,14 +21,14 @@
 use polars::prelude::DataFrame;
 use serde_json::json;
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::kind::{Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
-use crate::table::{f64_column, str_column, Columns};
-use crate::Output;
 use woodpile_analysis::lm::Form;
 use woodpile_analysis::product::{errors, product, Fitted};
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{f64_column, str_column, Columns};
+use woodpile_pipeline::Output;
 
 /// A parsed approximate stage.
 #[derive(Debug, Clone, PartialEq)]

@@ -30,16 +30,17 @@ use std::path::{Path, PathBuf};
 use serde_json::json;
 use woodpile_sim::run::{simulate, Outcome};
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::grid::AxisValue;
-use crate::kind::{Context, Inputs, Kind, KindCheck};
 use crate::reduce::Reduce;
 use crate::reduce::MAXIMIZABLE;
-use crate::stage::Stage;
 use crate::sweep::Sweep;
-use crate::table::{f64_column, Columns};
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::grid::AxisValue;
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::layout::best_path;
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{f64_column, Columns};
+use woodpile_pipeline::Output;
 
 /// A parsed optimize stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -195,7 +196,7 @@ impl Optimize {
                 return Ok(out.clone());
             }
             let scene = sweep.scene_with(values, Some(self.tolerance))?;
-            crate::points::count_simulation();
+            woodpile_pipeline::points::count_simulation();
             let out = simulate(&scene.scenario, &mut ())
                 .map_err(|e| fail(format!("refinement scene failed: {e}")))?;
             evaluated.borrow_mut().push((values.to_vec(), out.clone()));
@@ -328,7 +329,7 @@ impl Optimize {
             self.tolerance,
             path.display()
         );
-        crate::atomic::write(&path, (header + &text).as_bytes())?;
+        woodpile_pipeline::atomic::write(&path, (header + &text).as_bytes())?;
 
         let grid_first = rows
             .first()
@@ -421,11 +422,6 @@ fn best_values_of(values: &[AxisValue], searched: &[usize]) -> Vec<f64> {
     searched.iter().map(|&k| values[k].as_f64()).collect()
 }
 
-/// Where stage `name` writes its best optimum: beside its table.
-pub fn best_path(results: &Path, name: &str) -> PathBuf {
-    results.join(format!("{name}.best.toml"))
-}
-
 impl Kind for Optimize {
     fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
         let error = |key: &str, reason: String| Err((key.to_string(), reason));
@@ -466,11 +462,10 @@ impl Kind for Optimize {
         let input = &ctx.stage.inputs[0];
         let frame = ctx.input(input)?;
         let sweep = ctx
-            .pipeline
-            .stage(input)?
+            .upstream(input)?
             .inputs
             .first()
-            .and_then(|s| ctx.pipeline.sweep(s))
+            .and_then(|s| ctx.upstream(s).ok()?.get::<Sweep>())
             .ok_or_else(|| {
                 PipelineError::stage(ctx.name(), format!("`{input}` does not read a sweep"))
             })?;

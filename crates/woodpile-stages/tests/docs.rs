@@ -1,12 +1,11 @@
 //! `docs/stage-kinds.md` is generated from the module documentation of every stage kind
-//! (`src/kinds/<kind>.rs`, the one place each kind's keys are described), so the reference a user
-//! reads cannot drift from the code. This test fails when it is out of date;
-//! `UPDATE_DOCS=1 cargo test -p woodpile-pipeline --test docs` (or `make docs`) rewrites it.
+//! (`crates/woodpile-stages/src/<kind>.rs`, or `<kind>/mod.rs`, the one place each kind's keys
+//! are described), so the reference a user reads cannot drift from the code. This test fails when it is out of date;
+//! `UPDATE_DOCS=1 cargo test -p woodpile-stages --test docs` (or `make docs`) rewrites it.
 #![allow(clippy::unwrap_used)]
 
 use std::path::Path;
-
-use woodpile_pipeline::kind;
+use woodpile_stages::KINDS;
 
 fn module_doc(path: &Path) -> String {
     let text = std::fs::read_to_string(path).unwrap();
@@ -24,15 +23,22 @@ fn generated() -> String {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut out = String::from(
         "# Stage kinds\n\n<!-- Generated from the module documentation of each kind \
-         (crates/woodpile-pipeline/src/kinds/<kind>.rs) by `make docs`; do not edit by hand. -->\n\n\
+         (crates/woodpile-stages/src/<kind>.rs) by `make docs`; do not edit by hand. -->\n\n\
          Every stage file takes the common keys below; the rest belong to its kind. Unknown keys \
          are errors that name the file and the key.\n\n",
     );
-    out.push_str(&module_doc(&src.join("stage.rs")));
+    out.push_str(&module_doc(
+        &src.join("../../woodpile-pipeline/src/stage.rs"),
+    ));
     out.push('\n');
-    for kind in kind::names() {
+    for kind in woodpile_stages::names() {
         out.push_str(&format!("\n## `{kind}`\n\n"));
-        out.push_str(&module_doc(&src.join(format!("kinds/{kind}.rs"))));
+        let file = src.join(format!("{kind}.rs"));
+        let file = match file.exists() {
+            true => file,
+            false => src.join(kind).join("mod.rs"),
+        };
+        out.push_str(&module_doc(&file));
         out.push('\n');
     }
     out
@@ -99,7 +105,7 @@ fn accuracy_caption(
 #[test]
 fn readme_captions_state_the_accuracy_of_the_committed_results() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let pipeline = woodpile_pipeline::Pipeline::load(&root.join("pipeline")).unwrap();
+    let pipeline = woodpile_pipeline::Pipeline::load(&root.join("pipeline"), KINDS).unwrap();
     let readme_path = root.join("README.md");
     let readme = std::fs::read_to_string(&readme_path).unwrap();
     let mut expected = String::new();

@@ -5,8 +5,10 @@
 use woodpile_sim::run::Scenario;
 use woodpile_sim::testing::Lcg;
 
-use crate::error::{PipelineError, Result};
-use crate::pipeline::Pipeline;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::pipeline::Pipeline;
+
+use crate::sweep::Sweep;
 
 /// The sweeps a survey draws from, with their labels: one of each kind of the paper's scenes.
 pub const SURVEY_SWEEPS: &[(&str, &str)] = &[
@@ -39,9 +41,13 @@ pub fn sampled_scenes(
     let mut scenes = Vec::with_capacity(per_sweep * sweeps.len());
     for _ in 0..per_sweep {
         for &(stage, label) in sweeps {
-            let sweep = pipeline.sweep(stage).ok_or_else(|| {
-                PipelineError::stage(stage, "a survey draws from this sweep, which is missing")
-            })?;
+            let sweep = pipeline
+                .stage(stage)
+                .ok()
+                .and_then(|s| s.get::<Sweep>())
+                .ok_or_else(|| {
+                    PipelineError::stage(stage, "a survey draws from this sweep, which is missing")
+                })?;
             let values: Vec<_> = sweep.axes.iter().map(|a| rng.pick(&a.values)).collect();
             let named: Vec<String> = sweep
                 .axes

@@ -55,13 +55,13 @@ use woodpile_plot::{
     cell_edges, Colours, Figure, HeatPanel, LinePanel, Mark, MarkAt, Panel, Series, View,
 };
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::kind::{Context, Inputs, Kind, KindCheck};
-use crate::manifest::Manifest;
-use crate::stage::Stage;
-use crate::table::{f64_column, matching_rows, str_column, Columns};
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::manifest::Manifest;
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{f64_column, matching_rows, str_column, Columns};
+use woodpile_pipeline::Output;
 
 /// A parsed render stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -195,10 +195,7 @@ impl Render {
 
     /// The figure files of stage `name` under `figures`.
     pub fn files(figures: &Path, name: &str) -> [PathBuf; 2] {
-        [
-            figures.join(format!("{name}.png")),
-            figures.join(format!("{name}.svg")),
-        ]
+        woodpile_pipeline::layout::figure_paths(figures, name)
     }
 
     /// Draws the panels from `inputs` (stage name to its table and manifest) and returns the
@@ -242,8 +239,8 @@ impl Render {
         };
         let [png, svg] = Render::files(figures, stage);
         let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
-        crate::atomic::write(&png, &figure.png().map_err(drawing)?)?;
-        crate::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
+        woodpile_pipeline::atomic::write(&png, &figure.png().map_err(drawing)?)?;
+        woodpile_pipeline::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
         Ok(Output {
             failures: Vec::new(),
             frame: plotted(&figure.panels, &names).into_frame()?,
@@ -655,7 +652,7 @@ impl PanelSpec {
                 return Err(format!(
                     "key `{key}`: input `{}`: {}",
                     self.input,
-                    crate::table::missing_column(input, column)
+                    woodpile_pipeline::table::missing_column(input, column)
                 ));
             }
         }

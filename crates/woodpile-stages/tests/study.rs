@@ -5,9 +5,11 @@
 mod common;
 
 use common::Project;
-use woodpile_pipeline::status::{output_path, state, State};
+use woodpile_pipeline::layout::output_path;
+use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::{table, Pipeline};
+use woodpile_stages::KINDS;
 
 const DESIGN: &str = r#"
 kind = "design"
@@ -119,7 +121,7 @@ eps = "$eps"
         base.replace("t_end = 10.0", "t_end = 12.0"),
     )
     .unwrap();
-    let pipeline = Pipeline::load(&p.root().join("pipeline")).unwrap();
+    let pipeline = Pipeline::load(&p.root().join("pipeline"), KINDS).unwrap();
     let st = state(
         &pipeline,
         &p.results(),

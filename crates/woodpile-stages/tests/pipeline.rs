@@ -5,13 +5,15 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+use woodpile_stages::KINDS;
 
 use woodpile_pipeline::diff::{diff, DiffOptions, Tolerance};
 use woodpile_pipeline::events::Events;
+use woodpile_pipeline::layout::output_path;
+use woodpile_pipeline::layout::points_dir;
 use woodpile_pipeline::points::PointStore;
 use woodpile_pipeline::run::{run, RunOptions};
-use woodpile_pipeline::status::{output_path, state, State};
-use woodpile_pipeline::sweep::points_dir;
+use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::{table, Pipeline, PipelineError};
 
 /// Counts what a run did.
@@ -89,7 +91,7 @@ impl Project {
     }
 
     fn load(&self) -> Pipeline {
-        Pipeline::load(&self.pipeline).unwrap()
+        Pipeline::load(&self.pipeline, KINDS).unwrap()
     }
 
     fn run(&self, targets: &[&str]) -> Counter {
@@ -126,7 +128,9 @@ impl Project {
 
 fn load_error(stages: &[(&str, &str)]) -> String {
     let project = Project::new(stages);
-    Pipeline::load(&project.pipeline).unwrap_err().to_string()
+    Pipeline::load(&project.pipeline, KINDS)
+        .unwrap_err()
+        .to_string()
 }
 
 #[test]
@@ -255,7 +259,7 @@ fn an_interrupted_sweep_resumes_without_repeating_finished_points() {
     let sweep = pipeline
         .stage("sweep")
         .unwrap()
-        .get::<woodpile_pipeline::sweep::Sweep>()
+        .get::<woodpile_stages::sweep::Sweep>()
         .unwrap();
     let points = sweep.points().unwrap();
     std::fs::remove_file(store.path(&points[1].0)).unwrap();
@@ -1411,7 +1415,7 @@ fn stages_in_folders_load_and_a_name_twice_is_an_error() {
         .file
         .ends_with("f1/sweep.toml"));
     std::fs::write(p.pipeline.join("sweep.toml"), SWEEP).unwrap();
-    let e = Pipeline::load(&p.pipeline).unwrap_err().to_string();
+    let e = Pipeline::load(&p.pipeline, KINDS).unwrap_err().to_string();
     assert!(
         e.contains("defined twice") && e.contains("f1/sweep.toml"),
         "{e}"
@@ -1533,10 +1537,10 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
 #[test]
 fn an_unknown_kind_lists_every_kind() {
     let e = load_error(&[("x", "kind = \"plot\"")]);
-    for kind in woodpile_pipeline::kind::names() {
+    for kind in woodpile_stages::names() {
         assert!(e.contains(kind), "{kind} missing from: {e}");
     }
-    assert!(woodpile_pipeline::kind::names().any(|k| k == "design"));
+    assert!(woodpile_stages::names().any(|k| k == "design"));
 }
 
 /// Errors keep their causes: a scene the scene crate rejects, a stage file the TOML parser
@@ -1545,7 +1549,7 @@ fn an_unknown_kind_lists_every_kind() {
 fn errors_keep_their_sources() {
     use std::error::Error;
     let p = Project::new(&[("sweep", &SWEEP.replace("from = 0.5, to", "from = -0.5, to"))]);
-    let e = Pipeline::load(&p.pipeline).unwrap_err();
+    let e = Pipeline::load(&p.pipeline, KINDS).unwrap_err();
     assert!(e.to_string().contains("scene.defect[0].eps"), "{e}");
     let scene = e
         .source()
@@ -1555,7 +1559,7 @@ fn errors_keep_their_sources() {
         "{scene:?}"
     );
     let p = Project::new(&[("sweep", "kind = \"sweep\"\n[scene\n")]);
-    let e = Pipeline::load(&p.pipeline).unwrap_err();
+    let e = Pipeline::load(&p.pipeline, KINDS).unwrap_err();
     assert!(e.source().is_some_and(|s| s.is::<toml::de::Error>()), "{e}");
     let e = table::read(&p.results.join("absent.parquet")).unwrap_err();
     assert!(e.source().is_some_and(|s| s.is::<std::io::Error>()), "{e}");
@@ -1599,7 +1603,7 @@ fn stages_run_side_by_side_within_their_kinds_limits() {
     ];
     let p = Project::new(&stages);
     let events = Overlaps::default();
-    let pipeline = Pipeline::load(&p.pipeline).unwrap();
+    let pipeline = Pipeline::load(&p.pipeline, KINDS).unwrap();
     let options = RunOptions {
         results: p.results.clone(),
         figures: p.results.join("figures"),

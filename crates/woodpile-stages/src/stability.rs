@@ -33,12 +33,12 @@ use serde_json::json;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
 use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
-use crate::table::Columns;
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::Columns;
+use woodpile_pipeline::Output;
 
 /// The defect parameter a stability map varies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -170,7 +170,7 @@ impl Stability {
                     tolerance_explicit: true,
                     dt: None,
                 };
-                crate::points::count_simulation();
+                woodpile_pipeline::points::count_simulation();
                 let e_ref = simulate(&reference, &mut ())
                     .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
                     .fractions
@@ -326,7 +326,7 @@ fn classify(
         sample_every: scenario.t_end,
         ..scenario.clone()
     };
-    crate::points::count_simulation();
+    woodpile_pipeline::points::count_simulation();
     match run_with_plan(&one_interval, &plan, &mut (), true) {
         Err(e) => (2, None, Some(e.to_string())),
         Ok(o) if !(o.stats.max_energy_drift <= 1.0) => (
@@ -364,8 +364,8 @@ struct Run {
 }
 
 impl Kind for Stability {
-    fn sharing(&self) -> crate::kind::Sharing {
-        crate::kind::Sharing::Parallel
+    fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
+        woodpile_pipeline::kind::Sharing::Parallel
     }
 
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {

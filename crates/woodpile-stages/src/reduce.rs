@@ -14,14 +14,14 @@
 
 use serde_json::json;
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::grid::Axis;
-use crate::kind::{Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
 use crate::sweep::Sweep;
-use crate::table::{f64_column, rows_frame, str_column, Cell, Row as TableRow};
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::grid::Axis;
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row as TableRow};
+use woodpile_pipeline::Output;
 
 /// Columns a maximisation may target.
 pub const MAXIMIZABLE: &[&str] = &["E_tr", "R", "T"];
@@ -332,13 +332,14 @@ impl Kind for Reduce {
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         let input = &ctx.stage.inputs[0];
         let frame = ctx.input(input)?;
-        let axes = ctx
-            .pipeline
-            .sweep_axes(input)
-            .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?;
+        let upstream = ctx.upstream(input)?;
+        let axes = &upstream
+            .get::<Sweep>()
+            .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?
+            .axes;
         let mut output = self.run(ctx.name(), &frame, axes)?;
         // The sweep's scene, grid and tolerance, so the table explains itself without its input.
-        let params = &ctx.pipeline.stage(input)?.params;
+        let params = &upstream.params;
         output.summary["input"] = json!({
             "stage": input,
             "scene": params.get("scene"),

@@ -23,13 +23,13 @@
 use polars::prelude::DataFrame;
 use serde_json::json;
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::kind::{Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
-use crate::table::{f64_column, matching_rows, rows_frame, Cell, Row};
-use crate::Output;
 use woodpile_analysis::lm::{fit, Fit, Form};
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{f64_column, matching_rows, rows_frame, Cell, Row};
+use woodpile_pipeline::Output;
 
 /// A parsed fit stage.
 #[derive(Debug, Clone, PartialEq)]

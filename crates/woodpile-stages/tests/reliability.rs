@@ -6,6 +6,7 @@
 mod common;
 
 use std::path::Path;
+use woodpile_stages::KINDS;
 
 use common::Project;
 use woodpile_pipeline::events::Silent;
@@ -135,7 +136,9 @@ fn two_reports_cannot_claim_one_file_by_spelling_it_twice() {
         ("a", &REPORT.replace("REPORT.md", "d/x.md")),
         ("b", &REPORT.replace("REPORT.md", "d//x.md")),
     ]);
-    let err = Pipeline::load(&p.pipeline()).unwrap_err().to_string();
+    let err = Pipeline::load(&p.pipeline(), KINDS)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("written by stage"), "{err}");
 }
 
@@ -161,7 +164,7 @@ fn symlink_loops_are_not_followed() {
     let p = Project::new(&[("sweep", SWEEP)]);
     std::os::unix::fs::symlink(".", p.pipeline().join("x")).unwrap();
     std::os::unix::fs::symlink(".", p.pipeline().join("y")).unwrap();
-    let pipeline = Pipeline::load(&p.pipeline()).unwrap();
+    let pipeline = Pipeline::load(&p.pipeline(), KINDS).unwrap();
     assert_eq!(pipeline.stages().len(), 1);
     p.run(&[]).unwrap();
     let copy = p.root().join("copy");
@@ -208,7 +211,7 @@ fn non_regular_files_in_results_are_damaged_never_read() {
 fn shard_counts_are_bounded_and_missing_shards_counted() {
     use woodpile_pipeline::shard::{merge, run_shard, Shard};
     let p = Project::new(&[("sweep", SWEEP)]);
-    let pipeline = Pipeline::load(&p.pipeline()).unwrap();
+    let pipeline = Pipeline::load(&p.pipeline(), KINDS).unwrap();
     let err = run_shard(
         &pipeline,
         "sweep",
@@ -235,7 +238,9 @@ fn shard_counts_are_bounded_and_missing_shards_counted() {
 
 fn load_error(stages: &[(&str, &str)]) -> String {
     let p = Project::new(stages);
-    Pipeline::load(&p.pipeline()).unwrap_err().to_string()
+    Pipeline::load(&p.pipeline(), KINDS)
+        .unwrap_err()
+        .to_string()
 }
 
 /// Requests whose planning alone would take gigabytes are refused at load, naming the key.

@@ -38,13 +38,15 @@ use std::path::{Path, PathBuf};
 use polars::prelude::DataFrame;
 use serde_json::json;
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::kind::{Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
-use crate::status::output_path;
-use crate::table::{self, f64_column, matching_rows, rows_frame, str_column, Cell, Row};
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::layout::output_path;
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{
+    self, f64_column, matching_rows, rows_frame, str_column, Cell, Row,
+};
+use woodpile_pipeline::Output;
 
 /// A parsed report stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -261,7 +263,7 @@ impl Report {
             .ok()
             .flatten();
         let named = previous.is_some_and(|m| m.summary["markdown"] == self.markdown.as_str());
-        let marked = crate::regular::read(path, 1 << 26)
+        let marked = woodpile_pipeline::regular::read(path, 1 << 26)
             .ok()
             .and_then(|bytes| {
                 let head = &bytes[..bytes.len().min(4096)];
@@ -288,10 +290,7 @@ impl Report {
 
     /// The Markdown file for outputs under `results`.
     pub fn markdown_path(&self, results: &Path) -> PathBuf {
-        results
-            .parent()
-            .unwrap_or_else(|| Path::new(""))
-            .join(&self.markdown)
+        woodpile_pipeline::layout::markdown_path(results, &self.markdown)
     }
 
     pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
@@ -325,7 +324,7 @@ impl Report {
         let text = markdown(stage, self, &evaluated);
         let path = self.markdown_path(results);
         self.check_owned(stage, &path, results)?;
-        crate::atomic::write(&path, text.as_bytes())?;
+        woodpile_pipeline::atomic::write(&path, text.as_bytes())?;
         let reproduced = evaluated
             .iter()
             .zip(&self.quotes)
@@ -991,6 +990,10 @@ impl Kind for Report {
 
     fn files(&self, _: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
         vec![self.markdown_path(results)]
+    }
+
+    fn claims(&self) -> Vec<(&'static str, String)> {
+        vec![("markdown", self.markdown.clone())]
     }
 }
 

@@ -34,12 +34,12 @@ use woodpile_scene::Scene;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
-use crate::table::{rows_frame, Cell, Row};
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{rows_frame, Cell, Row};
+use woodpile_pipeline::Output;
 
 /// A parsed work-precision stage.
 #[derive(Debug, Clone)]
@@ -178,7 +178,7 @@ impl WorkPrecision {
                 let mut outcome: Option<std::result::Result<Outcome, String>> = None;
                 for _ in 0..self.repeats {
                     let t0 = Instant::now();
-                    crate::points::count_simulation();
+                    woodpile_pipeline::points::count_simulation();
                     let result = simulate(&scenario, &mut ()).map_err(|e| e.to_string());
                     best = best.min(t0.elapsed().as_secs_f64() * 1e3);
                     let failed = result.is_err();
@@ -233,7 +233,7 @@ fn reference(
     )
     .map_err(|e| e.to_string())?;
     plan.drift_limit = f64::INFINITY;
-    crate::points::count_simulation();
+    woodpile_pipeline::points::count_simulation();
     let outcome = run_with_plan(scenario, &plan, &mut (), true).map_err(|e| e.to_string())?;
     let drift = (!scenario.model.is_time_dependent()).then_some(outcome.stats.max_energy_drift);
     Ok((outcome.fractions.trapped, drift))
@@ -306,8 +306,8 @@ impl Row for Run<'_> {
 }
 
 impl Kind for WorkPrecision {
-    fn sharing(&self) -> crate::kind::Sharing {
-        crate::kind::Sharing::Alone
+    fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
+        woodpile_pipeline::kind::Sharing::Alone
     }
 
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {

@@ -53,15 +53,15 @@ use rayon::prelude::*;
 use serde_json::json;
 use woodpile_scene::Scene;
 
-use crate::error::{PipelineError, Result};
-use crate::events::Events;
-use crate::fields::Fields;
-use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::points::{simulate_point, PointData, PointResult, PointStore, Series};
-use crate::stage::Stage;
-use crate::sweep::point_key;
-use crate::table::{rows_frame, Cell, Row};
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::events::Events;
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::layout::best_path;
+use woodpile_pipeline::points::{point_key, PointData, PointResult, PointStore, Series};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{rows_frame, Cell, Row};
+use woodpile_pipeline::Output;
 
 /// A parsed design stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -462,14 +462,7 @@ impl Design {
                 }
                 let scene = self.scene(&layout, tolerance)?;
                 let key = point_key(&scene, Series::Energy);
-                let result = match store.load(&key) {
-                    Some(cached) => cached,
-                    None => {
-                        let result = simulate_point(&scene, Series::Energy);
-                        store.save(&key, &result)?;
-                        result
-                    }
-                };
+                let result = store.get_or_simulate(&key, &scene, Series::Energy)?;
                 events.point_done();
                 let score = self.score(&result);
                 Ok(Evaluated {
@@ -657,7 +650,7 @@ impl Design {
             self.verify_tolerance,
             best_file.display()
         );
-        crate::atomic::write(&best_file, (header + &text).as_bytes())?;
+        woodpile_pipeline::atomic::write(&best_file, (header + &text).as_bytes())?;
 
         let de_best = self.best_of(&rows, "differential evolution");
         let random_best = self.best_of(&rows, "random");
@@ -880,11 +873,6 @@ impl Row for TrialRow<'_> {
     }
 }
 
-/// Where stage `name` writes its best design: beside its table.
-pub fn best_path(results: &Path, name: &str) -> PathBuf {
-    results.join(format!("{name}.best.toml"))
-}
-
 fn parse_space(mut f: Fields<'_>) -> Result<Space> {
     let sites = parse_sites(&mut f)?;
     let (lo, hi) = match (&sites, f.optional::<toml::Value>("resonators")?) {
@@ -1026,8 +1014,8 @@ fn parse_values(f: &mut Fields<'_>, key: &str) -> Result<Values> {
 }
 
 impl Kind for Design {
-    fn sharing(&self) -> crate::kind::Sharing {
-        crate::kind::Sharing::Parallel
+    fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
+        woodpile_pipeline::kind::Sharing::Parallel
     }
 
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {

@@ -32,14 +32,14 @@ use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::observe::SpaceTimeField;
 use woodpile_sim::run::simulate;
 
-use crate::error::{PipelineError, Result};
-use crate::fields::Fields;
-use crate::grid::{Axis, AxisValue};
-use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::stage::Stage;
 use crate::sweep::Sweep;
-use crate::table::Columns;
-use crate::Output;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::grid::{Axis, AxisValue};
+use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::Columns;
+use woodpile_pipeline::Output;
 
 /// A parsed spacetime stage.
 #[derive(Debug, Clone)]
@@ -128,7 +128,7 @@ impl SpaceTime {
                 &sweep.axes,
             ),
             Source::Design(design) => {
-                let path = crate::design::best_path(results, design);
+                let path = woodpile_pipeline::layout::best_path(results, design);
                 let scene = woodpile_scene::load(&path)
                     .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
                 if self.sites[0] < scene.first_site || self.sites[1] > scene.last_site {
@@ -160,7 +160,7 @@ impl SpaceTime {
             .map(|(i, (values, scene))| {
                 let model = &scene.scenario.model;
                 let mut field = SpaceTimeField::new(model, 1, 1);
-                crate::points::count_simulation();
+                woodpile_pipeline::points::count_simulation();
                 let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;

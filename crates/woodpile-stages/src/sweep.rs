@@ -25,7 +25,7 @@
 //! and the reason in `failure`: a failure is reported, never written as a number.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use polars::prelude::DataFrame;
 use rayon::prelude::*;
@@ -33,17 +33,19 @@ use serde_json::{json, Value};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 
-use crate::canonical::{code_version, scene_json, Key};
-use crate::error::{PipelineError, Result};
-use crate::events::Events;
-use crate::fields::Fields;
-use crate::grid::{parse_axes, point, point_count, Axis, AxisValue};
-use crate::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use crate::points::{simulate_point, PointData, PointResult, PointStore, Series};
-use crate::stage::Stage;
-use crate::table::{rows_frame, Cell, Row};
-use crate::template::Template;
-use crate::Output;
+use woodpile_pipeline::canonical::Key;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::events::Events;
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::grid::{parse_axes, point, point_count, Axis, AxisValue};
+use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck, PointGrid};
+use woodpile_pipeline::points::{
+    point_key, PointData, PointResult, PointStats, PointStore, Series,
+};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::table::{rows_frame, Cell, Row};
+use woodpile_pipeline::template::Template;
+use woodpile_pipeline::Output;
 
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]
@@ -171,18 +173,6 @@ impl Sweep {
             .collect()
     }
 
-    /// How many of the points are already in `store`.
-    pub fn cached(&self, store: &PointStore) -> Result<usize> {
-        // One scene at a time per thread: a dry run of a large grid holds no list of scenes.
-        (0..self.count())
-            .into_par_iter()
-            .map(|i| {
-                let key = point_key(&self.scene_at(i)?, self.series);
-                Ok(usize::from(store.path(&key).exists()))
-            })
-            .sum()
-    }
-
     /// Simulates what `store` lacks and assembles the whole output.
     pub(crate) fn run(
         &self,
@@ -197,54 +187,6 @@ impl Sweep {
             frame,
             summary: self.summary(&stats)?,
         })
-    }
-
-    /// Simulates what `store` lacks among the points `indices` (increasing) and assembles
-    /// their rows: the whole output, or one shard's part of it.
-    pub(crate) fn run_points(
-        &self,
-        stage: &str,
-        store: &PointStore,
-        events: &dyn Events,
-        indices: &[usize],
-    ) -> Result<(DataFrame, SweepStats)> {
-        let points = self.points_at(indices)?;
-        let mut results: Vec<Option<PointResult>> =
-            points.par_iter().map(|(k, _)| store.load(k)).collect();
-        // A scene listed twice (an axis value repeated) is simulated once: its first point.
-        let mut first_of: HashMap<&Key, usize> = HashMap::new();
-        let todo: Vec<usize> = (0..points.len())
-            .filter(|&i| results[i].is_none() && *first_of.entry(&points[i].0).or_insert(i) == i)
-            .collect();
-        events.simulating(stage, todo.len(), points.len() - todo.len());
-        let computed: Vec<(usize, PointResult)> = todo
-            .par_iter()
-            .map(|&i| {
-                let (key, scene) = &points[i];
-                let result = simulate_point(scene, self.series);
-                store.save(key, &result)?;
-                events.point_done();
-                Ok((i, result))
-            })
-            .collect::<Result<_>>()?;
-        for (i, result) in computed {
-            results[i] = Some(result);
-        }
-        for i in 0..points.len() {
-            if results[i].is_none() {
-                results[i] = results[first_of[&points[i].0]].clone();
-            }
-        }
-        let results: Vec<PointResult> = results.into_iter().flatten().collect();
-        let stats = SweepStats::of(&results);
-        if stats.failed > 0 {
-            events.warn(&format!(
-                "stage `{stage}`: {} of {} points failed (null rows with the reason in `failure`)",
-                stats.failed, stats.points
-            ));
-        }
-        let frame = self.table(indices, &points, &results)?;
-        Ok((frame, stats))
     }
 
     /// The output rows of the points `indices`: one per sample of each point, or one with the
@@ -272,90 +214,6 @@ impl Sweep {
         }
         rows_frame(&rows)
     }
-
-    /// The manifest summary of a whole sweep with statistics `stats`.
-    pub(crate) fn summary(&self, stats: &SweepStats) -> Result<Value> {
-        let scene = self.scene_at(0)?;
-        let physical = scene.physical.as_ref().map(|p| {
-            json!({
-                "time_scale_s": p.scales.time_s(),
-                "length_scale_m": p.scales.length_m(),
-                "defects": p.defects,
-            })
-        });
-        let first = scene.scenario;
-        Ok(json!({
-            "points": stats.points,
-            "failed": stats.failed,
-            "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
-            "method": match first.method { MethodChoice::Auto => "auto", MethodChoice::Named(m) => m.name() },
-            "tolerance": first.accuracy.tolerance,
-            "dt": first.accuracy.dt,
-            "t_end": first.t_end,
-            "sample_every": first.sample_every,
-            "physical_point_0": physical,
-            "series": match self.series { Series::Energy => "energy", Series::Kinetic => "kinetic" },
-            "rhs_evals": stats.rhs_evals,
-            "max_error_estimate": stats.max_error_estimate,
-            "max_energy_drift": stats.max_energy_drift,
-        }))
-    }
-}
-
-/// Facts about a set of simulated points that combine exactly across shards (counts, sums of
-/// integers, maxima), so a merged sweep reports what a single run would.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SweepStats {
-    /// Points.
-    pub points: usize,
-    /// Of which failed.
-    pub failed: usize,
-    /// Right-hand-side evaluations of all successful points.
-    pub rhs_evals: u64,
-    /// Largest `auto` error estimate.
-    pub max_error_estimate: Option<f64>,
-    /// Largest relative energy drift.
-    pub max_energy_drift: Option<f64>,
-}
-
-impl SweepStats {
-    fn of(results: &[PointResult]) -> Self {
-        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
-        let max =
-            |f: fn(&crate::points::PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
-        Self {
-            points: results.len(),
-            failed: results.iter().filter(|r| r.is_err()).count(),
-            rhs_evals: ok().map(|p| p.rhs_evals).sum(),
-            max_error_estimate: max(|p| p.error_estimate),
-            max_energy_drift: max(|p| p.energy_drift),
-        }
-    }
-
-    /// The statistics of the union of two disjoint point sets.
-    pub fn merge(self, other: SweepStats) -> SweepStats {
-        let max = |a: Option<f64>, b: Option<f64>| match (a, b) {
-            (Some(x), Some(y)) => Some(x.max(y)),
-            (x, y) => x.or(y),
-        };
-        SweepStats {
-            points: self.points + other.points,
-            failed: self.failed + other.failed,
-            rhs_evals: self.rhs_evals + other.rhs_evals,
-            max_error_estimate: max(self.max_error_estimate, other.max_error_estimate),
-            max_energy_drift: max(self.max_energy_drift, other.max_energy_drift),
-        }
-    }
-}
-
-/// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
-/// that energy points keep their keys), the series.
-pub fn point_key(scene: &Scene, series: Series) -> Key {
-    let mut key = json!({"scene": scene_json(scene), "code": code_version()});
-    if series == Series::Kinetic {
-        key["series"] = json!("kinetic");
-    }
-    Key::of(&key)
 }
 
 /// One output row: a sample of a point's series, or the one row of a failed point.
@@ -399,14 +257,101 @@ impl Row for SampleRow<'_> {
     }
 }
 
-/// The directory a results tree keeps its point cache in.
-pub fn points_dir(results: &Path) -> PathBuf {
-    results.join("points")
+impl PointGrid for Sweep {
+    fn count(&self) -> usize {
+        self.count()
+    }
+
+    /// How many of the points are already in `store`.
+    fn cached(&self, store: &PointStore) -> Result<usize> {
+        // One scene at a time per thread: a dry run of a large grid holds no list of scenes.
+        (0..self.count())
+            .into_par_iter()
+            .map(|i| {
+                let key = point_key(&self.scene_at(i)?, self.series);
+                Ok(usize::from(store.path(&key).exists()))
+            })
+            .sum()
+    }
+
+    /// Simulates what `store` lacks among the points `indices` (increasing) and assembles
+    /// their rows: the whole output, or one shard's part of it.
+    fn run_points(
+        &self,
+        stage: &str,
+        store: &PointStore,
+        events: &dyn Events,
+        indices: &[usize],
+    ) -> Result<(DataFrame, PointStats)> {
+        let points = self.points_at(indices)?;
+        let mut results: Vec<Option<PointResult>> =
+            points.par_iter().map(|(k, _)| store.load(k)).collect();
+        // A scene listed twice (an axis value repeated) is simulated once: its first point.
+        let mut first_of: HashMap<&Key, usize> = HashMap::new();
+        let todo: Vec<usize> = (0..points.len())
+            .filter(|&i| results[i].is_none() && *first_of.entry(&points[i].0).or_insert(i) == i)
+            .collect();
+        events.simulating(stage, todo.len(), points.len() - todo.len());
+        let computed: Vec<(usize, PointResult)> = todo
+            .par_iter()
+            .map(|&i| {
+                let (key, scene) = &points[i];
+                let result = store.get_or_simulate(key, scene, self.series)?;
+                events.point_done();
+                Ok((i, result))
+            })
+            .collect::<Result<_>>()?;
+        for (i, result) in computed {
+            results[i] = Some(result);
+        }
+        for i in 0..points.len() {
+            if results[i].is_none() {
+                results[i] = results[first_of[&points[i].0]].clone();
+            }
+        }
+        let results: Vec<PointResult> = results.into_iter().flatten().collect();
+        let stats = PointStats::of(&results);
+        if stats.failed > 0 {
+            events.warn(&format!(
+                "stage `{stage}`: {} of {} points failed (null rows with the reason in `failure`)",
+                stats.failed, stats.points
+            ));
+        }
+        let frame = self.table(indices, &points, &results)?;
+        Ok((frame, stats))
+    }
+
+    fn summary(&self, stats: &PointStats) -> Result<Value> {
+        let scene = self.scene_at(0)?;
+        let physical = scene.physical.as_ref().map(|p| {
+            json!({
+                "time_scale_s": p.scales.time_s(),
+                "length_scale_m": p.scales.length_m(),
+                "defects": p.defects,
+            })
+        });
+        let first = scene.scenario;
+        Ok(json!({
+            "points": stats.points,
+            "failed": stats.failed,
+            "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
+            "method": match first.method { MethodChoice::Auto => "auto", MethodChoice::Named(m) => m.name() },
+            "tolerance": first.accuracy.tolerance,
+            "dt": first.accuracy.dt,
+            "t_end": first.t_end,
+            "sample_every": first.sample_every,
+            "physical_point_0": physical,
+            "series": match self.series { Series::Energy => "energy", Series::Kinetic => "kinetic" },
+            "rhs_evals": stats.rhs_evals,
+            "max_error_estimate": stats.max_error_estimate,
+            "max_energy_drift": stats.max_energy_drift,
+        }))
+    }
 }
 
 impl Kind for Sweep {
-    fn sharing(&self) -> crate::kind::Sharing {
-        crate::kind::Sharing::Parallel
+    fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
+        woodpile_pipeline::kind::Sharing::Parallel
     }
 
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
@@ -415,5 +360,9 @@ impl Kind for Sweep {
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         self.run(ctx.name(), ctx.store, ctx.events)
+    }
+
+    fn points(&self) -> Option<&dyn PointGrid> {
+        Some(self)
     }
 }

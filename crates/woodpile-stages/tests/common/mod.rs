@@ -3,10 +3,12 @@
 #![allow(dead_code, clippy::unwrap_used)]
 
 use std::path::{Path, PathBuf};
+use woodpile_stages::KINDS;
 
 use woodpile_pipeline::events::Silent;
+use woodpile_pipeline::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
-use woodpile_pipeline::status::{output_path, state, State};
+use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::Pipeline;
 
@@ -42,7 +44,7 @@ impl Project {
     }
     /// Runs `targets` (all when empty) with variants `sets`; the pipeline that ran.
     pub fn run_with(&self, sets: &[Set], targets: &[&str]) -> woodpile_pipeline::Result<Pipeline> {
-        let pipeline = Pipeline::load_with(&self.pipeline(), sets)?;
+        let pipeline = Pipeline::load_with(&self.pipeline(), KINDS, sets)?;
         let options = RunOptions {
             targets: targets.iter().map(|s| s.to_string()).collect(),
             force: false,
@@ -57,7 +59,7 @@ impl Project {
         self.run_with(&[], targets).map(|_| ())
     }
     pub fn state(&self, name: &str) -> State {
-        let p = Pipeline::load(&self.pipeline()).unwrap();
+        let p = Pipeline::load(&self.pipeline(), KINDS).unwrap();
         state(&p, &self.results(), &self.figures(), p.stage(name).unwrap())
     }
     pub fn output(&self, name: &str) -> PathBuf {

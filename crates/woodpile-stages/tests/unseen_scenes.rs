@@ -1,24 +1,28 @@
 //! `auto` on scenes no calibration chose: one scene of each sweep kind (F4, F5, F6, F7 coarse,
 //! F7 fine) drawn from the stage files' own grids by a fixed seed
-//! (`woodpile_pipeline::sampling`), each against a reference of its own (`rk4-contact` at
+//! (`woodpile_stages::sampling`), each against a reference of its own (`rk4-contact` at
 //! dt = 0.001, 0.00025 for a nonlinear resonator: 20 to 40 times finer than auto's steps at
 //! 1e-6). The larger survey behind docs/methods.md's table is
 //! `cargo run --release -p woodpile-bench --example auto_accuracy -- 1e-6 --survey 8`.
 #![allow(clippy::unwrap_used)]
 
 use std::path::Path;
+use woodpile_stages::KINDS;
 
-use woodpile_pipeline::sampling::sampled_sweep_scenes;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::run::{simulate, Scenario};
 use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance};
+use woodpile_stages::sampling::sampled_sweep_scenes;
 
 #[test]
 fn auto_meets_its_tolerance_on_sampled_sweep_scenes() {
     let tol = 1e-6;
-    let pipeline =
-        Pipeline::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../pipeline")).unwrap();
+    let pipeline = Pipeline::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../../pipeline"),
+        KINDS,
+    )
+    .unwrap();
     let scenes = sampled_sweep_scenes(&pipeline, 1).unwrap();
     assert_eq!(scenes.len(), 5);
     for (label, scenario) in scenes {

@@ -1,0 +1,62 @@
+//! Where everything a run writes lives, in one place: every path under a results tree or a
+//! figures folder is made here, so that the engine, the kinds and the tools that read the tree
+//! (diff, status, the Python package) agree on it.
+//!
+//! ```text
+//! results/<stage>.parquet                          a stage's table (with its manifest)
+//! results/<stage>.best.toml                        an optimum as a scene file (optimize, design)
+//! results/points/<key[..2]>/<key>.bin              one cached scene (points.rs)
+//! results/parts/<stage>/<key>.shard-I-of-N.parquet one shard of a sweep
+//! results/.lock                                    held by the run writing the tree
+//! figures/<stage>.png, figures/<stage>.svg         a render stage's figure
+//! <project>/<markdown>                             a report's Markdown, beside results/
+//! ```
+
+use std::path::{Path, PathBuf};
+
+/// The table of stage `name`.
+pub fn output_path(results: &Path, name: &str) -> PathBuf {
+    results.join(format!("{name}.parquet"))
+}
+
+/// The point cache of a results tree.
+pub fn points_dir(results: &Path) -> PathBuf {
+    results.join("points")
+}
+
+/// The directory of stage `stage`'s shard parts.
+pub fn parts_dir(results: &Path, stage: &str) -> PathBuf {
+    results.join("parts").join(stage)
+}
+
+/// The part file of shard `index` of `count` of `stage`, for the definition with key `key`.
+pub fn part_path(results: &Path, stage: &str, key: &str, index: usize, count: usize) -> PathBuf {
+    parts_dir(results, stage).join(format!("{key}.shard-{index}-of-{count}.parquet"))
+}
+
+/// The best scene an optimizing stage `name` found, as a scene file.
+pub fn best_path(results: &Path, name: &str) -> PathBuf {
+    results.join(format!("{name}.best.toml"))
+}
+
+/// The figure files of stage `name`: PNG, then SVG.
+pub fn figure_paths(figures: &Path, name: &str) -> [PathBuf; 2] {
+    [
+        figures.join(format!("{name}.png")),
+        figures.join(format!("{name}.svg")),
+    ]
+}
+
+/// A report's Markdown file `markdown` (relative to the project) for the results tree `results`:
+/// it lives beside the tree, so a scratch tree's report goes beside the scratch tree.
+pub fn markdown_path(results: &Path, markdown: &str) -> PathBuf {
+    results
+        .parent()
+        .unwrap_or_else(|| Path::new(""))
+        .join(markdown)
+}
+
+/// The lock file of a results tree.
+pub fn lock_path(results: &Path) -> PathBuf {
+    results.join(crate::lock::LOCK_FILE)
+}
