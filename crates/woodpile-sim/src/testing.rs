@@ -2,7 +2,7 @@
 //! benchmarks; compiled only for them (`cfg(test)` or the `testing` feature). The fixtures
 //! are small and explicit (the standard scene below is the one every speed claim uses); scenes
 //! drawn from the paper's grids come from the stage files themselves
-//! (`woodpile_pipeline::sampling`), never from copies of them.
+//! (`woodpile_stages::sampling`), never from copies of them.
 //!
 //! The known answers are exact: a host–resonator pair is a linear oscillator with
 //! omega^2 = kappa (1/m + 1/eps); a head-on Hertz collision of two equal free beads exchanges
