@@ -4,6 +4,7 @@
 //!
 //! - [`lm`]: Levenberg–Marquardt fits of the paper's three-parameter forms (power law, tanh).
 //! - [`nelder_mead`]: derivative-free maximisation, for refining optima between grid points.
+//! - [`search`]: differential evolution and random search in the unit cube, seeded.
 //! - [`product`]: the paper's product approximation of two-defect trapping and its error
 //!   measures.
 #![warn(missing_docs)]
@@ -11,3 +12,4 @@
 pub mod lm;
 pub mod nelder_mead;
 pub mod product;
+pub mod search;

@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use crate::error::PipelineError;
+use crate::table::Match;
 
 /// The keys of one TOML table not yet consumed.
 pub struct Fields<'a> {
@@ -88,16 +89,39 @@ impl<'a> Fields<'a> {
         }
     }
 
-    /// An optional `key = { column = value, ... }` row filter (numeric equality).
-    pub fn equality_filter(&mut self, key: &str) -> Result<Vec<(String, f64)>, PipelineError> {
+    /// An optional `key = [lo, hi]` of finite numbers, the one parser of every range key:
+    /// `lo <= hi` for a closed range ([`Ends::MayMeet`]), `lo < hi` for an interval of
+    /// positive width ([`Ends::Apart`]).
+    pub fn interval(&mut self, key: &str, ends: Ends) -> Result<Option<[f64; 2]>, PipelineError> {
+        let Some(value) = self.table.remove(key) else {
+            return Ok(None);
+        };
+        match (Vec::<f64>::from_toml(value).as_deref(), ends) {
+            (Some(&[lo, hi]), Ends::MayMeet) if lo <= hi => Ok(Some([lo, hi])),
+            (Some(&[lo, hi]), Ends::Apart) if lo < hi => Ok(Some([lo, hi])),
+            (_, Ends::MayMeet) => Err(self.error(key, "expected [lo, hi] with lo <= hi")),
+            (_, Ends::Apart) => Err(self.error(key, "expected [lo, hi] with lo < hi")),
+        }
+    }
+
+    /// An optional `key = { column = value, ... }` row filter, the one `where` of every kind:
+    /// each value a number or a string, matched by equality ([`crate::table::matching_rows`]).
+    pub fn equality_filter(&mut self, key: &str) -> Result<Vec<(String, Match)>, PipelineError> {
         let Some(table) = self.optional::<toml::Table>(key)? else {
             return Ok(Vec::new());
         };
-        let mut f = self.nested(key, table);
-        f.keys()
-            .into_iter()
-            .map(|column| Ok((column.clone(), f.required::<f64>(&column)?)))
-            .collect()
+        let f = self.nested(key, table);
+        let mut filter = Vec::with_capacity(f.table.len());
+        for (column, value) in &f.table {
+            let m = match value {
+                toml::Value::Float(x) => Match::Number(*x),
+                toml::Value::Integer(i) => Match::Number(*i as f64),
+                toml::Value::String(s) => Match::Text(s.clone()),
+                _ => return Err(f.error(column, "expected a number or a string")),
+            };
+            filter.push((column.clone(), m));
+        }
+        Ok(filter)
     }
 
     /// `key = [{ ... }, ...]`: each table as its own [`Fields`] (keys `key[i].…`), none when
@@ -133,6 +157,15 @@ impl<'a> Fields<'a> {
             Some(key) => Err(self.error(key, "unknown key")),
         }
     }
+}
+
+/// How the ends of a `[lo, hi]` range may compare ([`Fields::interval`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ends {
+    /// `lo <= hi`: a closed range, possibly one point.
+    MayMeet,
+    /// `lo < hi`: a range of positive width (an axis, a search box).
+    Apart,
 }
 
 /// A Rust type a TOML value converts to.

@@ -44,8 +44,45 @@ impl Manifest {
         serde_json::to_string(self).unwrap_or_default()
     }
 
+    /// The value at `path` in the manifest's JSON ([`lookup`]).
+    pub fn lookup(&self, path: &str) -> Option<Value> {
+        lookup(&serde_json::to_value(self).ok()?, path).cloned()
+    }
+
     /// Parses [`Manifest::to_json_text`]'s output.
     pub fn from_json_text(text: &str) -> Result<Self, serde_json::Error> {
         serde_json::from_str(text)
+    }
+}
+
+/// The one way a manifest value is addressed, by render titles and report sources alike:
+/// dotted keys from the top (`summary.tolerance`, `params.scene.defect.0.eps`), a number
+/// indexing an array. A path starting with `/` is read as a JSON pointer
+/// (`/summary/tolerance`), the same keys with slashes.
+pub fn lookup<'v>(value: &'v Value, path: &str) -> Option<&'v Value> {
+    let keys = match path.strip_prefix('/') {
+        Some(pointer) => pointer.split('/'),
+        None => path.split('.'),
+    };
+    keys.filter(|k| !k.is_empty())
+        .try_fold(value, |v, k| match (v, k.parse::<usize>()) {
+            (Value::Array(items), Ok(i)) => items.get(i),
+            _ => v.get(k),
+        })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dotted_paths_and_pointers_address_the_same_values() {
+        let v = serde_json::json!({"summary": {"tol": 1e-6}, "params": {"d": [{"eps": 2.0}]}});
+        assert_eq!(lookup(&v, "summary.tol"), Some(&serde_json::json!(1e-6)));
+        assert_eq!(lookup(&v, "/summary/tol"), lookup(&v, "summary.tol"));
+        assert_eq!(lookup(&v, "params.d.0.eps"), Some(&serde_json::json!(2.0)));
+        assert_eq!(lookup(&v, "/params/d/0/eps"), Some(&serde_json::json!(2.0)));
+        assert_eq!(lookup(&v, "params.d.1.eps"), None);
+        assert_eq!(lookup(&v, "summary.missing"), None);
     }
 }

@@ -505,14 +505,28 @@ fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 /// The rows of `frame` where every `(column, value)` of `filter` holds (all rows if empty).
-pub fn matching_rows(frame: &DataFrame, filter: &[(String, f64)]) -> Result<Vec<usize>> {
-    let columns: Vec<(Vec<Option<f64>>, f64)> = filter
-        .iter()
-        .map(|(c, v)| Ok((f64_column(frame, c)?, *v)))
-        .collect::<Result<_>>()?;
+pub fn matching_rows(frame: &DataFrame, filter: &[(String, Match)]) -> Result<Vec<usize>> {
+    let mut numbers: Vec<(Vec<Option<f64>>, f64)> = Vec::new();
+    let mut texts: Vec<(Vec<Option<String>>, &str)> = Vec::new();
+    for (column, m) in filter {
+        match m {
+            Match::Number(x) => numbers.push((f64_column(frame, column)?, *x)),
+            Match::Text(t) => texts.push((str_column(frame, column)?, t)),
+        }
+    }
     Ok((0..frame.height())
-        .filter(|&r| columns.iter().all(|(col, v)| col[r] == Some(*v)))
+        .filter(|&r| numbers.iter().all(|(col, v)| col[r] == Some(*v)))
+        .filter(|&r| texts.iter().all(|(col, t)| col[r].as_deref() == Some(*t)))
         .collect())
+}
+
+/// One equality of a row filter (`where = { column = value }`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Match {
+    /// The number in a numeric column.
+    Number(f64),
+    /// The string in a string column.
+    Text(String),
 }
 
 /// A column of `frame` as strings, nulls kept.

@@ -8,6 +8,7 @@
 
 mod colour;
 mod draw;
+mod grid;
 
 use std::sync::OnceLock;
 
@@ -15,6 +16,7 @@ use plotters::prelude::*;
 
 pub use colour::{diverging, viridis};
 pub use draw::{cell_edges, tick};
+pub use grid::Grid;
 
 /// Drawing failed.
 #[derive(Debug, thiserror::Error)]

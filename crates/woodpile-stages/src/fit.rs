@@ -4,7 +4,7 @@
 //! kind = "fit"
 //! inputs = ["f4_fractions"]
 //! x = "eps"
-//! where = { L = 0 }                        # optional: keep rows where these columns equal these values
+//! where = { L = 0 }                        # optional: keep rows where these columns equal these values (numbers or strings)
 //! [[model]]
 //! name = "T1"
 //! y = "T"
@@ -25,10 +25,10 @@ use serde_json::json;
 
 use woodpile_analysis::lm::{fit, Fit, Form};
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::fields::{Ends, Fields};
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
-use woodpile_pipeline::table::{f64_column, matching_rows, rows_frame, Cell, Row};
+use woodpile_pipeline::table::{f64_column, matching_rows, rows_frame, Cell, Match, Row};
 use woodpile_pipeline::Output;
 
 /// A parsed fit stage.
@@ -37,7 +37,7 @@ pub struct FitStage {
     /// The x column.
     pub x: String,
     /// Row filter: column = value.
-    pub filter: Vec<(String, f64)>,
+    pub filter: Vec<(String, Match)>,
     /// The models.
     pub models: Vec<Model>,
 }
@@ -100,11 +100,7 @@ impl FitStage {
                 .ok_or_else(|| f.error("start", "missing (expected [A, B, C])"))?;
             let paper = f.take("paper");
             let paper = triple(&f, "paper", paper)?;
-            let x_range = match f.optional::<Vec<f64>>("x_range")?.as_deref() {
-                None => None,
-                Some(&[lo, hi]) if lo <= hi => Some([lo, hi]),
-                Some(_) => return Err(f.error("x_range", "expected [lo, hi] with lo <= hi")),
-            };
+            let x_range = f.interval("x_range", Ends::MayMeet)?;
             f.finish()?;
             models.push(Model {
                 name,

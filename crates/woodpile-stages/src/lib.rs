@@ -20,6 +20,7 @@ pub mod render;
 pub mod report;
 #[cfg(feature = "testing")]
 pub mod sampling;
+pub mod schema;
 pub mod spacetime;
 pub mod stability;
 pub mod sweep;

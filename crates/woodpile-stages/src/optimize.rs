@@ -31,10 +31,9 @@ use serde_json::json;
 use woodpile_sim::run::{simulate, Outcome};
 
 use crate::reduce::Reduce;
-use crate::reduce::MAXIMIZABLE;
 use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::fields::{Ends, Fields};
 use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::layout::best_path;
@@ -42,11 +41,13 @@ use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, Columns};
 use woodpile_pipeline::Output;
 
+use crate::schema::Fraction;
+
 /// A parsed optimize stage.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Optimize {
-    /// The column maximised.
-    pub column: String,
+    /// The fraction maximised.
+    pub column: Fraction,
     /// The axes searched.
     pub over: Vec<String>,
     /// Scene tolerance of the refinement runs.
@@ -69,10 +70,12 @@ const MAX_EVALUATIONS: usize = 120;
 
 impl Optimize {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Optimize> {
-        let column: String = fields.optional("column")?.unwrap_or_else(|| "E_tr".into());
-        if !MAXIMIZABLE.contains(&column.as_str()) {
-            return Err(fields.error("column", format!("expected one of {MAXIMIZABLE:?}")));
-        }
+        let column: String = fields
+            .optional("column")?
+            .unwrap_or_else(|| Fraction::Trapped.column().into());
+        let Some(column) = Fraction::named(&column) else {
+            return Err(fields.error("column", format!("expected one of {}", Fraction::listed())));
+        };
         let over: Vec<String> = fields.required("over")?;
         if over.is_empty() {
             return Err(fields.error("over", "name at least one axis"));
@@ -83,31 +86,13 @@ impl Optimize {
         }
         let mut bounds = Vec::new();
         if let Some(table) = fields.optional::<toml::Table>("bounds")? {
-            for (name, value) in table {
-                let pair = match &value {
-                    toml::Value::Array(items) => match items.as_slice() {
-                        [a, b] => a
-                            .as_float()
-                            .or(a.as_integer().map(|i| i as f64))
-                            .zip(b.as_float().or(b.as_integer().map(|i| i as f64))),
-                        _ => None,
-                    },
-                    _ => None,
-                };
-                match pair {
-                    Some((lo, hi)) if lo.is_finite() && hi.is_finite() && lo < hi => {
-                        if !over.contains(&name) {
-                            return Err(fields.error(
-                                &format!("bounds.{name}"),
-                                "bounds only axes named in `over`",
-                            ));
-                        }
-                        bounds.push((name, lo, hi));
+            let mut f = fields.nested("bounds", table);
+            for name in f.keys() {
+                if let Some([lo, hi]) = f.interval(&name, Ends::Apart)? {
+                    if !over.contains(&name) {
+                        return Err(f.error(&name, "bounds only axes named in `over`"));
                     }
-                    _ => {
-                        return Err(fields
-                            .error(&format!("bounds.{name}"), "expected [lo, hi] with lo < hi"))
-                    }
+                    bounds.push((name, lo, hi));
                 }
             }
         }
@@ -150,7 +135,7 @@ impl Optimize {
     ) -> Result<Output> {
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let col = |name: &str| f64_column(input, name).map_err(|e| fail(e.to_string()));
-        let target = col(&self.column)?;
+        let target = col(self.column.column())?;
         let mut ranked: Vec<usize> = (0..input.height())
             .filter(|&r| target[r].is_some_and(f64::is_finite))
             .collect();
@@ -202,10 +187,9 @@ impl Optimize {
             evaluated.borrow_mut().push((values.to_vec(), out.clone()));
             Ok(out)
         };
-        let value_of = |out: &Outcome| match self.column.as_str() {
-            "R" => out.fractions.reflected,
-            "T" => out.fractions.transmitted,
-            _ => out.fractions.trapped,
+        let value_of = |out: &Outcome| {
+            let f = &out.fractions;
+            self.column.of(f.reflected, f.transmitted, f.trapped)
         };
         let grid_values_of = |row: usize| -> Result<Vec<AxisValue>> {
             sweep
@@ -324,7 +308,7 @@ impl Optimize {
         let text = toml::to_string(&table).map_err(|e| fail(e.to_string()))?;
         let header = format!(
             "# The optimum stage `{stage}` found: {} = {best_value} at t_end = {}, tolerance {:e}.\n# Run it with: woodpile simulate {}\n",
-            self.column,
+            self.column.column(),
             scene.scenario.t_end,
             self.tolerance,
             path.display()

@@ -14,17 +14,15 @@
 
 use serde_json::json;
 
+use crate::schema::{sweep, Fraction};
 use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::Axis;
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
-use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row as TableRow};
+use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row};
 use woodpile_pipeline::Output;
-
-/// Columns a maximisation may target.
-pub const MAXIMIZABLE: &[&str] = &["E_tr", "R", "T"];
 
 /// A parsed reduce stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,8 +36,8 @@ pub struct Reduce {
 /// Keep the best point per group.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Maximize {
-    /// The column maximised.
-    pub column: String,
+    /// The fraction maximised.
+    pub column: Fraction,
     /// The axes searched; the others form the groups.
     pub over: Vec<String>,
 }
@@ -54,10 +52,14 @@ impl Reduce {
             None => None,
             Some(table) => {
                 let mut m = fields.nested("maximize", table);
-                let column: String = m.optional("column")?.unwrap_or_else(|| "E_tr".into());
-                if !MAXIMIZABLE.contains(&column.as_str()) {
-                    return Err(m.error("column", format!("expected one of {MAXIMIZABLE:?}")));
-                }
+                let column: String = m
+                    .optional("column")?
+                    .unwrap_or_else(|| Fraction::Trapped.column().into());
+                let Some(column) = Fraction::named(&column) else {
+                    return Err(
+                        m.error("column", format!("expected one of {}", Fraction::listed()))
+                    );
+                };
                 let over: Vec<String> = m.required("over")?;
                 if over.is_empty() {
                     return Err(m.error("over", "name at least one axis"));
@@ -113,7 +115,7 @@ struct Reduced<'a> {
     pick: &'a Pick,
 }
 
-impl TableRow for Reduced<'_> {
+impl Row for Reduced<'_> {
     fn cells(&self) -> Vec<(&str, Cell)> {
         let p = self.pick;
         let mut cells: Vec<(&str, Cell)> = self
@@ -128,20 +130,20 @@ impl TableRow for Reduced<'_> {
                 (axis.name.as_str(), cell)
             })
             .collect();
-        let at = |f: fn(&Row) -> f64| p.row.as_ref().map(f);
+        let at = |f: fn(&Sample) -> f64| p.row.as_ref().map(f);
         cells.extend([
-            ("t", at(|r| r.t).into()),
-            ("R", at(|r| r.r).into()),
-            ("T", at(|r| r.tr).into()),
-            ("E_tr", at(|r| r.e_tr).into()),
-            ("E", at(|r| r.e).into()),
+            (sweep::TIME, at(|r| r.t).into()),
+            (Fraction::Reflected.column(), at(|r| r.r).into()),
+            (Fraction::Transmitted.column(), at(|r| r.tr).into()),
+            (Fraction::Trapped.column(), at(|r| r.e_tr).into()),
+            (sweep::ENERGY, at(|r| r.e).into()),
             (
-                "error_estimate",
+                sweep::ERROR_ESTIMATE,
                 p.row.and_then(|r| r.error_estimate).into(),
             ),
             ("points", Cell::from(p.points as i64)),
             ("failed", Cell::from(p.failed as i64)),
-            ("failure", p.failure.clone().into()),
+            (sweep::FAILURE, p.failure.clone().into()),
         ]);
         cells
     }
@@ -149,7 +151,7 @@ impl TableRow for Reduced<'_> {
 
 /// One sample row of a sweep.
 #[derive(Debug, Clone, Copy)]
-struct Row {
+struct Sample {
     t: f64,
     r: f64,
     tr: f64,
@@ -162,7 +164,7 @@ struct Row {
 #[derive(Debug, Clone)]
 struct Pick {
     axes: Vec<f64>,
-    row: Option<Row>,
+    row: Option<Sample>,
     points: usize,
     failed: usize,
     failure: Option<String>,
@@ -184,23 +186,23 @@ struct SweepRows {
 impl SweepRows {
     fn read(frame: &polars::prelude::DataFrame, axes: &[Axis]) -> Result<Self> {
         Ok(Self {
-            point: f64_column(frame, "point")?,
+            point: f64_column(frame, sweep::POINT)?,
             axes: axes
                 .iter()
                 .map(|a| f64_column(frame, &a.name))
                 .collect::<Result<_>>()?,
-            t: f64_column(frame, "t")?,
-            r: f64_column(frame, "R")?,
-            tr: f64_column(frame, "T")?,
-            e_tr: f64_column(frame, "E_tr")?,
-            e: f64_column(frame, "E")?,
-            error_estimate: f64_column(frame, "error_estimate")?,
-            failure: str_column(frame, "failure")?,
+            t: f64_column(frame, sweep::TIME)?,
+            r: f64_column(frame, Fraction::Reflected.column())?,
+            tr: f64_column(frame, Fraction::Transmitted.column())?,
+            e_tr: f64_column(frame, Fraction::Trapped.column())?,
+            e: f64_column(frame, sweep::ENERGY)?,
+            error_estimate: f64_column(frame, sweep::ERROR_ESTIMATE)?,
+            failure: str_column(frame, sweep::FAILURE)?,
         })
     }
 
-    fn row(&self, i: usize) -> Option<Row> {
-        Some(Row {
+    fn row(&self, i: usize) -> Option<Sample> {
+        Some(Sample {
             t: self.t[i]?,
             r: self.r[i]?,
             tr: self.tr[i]?,
@@ -274,13 +276,7 @@ fn maximize(picks: &[Pick], axes: &[Axis], m: &Maximize) -> Vec<Pick> {
             .map(|&k| p.axes[k].to_bits())
             .collect::<Vec<u64>>()
     };
-    let value = |p: &Pick| {
-        p.row.map(|r| match m.column.as_str() {
-            "R" => r.r,
-            "T" => r.tr,
-            _ => r.e_tr,
-        })
-    };
+    let value = |p: &Pick| p.row.map(|r| m.column.of(r.r, r.tr, r.e_tr));
     let mut order: Vec<Vec<u64>> = Vec::new();
     let mut best: std::collections::HashMap<Vec<u64>, Pick> = std::collections::HashMap::new();
     for p in picks {

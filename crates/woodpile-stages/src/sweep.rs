@@ -47,6 +47,8 @@ use woodpile_pipeline::table::{rows_frame, Cell, Row};
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
 
+use crate::schema::{sweep as columns, Fraction};
+
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]
 pub struct Sweep {
@@ -228,7 +230,7 @@ struct SampleRow<'a> {
 
 impl Row for SampleRow<'_> {
     fn cells(&self) -> Vec<(&str, Cell)> {
-        let mut cells = vec![("point", Cell::from(self.point as i64))];
+        let mut cells = vec![(columns::POINT, Cell::from(self.point as i64))];
         for (axis, value) in self.axes.iter().zip(&self.values) {
             let cell = match (axis.is_integer(), *value) {
                 (true, AxisValue::Int(i)) => Cell::from(i),
@@ -240,18 +242,27 @@ impl Row for SampleRow<'_> {
         let ok = self.result.as_ref().ok();
         let at = |series: fn(&PointData) -> &Vec<f64>| ok.map(|p| series(p)[self.sample]);
         cells.extend([
-            ("t", at(|p| &p.t).into()),
-            ("R", at(|p| &p.reflected).into()),
-            ("T", at(|p| &p.transmitted).into()),
-            ("E_tr", at(|p| &p.trapped).into()),
-            ("E", at(|p| &p.energy).into()),
-            ("method", ok.map(|p| p.method.clone()).into()),
-            ("dt", ok.and_then(|p| p.dt).into()),
-            ("steps", ok.map(|p| p.steps as i64).into()),
-            ("error_estimate", ok.and_then(|p| p.error_estimate).into()),
-            ("energy_drift", ok.and_then(|p| p.energy_drift).into()),
-            ("failure", self.result.as_ref().err().cloned().into()),
-            ("scene_key", self.key.to_string().into()),
+            (columns::TIME, at(|p| &p.t).into()),
+            (Fraction::Reflected.column(), at(|p| &p.reflected).into()),
+            (
+                Fraction::Transmitted.column(),
+                at(|p| &p.transmitted).into(),
+            ),
+            (Fraction::Trapped.column(), at(|p| &p.trapped).into()),
+            (columns::ENERGY, at(|p| &p.energy).into()),
+            (columns::METHOD, ok.map(|p| p.method.clone()).into()),
+            (columns::DT, ok.and_then(|p| p.dt).into()),
+            (columns::STEPS, ok.map(|p| p.steps as i64).into()),
+            (
+                columns::ERROR_ESTIMATE,
+                ok.and_then(|p| p.error_estimate).into(),
+            ),
+            (
+                columns::ENERGY_DRIFT,
+                ok.and_then(|p| p.energy_drift).into(),
+            ),
+            (columns::FAILURE, self.result.as_ref().err().cloned().into()),
+            (columns::SCENE_KEY, self.key.to_string().into()),
         ]);
         cells
     }

@@ -1,0 +1,106 @@
+//! A layout made a scene and simulated through the point cache, and its result scored.
+
+use rayon::prelude::*;
+use woodpile_scene::Scene;
+
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::events::Events;
+use woodpile_pipeline::points::{point_key, PointResult, PointStore, Series};
+
+use super::{Design, Evaluated, Layout, Search};
+use crate::schema::Fraction;
+
+impl Design {
+    /// The scene table of `layout` (with `run.tolerance` replaced when given).
+    pub(super) fn table(&self, layout: &Layout, tolerance: Option<f64>) -> toml::Table {
+        let mut table = self.template.clone();
+        let defects = layout
+            .resonators
+            .iter()
+            .map(|r| {
+                let mut d = toml::Table::new();
+                d.insert("site".into(), toml::Value::Integer(r.site));
+                d.insert("eps".into(), toml::Value::Float(r.eps));
+                d.insert("kappa".into(), toml::Value::Float(r.kappa));
+                d.insert("p".into(), toml::Value::Integer(r.p));
+                toml::Value::Table(d)
+            })
+            .collect();
+        table.insert("defect".into(), toml::Value::Array(defects));
+        if let Some(tol) = tolerance {
+            if let Some(toml::Value::Table(run)) = table.get_mut("run") {
+                run.insert("tolerance".into(), toml::Value::Float(tol));
+            }
+        }
+        table
+    }
+
+    pub(super) fn scene(&self, layout: &Layout, tolerance: Option<f64>) -> Result<Scene> {
+        woodpile_scene::from_table(self.table(layout, tolerance), &self.file)
+            .map_err(|e| PipelineError::scene(&self.file, "scene", e, ""))
+    }
+
+    /// The objective of a result, as a score to maximise (failures and infeasible designs
+    /// score -inf, so any working design beats them).
+    pub(super) fn score(&self, result: &PointResult) -> f64 {
+        let Ok(data) = result else {
+            return f64::NEG_INFINITY;
+        };
+        let series = match self.objective {
+            Fraction::Reflected => &data.reflected,
+            Fraction::Transmitted => &data.transmitted,
+            Fraction::Trapped => &data.trapped,
+        };
+        match series.last() {
+            Some(&v) if v.is_finite() => {
+                if self.maximise {
+                    v
+                } else {
+                    -v
+                }
+            }
+            _ => f64::NEG_INFINITY,
+        }
+    }
+
+    /// Evaluates `layouts` in parallel through the point cache, in order.
+    pub(super) fn evaluate(
+        &self,
+        search: Search,
+        layouts: Vec<Layout>,
+        tolerance: Option<f64>,
+        store: &PointStore,
+        events: &dyn Events,
+    ) -> Result<Vec<Evaluated>> {
+        layouts
+            .into_par_iter()
+            .map(|layout| {
+                if let Some(bound) = self.space.max_total_eps {
+                    if layout.total_eps() > bound {
+                        let reason =
+                            format!("total eps {} above the bound {bound}", layout.total_eps());
+                        return Ok(Evaluated {
+                            search,
+                            layout,
+                            result: Err(reason),
+                            score: f64::NEG_INFINITY,
+                            key: String::new(),
+                        });
+                    }
+                }
+                let scene = self.scene(&layout, tolerance)?;
+                let key = point_key(&scene, Series::Energy);
+                let result = store.get_or_simulate(&key, &scene, Series::Energy)?;
+                events.point_done();
+                let score = self.score(&result);
+                Ok(Evaluated {
+                    search,
+                    layout,
+                    result,
+                    score,
+                    key: key.to_string(),
+                })
+            })
+            .collect()
+    }
+}

@@ -1,0 +1,467 @@
+//! `kind = "design"`: inverse design. Search a space of resonator layouts — how many
+//! resonators, on which sites, with which eps, kappa and p — for the scene that maximises (or
+//! minimises) a fraction at the read-out time `run.t_end`, around a scene template that fixes
+//! the chain, the impulse, the run and the fractions' region.
+//!
+//! ```toml
+//! kind = "design"
+//! seed = 2026                         # the search is a function of the seed, for any thread count
+//! budget = 1500                       # evaluations for the optimiser, and again for random search
+//! refine = 150                        # Nelder–Mead evaluations polishing the best candidate
+//! objective = "E_tr"                  # E_tr, R or T
+//! goal = "max"                        # or "min"
+//! verify_tolerance = 1e-8             # the best design is simulated again at this tolerance
+//! robustness = { samples = 200, spreads = [0.01, 0.05] }   # optional: every eps and kappa off by ±spread
+//! [scene]                             # a scene file without defects; its fractions region is required
+//! chain = { n = 100, boundary = "fixed" }
+//! impulse = { site = -25, velocity = 1.0 }
+//! run = { t_end = 150.0, method = "auto", tolerance = 1e-6 }
+//! fractions = { region = [-1, 21] }
+//! [space]
+//! resonators = [1, 4]                 # how many, inclusive
+//! sites = [0, 20]                     # paper sites they may occupy (one resonator per site)
+//! # sites = [0, 10, 20]               # or: only these sites (also { among = [0, 10] })
+//! # sites = { fixed = [0, 10, 20] }   # or: one resonator on each of these (then `resonators` may go)
+//! eps = { min = 0.1, max = 100.0, log = true }   # or a list of the values allowed: [0.5, 1.0, 2.0]
+//! kappa = { min = 0.1, max = 10.0, log = true }
+//! p = [1]                             # allowed coupling exponents
+//! max_total_eps = 200.0               # optional: a bound on the added mass, sum of eps
+//! ```
+//!
+//! The optimiser is differential evolution (DE/rand/1/bin, population 20, F = 0.6, CR = 0.9)
+//! on a genome in [0, 1]^(1 + 4 K) (the count, then site, eps, kappa, p for K slots), decoded
+//! to a scene with its defects sorted by site, so equal designs share one cached point. Random
+//! search of the same budget is the baseline it must beat. The best candidate of each search
+//! is refined by Nelder–Mead, the robustness study samples around the best of the searches, and
+//! the best design any evaluation found (a robustness sample included) is verified and written:
+//! when the baseline's beats the optimiser's, the summary says so (`best_search`,
+//! `baseline_beat_optimiser`). Every evaluation is a scene through
+//! the point cache: an interrupted or extended search repeats no simulation. A generation's
+//! scenes are simulated in parallel and used in a fixed order, so the result depends on the
+//! seed alone.
+//!
+//! Output: one row per evaluation (`search`: differential evolution, random, refinement,
+//! verification, robustness ±s), with the design (`resonators`, and `sites`, `eps`, `kappa`
+//! and `p` as list columns, `total_eps`), the fractions, the error estimate, `best_so_far` within its search,
+//! `quantile` (a robustness sample's rank among its spread's samples) and `failure`; and `results/<stage>.best.toml`, the best design as a scene file that
+//! `woodpile simulate` runs as it is.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::json;
+use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64};
+
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::events::Events;
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::layout::best_path;
+use woodpile_pipeline::points::{PointResult, PointStore};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::Output;
+
+use crate::schema::Fraction;
+
+mod evaluate;
+mod search;
+mod space;
+mod trials;
+
+pub use space::{Layout, Range, Resonator, Sites, Space, Values};
+
+pub use search::Search;
+
+use space::{parse_space, round_sig, GENES};
+
+/// Differential evolution's population: a design's budget is at least one generation.
+const POPULATION: usize = DifferentialEvolution::POPULATION;
+
+/// A parsed design stage.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Design {
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Evaluations for each of the optimiser and the random baseline.
+    pub budget: usize,
+    /// Nelder–Mead evaluations on the best candidate.
+    pub refine: usize,
+    /// Which fraction.
+    pub objective: Fraction,
+    /// Maximise (true) or minimise.
+    pub maximise: bool,
+    /// Tolerance of the best design's verification run.
+    pub verify_tolerance: f64,
+    /// Perturbation study of the best design: samples per spread, and the spreads.
+    pub robustness: Option<(usize, Vec<f64>)>,
+    /// The search space.
+    pub space: Space,
+    template: toml::Table,
+    file: PathBuf,
+}
+
+/// One evaluated design.
+#[derive(Debug, Clone)]
+struct Evaluated {
+    search: Search,
+    layout: Layout,
+    result: PointResult,
+    score: f64,
+    key: String,
+}
+
+impl Design {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Design> {
+        let positive_int = |fields: &mut Fields<'_>, key: &str, default: Option<i64>| {
+            let value = match (fields.optional::<i64>(key)?, default) {
+                (Some(v), _) => v,
+                (None, Some(d)) => d,
+                (None, None) => return Err(fields.error(key, "is required")),
+            };
+            if !(0..=1_000_000).contains(&value) {
+                return Err(fields.error(key, "expected an integer from 0 to 1000000"));
+            }
+            Ok(value as usize)
+        };
+        let seed = fields.required::<i64>("seed")? as u64;
+        let budget = positive_int(fields, "budget", None)?;
+        if budget < POPULATION {
+            return Err(fields.error("budget", format!("at least {POPULATION} evaluations")));
+        }
+        let refine = positive_int(fields, "refine", Some(0))?;
+        let objective = fields.required::<String>("objective")?;
+        let Some(objective) = Fraction::named(&objective) else {
+            return Err(fields.error(
+                "objective",
+                format!("expected \"E_tr\", \"R\" or \"T\", got \"{objective}\""),
+            ));
+        };
+        let maximise = match fields.optional::<String>("goal")?.as_deref() {
+            None | Some("max") => true,
+            Some("min") => false,
+            Some(other) => {
+                return Err(fields.error(
+                    "goal",
+                    format!("expected \"max\" or \"min\", got \"{other}\""),
+                ))
+            }
+        };
+        let verify_tolerance = fields.optional::<f64>("verify_tolerance")?.unwrap_or(1e-8);
+        let robustness = match fields.optional::<toml::Table>("robustness")? {
+            None => None,
+            Some(table) => {
+                let mut f = fields.nested("robustness", table);
+                let samples = positive_int(&mut f, "samples", None)?;
+                let spreads: Vec<f64> = f.required("spreads")?;
+                if spreads.iter().any(|s| !(0.0..1.0).contains(s)) {
+                    return Err(f.error("spreads", "expected fractions in [0, 1)"));
+                }
+                f.finish()?;
+                Some((samples, spreads))
+            }
+        };
+        let Some(space) = fields.optional::<toml::Table>("space")? else {
+            return Err(fields.error("space", "is required"));
+        };
+        let space = parse_space(fields.nested("space", space))?;
+        let template: toml::Table = fields.required("scene")?;
+        if template.contains_key("defect") {
+            return Err(fields.error(
+                "scene.defect",
+                "the design places the defects: leave them out",
+            ));
+        }
+        let region = template
+            .get("fractions")
+            .and_then(|f| f.get("region"))
+            .is_some();
+        if !region {
+            return Err(fields.error(
+                "scene.fractions.region",
+                "is required: the trap's region must not move with the design",
+            ));
+        }
+        let design = Design {
+            seed,
+            budget,
+            refine,
+            objective,
+            maximise,
+            verify_tolerance,
+            robustness,
+            space,
+            template,
+            file: fields.file().to_path_buf(),
+        };
+        // The extremes of the space must make valid scenes: catch a bad template now.
+        let dimension = design.space.dimension();
+        for corner in [0.0, 1.0 - 1e-12] {
+            design.scene(&design.space.decode(&vec![corner; dimension]), None)?;
+        }
+        Ok(design)
+    }
+
+    pub(crate) fn run(
+        &self,
+        stage: &str,
+        store: &PointStore,
+        results: &Path,
+        events: &dyn Events,
+    ) -> Result<Output> {
+        let d = self.space.dimension();
+        let robust: usize = self
+            .robustness
+            .as_ref()
+            .map_or(0, |(samples, spreads)| samples * spreads.len());
+        let total = 2 * self.budget + self.refine + 1 + robust;
+        events.simulating(stage, total, 0);
+        let mut rows: Vec<Evaluated> = Vec::with_capacity(total);
+
+        // Differential evolution, a generation at a time.
+        let mut de = DifferentialEvolution::new(d, SplitMix64(self.seed ^ 0xde));
+        let layouts = de
+            .population()
+            .iter()
+            .map(|g| self.space.decode(g))
+            .collect();
+        let first = self.evaluate(Search::DifferentialEvolution, layouts, None, store, events)?;
+        de.start(first.iter().map(|e| e.score).collect());
+        rows.extend(first);
+        let mut spent = POPULATION;
+        while spent < self.budget {
+            let trials = de.trials(POPULATION.min(self.budget - spent));
+            let layouts = trials.iter().map(|g| self.space.decode(g)).collect();
+            let evaluated =
+                self.evaluate(Search::DifferentialEvolution, layouts, None, store, events)?;
+            let scores: Vec<f64> = evaluated.iter().map(|e| e.score).collect();
+            spent += trials.len();
+            de.select(trials, &scores);
+            rows.extend(evaluated);
+        }
+
+        // Random search of the same budget: the baseline.
+        let random_genomes = random_points(d, self.budget, &mut SplitMix64(self.seed ^ 0x5eed));
+        let layouts = random_genomes
+            .iter()
+            .map(|g| self.space.decode(g))
+            .collect();
+        let random_rows = self.evaluate(Search::Random, layouts, None, store, events)?;
+        let random_best = (0..random_rows.len())
+            .max_by(|&a, &b| random_rows[a].score.total_cmp(&random_rows[b].score));
+        rows.extend(random_rows.iter().cloned());
+
+        // Refinement: Nelder–Mead on the eps and kappa genes of each search's best candidate,
+        // its count and sites fixed.
+        let mut starts = Vec::new();
+        if let Some((genome, score)) = de.best() {
+            starts.push((Search::Refinement, genome.to_vec(), score));
+        }
+        if let Some(i) = random_best {
+            starts.push((
+                Search::RefinementOfRandom,
+                random_genomes[i].clone(),
+                random_rows[i].score,
+            ));
+        }
+        for (label, start, score) in starts {
+            rows.extend(self.refine_from(stage, label, &start, score, store, events)?);
+        }
+
+        // The best design of the searches; the robustness study is around it.
+        let best = rows
+            .iter()
+            .max_by(|a, b| a.score.total_cmp(&b.score))
+            .cloned()
+            .ok_or_else(|| PipelineError::stage(stage, "no design was evaluated"))?;
+        if !best.score.is_finite() {
+            return Err(PipelineError::stage(stage, "every design failed"));
+        }
+
+        // Robustness: the best design with every eps and kappa off by up to ±spread.
+        if let Some((samples, spreads)) = &self.robustness {
+            for (k, &spread) in spreads.iter().enumerate() {
+                let mut rng = SplitMix64(self.seed ^ (0x7000 + k as u64));
+                let layouts = (0..*samples)
+                    .map(|_| Layout {
+                        resonators: best
+                            .layout
+                            .resonators
+                            .iter()
+                            .map(|r| {
+                                let mut wobble = |x: f64| {
+                                    round_sig(x * (1.0 + spread * (2.0 * rng.uniform() - 1.0)))
+                                };
+                                Resonator {
+                                    eps: wobble(r.eps),
+                                    kappa: wobble(r.kappa),
+                                    ..*r
+                                }
+                            })
+                            .collect(),
+                    })
+                    .collect();
+                let label = Search::robustness(spread);
+                // In order of E_tr: the table then reads as the distribution's quantiles.
+                let mut samples = self.evaluate(label, layouts, None, store, events)?;
+                samples.sort_by(|a, b| a.score.total_cmp(&b.score));
+                rows.extend(samples);
+            }
+        }
+
+        // The best design any evaluation found (a robustness sample may beat the searches'),
+        // verified at the tight tolerance: what the best file holds.
+        let best = rows
+            .iter()
+            .max_by(|a, b| a.score.total_cmp(&b.score))
+            .cloned()
+            .unwrap_or(best);
+        let verified = self
+            .evaluate(
+                Search::Verification,
+                vec![best.layout.clone()],
+                Some(self.verify_tolerance),
+                store,
+                events,
+            )?
+            .remove(0);
+        let verified_score = verified.score;
+        rows.push(verified.clone());
+
+        let best_file = best_path(results, stage);
+        let text = toml::to_string(&self.table(&verified.layout, Some(self.verify_tolerance)))
+            .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
+        let header = format!(
+            "# The best design found by stage `{stage}` (woodpile run {stage}): {} = {} at t_end,\n# verified at tolerance {:e}. Run it with: woodpile simulate {}\n",
+            self.objective_name(),
+            self.shown(verified_score),
+            self.verify_tolerance,
+            best_file.display()
+        );
+        woodpile_pipeline::atomic::write(&best_file, (header + &text).as_bytes())?;
+
+        let de_best = self.best_of(&rows, Search::DifferentialEvolution);
+        let random_best = self.best_of(&rows, Search::Random);
+        let refined = self.best_of(&rows, Search::Refinement);
+        let refined_random = self.best_of(&rows, Search::RefinementOfRandom);
+        let frame = self.frame(&rows)?;
+        Ok(Output {
+            frame,
+            summary: json!({
+                "objective": self.objective_name(),
+                "goal": if self.maximise { "max" } else { "min" },
+                "evaluations": rows.len(),
+                "best": self.shown(verified_score),
+                "best_error_estimate": verified.result.as_ref().ok().and_then(|p| p.error_estimate),
+                "best_sites": verified.layout.list(|r| r.site),
+                "best_eps": verified.layout.list(|r| r.eps),
+                "best_kappa": verified.layout.list(|r| r.kappa),
+                "differential_evolution_best": self.shown(de_best),
+                "random_best": self.shown(random_best),
+                "refined_best": self.shown(refined.max(de_best)),
+                "refined_random_best": self.shown(refined_random.max(random_best)),
+                "best_search": best.search.label(),
+                "baseline_beat_optimiser": refined_random.max(random_best) > refined.max(de_best),
+                "verify_tolerance": self.verify_tolerance,
+                "best_file": best_file.file_name().map(|n| n.to_string_lossy().into_owned()),
+            }),
+            failures: Vec::new(),
+        })
+    }
+
+    /// Nelder–Mead from `start` (score `score`) on the eps and kappa genes of its resonators,
+    /// within the `refine` budget; every trial a row labelled `label`.
+    fn refine_from(
+        &self,
+        stage: &str,
+        label: Search,
+        start: &[f64],
+        score: f64,
+        store: &PointStore,
+        events: &dyn Events,
+    ) -> Result<Vec<Evaluated>> {
+        if self.refine == 0 || !score.is_finite() {
+            return Ok(Vec::new());
+        }
+        let layout = self.space.decode(start);
+        let slots: Vec<usize> = (1..self.space.dimension())
+            .filter(|j| {
+                let gene = (j - 1) % GENES;
+                let slot = (j - 1) / GENES;
+                (gene == 1 || gene == 2) && slot < layout.resonators.len()
+            })
+            .collect();
+        let mut refined: Vec<Evaluated> = Vec::new();
+        let mut failure: Option<PipelineError> = None;
+        let mut objective = |x: &[f64]| -> Result<f64> {
+            let mut g = start.to_vec();
+            for (k, &j) in slots.iter().enumerate() {
+                g[j] = x[k].clamp(0.0, 1.0);
+            }
+            let layout = self.space.decode(&g);
+            match self.evaluate(label, vec![layout], None, store, events) {
+                Ok(mut e) => {
+                    let e = e.remove(0);
+                    let score = e.score;
+                    refined.push(e);
+                    Ok(score)
+                }
+                Err(err) => {
+                    failure = Some(PipelineError::stage(stage, err.to_string()));
+                    Ok(f64::NEG_INFINITY)
+                }
+            }
+        };
+        let x0: Vec<f64> = slots.iter().map(|&j| start[j]).collect();
+        if !x0.is_empty() {
+            let steps = vec![0.05; x0.len()];
+            woodpile_analysis::nelder_mead::maximise(
+                &mut objective,
+                &x0,
+                &steps,
+                score,
+                self.refine,
+            )?;
+        }
+        match failure {
+            Some(e) => Err(e),
+            None => Ok(refined),
+        }
+    }
+
+    fn objective_name(&self) -> &'static str {
+        self.objective.column()
+    }
+
+    /// A score back as the fraction.
+    fn shown(&self, score: f64) -> f64 {
+        if self.maximise {
+            score
+        } else {
+            -score
+        }
+    }
+
+    fn best_of(&self, rows: &[Evaluated], search: Search) -> f64 {
+        rows.iter()
+            .filter(|e| e.search == search)
+            .map(|e| e.score)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+impl Kind for Design {
+    fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
+        woodpile_pipeline::kind::Sharing::Parallel
+    }
+
+    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
+        no_inputs(stage)
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        self.run(ctx.name(), ctx.store, ctx.results, ctx.events)
+    }
+
+    fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
+        vec![best_path(results, stage)]
+    }
+}

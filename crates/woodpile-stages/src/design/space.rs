@@ -1,0 +1,407 @@
+//! The space a design searches: how many resonators, on which sites, with which eps, kappa
+//! and p; and the decoding of a genome in [0, 1]^d into one layout of it.
+
+use woodpile_pipeline::error::Result;
+use woodpile_pipeline::fields::Fields;
+
+/// A real parameter's range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound.
+    pub max: f64,
+    /// Searched on a log scale.
+    pub log: bool,
+}
+
+impl Range {
+    pub(super) fn at(&self, u: f64) -> f64 {
+        // The ends exactly: exp(ln 0.1) is not 0.1.
+        if u.is_nan() || u <= 0.0 {
+            return self.min;
+        }
+        if u >= 1.0 {
+            return self.max;
+        }
+        let x = if self.log {
+            (self.min.ln() + u * (self.max.ln() - self.min.ln())).exp()
+        } else {
+            self.min + u * (self.max - self.min)
+        };
+        x.clamp(self.min, self.max)
+    }
+}
+
+/// A parameter's values: a range, or a list to choose from (rods come in a few lengths).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Values {
+    /// Any value of the range.
+    Range(Range),
+    /// One of these.
+    List(Vec<f64>),
+}
+
+impl Values {
+    pub(super) fn at(&self, u: f64) -> f64 {
+        match self {
+            Values::Range(r) => r.at(u),
+            Values::List(values) => values[pick(u, values.len())],
+        }
+    }
+}
+
+/// Where resonators may go.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Sites {
+    /// Any paper site first..=last (`sites = [first, last]`).
+    Range(i64, i64),
+    /// Any of these sites (`sites = { among = [...] }`, or a list of three or more).
+    Among(Vec<i64>),
+    /// One resonator on each of these sites (`sites = { fixed = [...] }`): only the
+    /// parameters are searched.
+    Fixed(Vec<i64>),
+}
+
+impl Sites {
+    /// How many sites there are to choose from.
+    pub(super) fn count(&self) -> usize {
+        match self {
+            Sites::Range(a, b) => (b - a + 1).max(0) as usize,
+            Sites::Among(list) | Sites::Fixed(list) => list.len(),
+        }
+    }
+}
+
+/// The index `u` in [0, 1] picks among `n` choices.
+fn pick(u: f64, n: usize) -> usize {
+    ((u.clamp(0.0, 1.0) * n as f64) as usize).min(n.saturating_sub(1))
+}
+
+/// What may vary.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Space {
+    /// Fewest and most resonators.
+    pub resonators: (usize, usize),
+    /// Where they may go.
+    pub sites: Sites,
+    /// Mass ratio.
+    pub eps: Values,
+    /// Coupling.
+    pub kappa: Values,
+    /// Allowed exponents.
+    pub p: Vec<i64>,
+    /// Bound on the sum of eps.
+    pub max_total_eps: Option<f64>,
+}
+
+/// One resonator of a design.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resonator {
+    /// Its paper site.
+    pub site: i64,
+    /// Mass ratio.
+    pub eps: f64,
+    /// Coupling.
+    pub kappa: f64,
+    /// Coupling exponent.
+    pub p: i64,
+}
+
+/// One decoded design: resonators sorted by site.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    /// The resonators, by increasing site.
+    pub resonators: Vec<Resonator>,
+}
+
+impl Layout {
+    /// The added mass, the sum of eps.
+    pub fn total_eps(&self) -> f64 {
+        self.resonators.iter().map(|r| r.eps).sum()
+    }
+
+    /// One field of every resonator, as a comma-separated list.
+    pub fn list<T: std::fmt::Display>(&self, pick: impl Fn(&Resonator) -> T) -> String {
+        self.resonators
+            .iter()
+            .map(|r| pick(r).to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// Genes per resonator slot: site, eps, kappa, p.
+pub(super) const GENES: usize = 4;
+
+impl Space {
+    /// The genome's length: the count, then four genes per slot.
+    pub(super) fn dimension(&self) -> usize {
+        1 + GENES * self.resonators.1
+    }
+
+    /// The layout a genome in [0, 1]^d stands for: a resonator on a site already taken is
+    /// dropped, so every layout is valid and equal layouts come out equal.
+    pub(super) fn decode(&self, genome: &[f64]) -> Layout {
+        let (lo, hi) = self.resonators;
+        let count = lo + pick(genome[0], hi - lo + 1);
+        let mut resonators: Vec<Resonator> = Vec::with_capacity(count);
+        for slot in 0..count {
+            let g = &genome[1 + GENES * slot..1 + GENES * (slot + 1)];
+            let site = match &self.sites {
+                Sites::Range(first, last) => first + pick(g[0], (last - first + 1) as usize) as i64,
+                Sites::Among(list) => list[pick(g[0], list.len())],
+                Sites::Fixed(list) => list[slot],
+            };
+            if resonators.iter().any(|r| r.site == site) {
+                continue;
+            }
+            let eps = round_sig(self.eps.at(g[1]));
+            let kappa = round_sig(self.kappa.at(g[2]));
+            resonators.push(Resonator {
+                site,
+                eps,
+                kappa,
+                p: self.p[pick(g[3], self.p.len())],
+            });
+        }
+        resonators.sort_by_key(|r| r.site);
+        Layout { resonators }
+    }
+}
+
+/// 10 significant digits: a design file states its numbers exactly as they were simulated,
+/// and nearby genomes share cached points.
+pub(super) fn round_sig(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let digits = 9 - x.abs().log10().floor() as i32;
+    let scale = 10f64.powi(digits);
+    (x * scale).round() / scale
+}
+
+pub(super) fn parse_space(mut f: Fields<'_>) -> Result<Space> {
+    let sites = parse_sites(&mut f)?;
+    let (lo, hi) = match (&sites, f.optional::<toml::Value>("resonators")?) {
+        (Sites::Fixed(list), None) => (list.len() as i64, list.len() as i64),
+        (_, None) => return Err(f.error("resonators", "is required: [fewest, most]")),
+        (_, Some(toml::Value::Array(items))) => match items.as_slice() {
+            [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => (*a, *b),
+            _ => {
+                return Err(f.error(
+                    "resonators",
+                    "expected [fewest, most], integers with fewest <= most",
+                ))
+            }
+        },
+        (_, Some(_)) => return Err(f.error("resonators", "expected [fewest, most]")),
+    };
+    if lo < 0 || !(1..=64).contains(&hi) {
+        return Err(f.error(
+            "resonators",
+            "expected counts from 0 to 64, at least one resonator possible",
+        ));
+    }
+    if let Sites::Fixed(list) = &sites {
+        if (lo, hi) != (list.len() as i64, list.len() as i64) {
+            return Err(f.error(
+                "resonators",
+                format!(
+                    "with fixed sites there is one resonator per site: [{0}, {0}] (or leave it out)",
+                    list.len()
+                ),
+            ));
+        }
+    }
+    if (sites.count() as i64) < lo {
+        return Err(f.error("sites", "fewer sites than the fewest resonators"));
+    }
+    let eps = parse_values(&mut f, "eps")?;
+    let kappa = parse_values(&mut f, "kappa")?;
+    let p: Vec<i64> = match f.optional::<toml::Value>("p")? {
+        None => vec![1],
+        Some(toml::Value::Array(items)) if !items.is_empty() => items
+            .iter()
+            .map(|v| {
+                v.as_integer()
+                    .ok_or_else(|| f.error("p", "expected integers"))
+            })
+            .collect::<Result<_>>()?,
+        Some(_) => return Err(f.error("p", "expected a list of exponents")),
+    };
+    let max_total_eps = f.optional::<f64>("max_total_eps")?;
+    f.finish()?;
+    Ok(Space {
+        resonators: (lo as usize, hi as usize),
+        sites,
+        eps,
+        kappa,
+        p,
+        max_total_eps,
+    })
+}
+
+/// `sites`: `[first, last]`, a list of three or more sites, `{ among = [...] }` or
+/// `{ fixed = [...] }` (paper sites, distinct).
+fn parse_sites(f: &mut Fields<'_>) -> Result<Sites> {
+    const FORMS: &str =
+        "expected [first, last], a list of sites, { among = [...] } or { fixed = [...] }";
+    let integers = |f: &Fields<'_>, key: &str, items: &[toml::Value]| -> Result<Vec<i64>> {
+        let list: Vec<i64> = items
+            .iter()
+            .map(toml::Value::as_integer)
+            .collect::<Option<_>>()
+            .ok_or_else(|| f.error(key, "expected integer paper sites"))?;
+        let mut sorted = list.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        if sorted.len() != list.len() || list.is_empty() || list.len() > 64 {
+            return Err(f.error(key, "expected 1 to 64 distinct sites"));
+        }
+        Ok(sorted)
+    };
+    match f.required::<toml::Value>("sites")? {
+        toml::Value::Array(items) => match items.as_slice() {
+            [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => Ok(Sites::Range(*a, *b)),
+            [_, _] => Err(f.error("sites", "expected [first, last] with first <= last (for two separate sites: { among = [a, b] })")),
+            _ => Ok(Sites::Among(integers(f, "sites", &items)?)),
+        },
+        toml::Value::Table(table) => {
+            let mut t = f.nested("sites", table);
+            let form = match (t.take("among"), t.take("fixed")) {
+                (Some(toml::Value::Array(items)), None) => Sites::Among(integers(&t, "among", &items)?),
+                (None, Some(toml::Value::Array(items))) => Sites::Fixed(integers(&t, "fixed", &items)?),
+                _ => return Err(f.error("sites", FORMS)),
+            };
+            t.finish()?;
+            Ok(form)
+        }
+        _ => Err(f.error("sites", FORMS)),
+    }
+}
+
+/// `eps` or `kappa`: `{ min, max, log }`, or a list of the values allowed.
+fn parse_values(f: &mut Fields<'_>, key: &str) -> Result<Values> {
+    match f.optional::<toml::Value>(key)? {
+        Some(toml::Value::Array(items)) => {
+            let list: Option<Vec<f64>> = items
+                .iter()
+                .map(|v| match v {
+                    toml::Value::Float(x) if x.is_finite() && *x > 0.0 => Some(*x),
+                    toml::Value::Integer(i) if *i > 0 => Some(*i as f64),
+                    _ => None,
+                })
+                .collect();
+            match list {
+                Some(list) if !list.is_empty() => Ok(Values::List(list)),
+                _ => Err(f.error(
+                    key,
+                    "expected a list of positive numbers, or { min, max, log }",
+                )),
+            }
+        }
+        Some(toml::Value::Table(table)) => {
+            let mut r = f.nested(key, table);
+            let min: f64 = r.required("min")?;
+            let max: f64 = r.required("max")?;
+            let log = match r.take("log") {
+                None => false,
+                Some(toml::Value::Boolean(b)) => b,
+                Some(_) => return Err(r.error("log", "expected true or false")),
+            };
+            if !(min.is_finite() && max.is_finite() && min > 0.0 && min <= max) {
+                return Err(r.error("min", "expected 0 < min <= max"));
+            }
+            r.finish()?;
+            Ok(Values::Range(Range { min, max, log }))
+        }
+        Some(_) => Err(f.error(key, "expected { min, max, log } or a list of values")),
+        None => Err(f.error(key, "is required: { min, max, log } or a list of values")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use woodpile_analysis::search::SplitMix64;
+
+    fn space() -> Space {
+        Space {
+            resonators: (1, 3),
+            sites: Sites::Range(0, 4),
+            eps: Values::Range(Range {
+                min: 0.1,
+                max: 100.0,
+                log: true,
+            }),
+            kappa: Values::Range(Range {
+                min: 1.0,
+                max: 2.0,
+                log: false,
+            }),
+            p: vec![1, 3],
+            max_total_eps: None,
+        }
+    }
+
+    #[test]
+    fn genomes_decode_to_sorted_distinct_sites_within_the_space() {
+        let s = space();
+        let mut rng = SplitMix64(7);
+        for _ in 0..500 {
+            let g: Vec<f64> = (0..s.dimension()).map(|_| rng.uniform()).collect();
+            let layout = s.decode(&g);
+            let sites: Vec<i64> = layout.resonators.iter().map(|r| r.site).collect();
+            assert!(!sites.is_empty() && sites.len() <= 3);
+            assert!(sites.windows(2).all(|w| w[0] < w[1]), "{sites:?}");
+            for &Resonator {
+                site,
+                eps,
+                kappa,
+                p,
+            } in &layout.resonators
+            {
+                assert!((0..=4).contains(&site));
+                assert!((0.1..=100.0).contains(&eps) && (1.0..=2.0).contains(&kappa));
+                assert!(p == 1 || p == 3);
+            }
+        }
+        assert_eq!((s.eps.at(0.0), s.eps.at(1.0)), (0.1, 100.0));
+        assert!((s.eps.at(0.5) - 10f64.powf(0.5)).abs() < 1e-12);
+    }
+
+    /// Fixed sites get one resonator each, whatever the genome; listed sites and listed eps
+    /// values are the only ones chosen.
+    #[test]
+    fn fixed_and_listed_sites_and_listed_eps_are_respected() {
+        let mut rng = SplitMix64(11);
+        let fixed = Space {
+            resonators: (3, 3),
+            sites: Sites::Fixed(vec![0, 10, 20]),
+            eps: Values::List(vec![0.5, 2.0, 8.0]),
+            ..space()
+        };
+        let among = Space {
+            resonators: (1, 2),
+            sites: Sites::Among(vec![-3, 7, 9]),
+            ..space()
+        };
+        for _ in 0..300 {
+            let g: Vec<f64> = (0..fixed.dimension()).map(|_| rng.uniform()).collect();
+            let layout = fixed.decode(&g);
+            let sites: Vec<i64> = layout.resonators.iter().map(|r| r.site).collect();
+            assert_eq!(sites, [0, 10, 20]);
+            assert!(layout
+                .resonators
+                .iter()
+                .all(|r| [0.5, 2.0, 8.0].contains(&r.eps)));
+            let g: Vec<f64> = (0..among.dimension()).map(|_| rng.uniform()).collect();
+            assert!(among
+                .decode(&g)
+                .resonators
+                .iter()
+                .all(|r| [-3, 7, 9].contains(&r.site)));
+        }
+    }
+}

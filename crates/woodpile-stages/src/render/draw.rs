@@ -1,0 +1,248 @@
+//! A panel spec applied to its input table: the rows it keeps, read by role (x, the curves'
+//! y, the series column; or x, y, z and overlays), then one `woodpile_plot::Panel` per value of
+//! the `panels` column. The grid shaping of heat maps is `woodpile_plot::Grid`'s.
+
+use polars::prelude::DataFrame;
+use woodpile_plot::{Grid, HeatPanel, LinePanel, Panel, Series};
+
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::table::{f64_column, matching_rows, str_column};
+
+use super::spec::{PanelSpec, Plot};
+use super::MAX_PANELS;
+
+/// A column's values on the kept rows.
+type Values = Vec<Option<f64>>;
+
+/// The kept rows of a line plot, by role.
+struct LineData {
+    x: Values,
+    /// One per `y` column.
+    y: Vec<Values>,
+    /// The `series` column, when the single y is split into curves by it.
+    series: Option<Values>,
+    /// The `series_label` column: each curve's name.
+    labels: Option<Vec<Option<String>>>,
+}
+
+/// The kept rows of a heat map, by role.
+struct HeatData {
+    x: Values,
+    y: Values,
+    z: Values,
+    /// One per overlay, in order.
+    overlays: Vec<Values>,
+}
+
+enum Data {
+    Lines(LineData),
+    Heat(HeatData),
+}
+
+/// `values` on `rows` only.
+fn on(values: &[Option<f64>], rows: &[usize]) -> Values {
+    rows.iter().map(|&r| values[r]).collect()
+}
+
+impl PanelSpec {
+    /// The panels this spec draws from `input`: one, or one per value of `panels`.
+    pub(super) fn draw(&self, input: &DataFrame, title: Option<String>) -> Result<Vec<Panel>> {
+        let keep = matching_rows(input, &self.filter)?;
+        let column = |name: &String| -> Result<Values> {
+            let values = f64_column(input, name)?;
+            Ok(keep.iter().map(|&r| values[r]).collect())
+        };
+        // An optional string column (curve or panel names), on the kept rows.
+        let text_column = |name: Option<&String>| -> Result<Option<Vec<Option<String>>>> {
+            let Some(name) = name else { return Ok(None) };
+            let values = str_column(input, name)?;
+            Ok(Some(keep.iter().map(|&r| values[r].clone()).collect()))
+        };
+        let panel_name = match &self.plot {
+            Plot::Lines { panels, .. } | Plot::Heatmap { panels, .. } => panels.as_ref(),
+        };
+        let panel_values = match panel_name {
+            Some(p) => column(p)?,
+            None => vec![Some(0.0); keep.len()],
+        };
+        let mut keys: Vec<f64> = panel_values.iter().flatten().copied().collect();
+        keys.sort_by(f64::total_cmp);
+        keys.dedup();
+        if keys.len() > MAX_PANELS {
+            return Err(PipelineError::stage(
+                "render",
+                format!(
+                    "`panels = \"{}\"` makes {} panels, more than the {MAX_PANELS} a figure may have; filter the rows with `where` or choose another column",
+                    panel_name.map_or("", |p| p.as_str()),
+                    keys.len()
+                ),
+            ));
+        }
+        let data = match &self.plot {
+            Plot::Lines {
+                x,
+                y,
+                series,
+                series_label,
+                ..
+            } => {
+                let x = column(x)?;
+                let y = y.iter().map(column).collect::<Result<_>>()?;
+                let series = series.as_ref().map(column).transpose()?;
+                Data::Lines(LineData {
+                    x,
+                    y,
+                    series,
+                    labels: text_column(series_label.as_ref())?,
+                })
+            }
+            Plot::Heatmap {
+                x, y, z, overlays, ..
+            } => Data::Heat(HeatData {
+                x: column(x)?,
+                y: column(y)?,
+                z: column(z)?,
+                overlays: overlays
+                    .iter()
+                    .map(|(c, _)| column(c))
+                    .collect::<Result<_>>()?,
+            }),
+        };
+        let panel_values = &panel_values;
+        let height = keep.len();
+        let rows_of = move |key: f64| -> Vec<usize> {
+            (0..height)
+                .filter(|&r| panel_values[r] == Some(key))
+                .collect()
+        };
+        let panel_labels = text_column(self.panel_label.as_ref())?;
+        let title_of = |key: f64| {
+            if let Some(t) = &title {
+                return t.clone();
+            }
+            let labelled = panel_labels.as_ref().and_then(|labels| {
+                (0..height)
+                    .find(|&r| panel_values[r] == Some(key))
+                    .and_then(|r| labels[r].clone())
+            });
+            labelled.unwrap_or_else(|| {
+                panel_name
+                    .map(|p| format!("{p} = {}", woodpile_plot::tick(&key)))
+                    .unwrap_or_default()
+            })
+        };
+        let panels = keys
+            .iter()
+            .map(|&key| {
+                let rows = rows_of(key);
+                match &data {
+                    Data::Lines(d) => self.line_panel(d, &rows, title_of(key)),
+                    Data::Heat(d) => self.heat_panel(d, &rows, title_of(key)),
+                }
+            })
+            .collect();
+        Ok(panels)
+    }
+
+    /// One line panel from `data` on `rows`: a curve per y column, or per value of the series
+    /// column (in order of first appearance).
+    fn line_panel(&self, data: &LineData, rows: &[usize], title: String) -> Panel {
+        let Plot::Lines {
+            y: y_names,
+            x_label,
+            y_label,
+            series: series_name,
+            ..
+        } = &self.plot
+        else {
+            unreachable!("line_panel is called for line plots only")
+        };
+        let point =
+            |y: &Values, r: usize| (data.x[r].unwrap_or(f64::NAN), y[r].unwrap_or(f64::NAN));
+        let series = match (&data.series, series_name) {
+            (Some(ids), Some(name)) => {
+                let mut curves: Vec<(f64, Vec<usize>)> = Vec::new();
+                for &r in rows {
+                    let Some(id) = ids[r] else { continue };
+                    match curves.iter_mut().find(|(v, _)| *v == id) {
+                        Some((_, members)) => members.push(r),
+                        None => curves.push((id, vec![r])),
+                    }
+                }
+                curves
+                    .into_iter()
+                    .map(|(id, members)| Series {
+                        label: data
+                            .labels
+                            .as_ref()
+                            .and_then(|l| l[members[0]].clone())
+                            .unwrap_or_else(|| format!("{name} = {}", woodpile_plot::tick(&id))),
+                        points: members.iter().map(|&r| point(&data.y[0], r)).collect(),
+                    })
+                    .collect()
+            }
+            _ => y_names
+                .iter()
+                .zip(&data.y)
+                .map(|(name, y)| Series {
+                    label: name.clone(),
+                    points: rows.iter().map(|&r| point(y, r)).collect(),
+                })
+                .collect(),
+        };
+        Panel::Lines(LinePanel {
+            title,
+            x_label: x_label.clone(),
+            y_label: y_label.clone(),
+            series,
+            marks: self.marks.clone(),
+            view: self.view,
+        })
+    }
+
+    /// One heat-map panel from `data` on `rows`.
+    fn heat_panel(&self, data: &HeatData, rows: &[usize], title: String) -> Panel {
+        let Plot::Heatmap {
+            x_label,
+            y_label,
+            z_label,
+            mark_max,
+            overlays,
+            colours,
+            z_range,
+            ..
+        } = &self.plot
+        else {
+            unreachable!("heat_panel is called for heat maps only")
+        };
+        let y = on(&data.y, rows);
+        let grid = Grid::from_rows(&on(&data.x, rows), &y, &on(&data.z, rows));
+        // Each overlay: its x on every row of the map, as a step line over the row's cell.
+        let overlays = overlays
+            .iter()
+            .zip(&data.overlays)
+            .map(|((_, label), at)| Series {
+                label: label.clone(),
+                points: grid.row_steps(&y, &on(at, rows)),
+            })
+            .collect();
+        Panel::Heat(HeatPanel {
+            title,
+            x_label: x_label.clone(),
+            y_label: y_label.clone(),
+            z_label: z_label.clone(),
+            overlays,
+            marker: grid
+                .max
+                .filter(|_| *mark_max)
+                .map(|(x, y, v)| (x, y, format!("max {v:.4}"))),
+            xs: grid.xs,
+            ys: grid.ys,
+            z: grid.z,
+            colours: colours.clone(),
+            z_range: *z_range,
+            marks: self.marks.clone(),
+            view: self.view,
+        })
+    }
+}
