@@ -1,5 +1,6 @@
-//! What a stage kind is to the engine: the [`Kind`] trait, and the [`Registry`] of kinds a
-//! pipeline is loaded with. The engine names no kind: parsing, the unknown-kind error, the
+//! What a stage kind is to the engine: the [`Kind`] trait, the [`Registry`] of kinds a
+//! pipeline is loaded with, and the [`Stage`] that pairs a stage file with its kind (read from
+//! its file by `stage.rs`). The engine names no kind: parsing, the unknown-kind error, the
 //! DAG's input checks, running, freshness, dry-run counts and shards all go through these.
 
 use std::any::Any;
@@ -8,16 +9,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use polars::prelude::DataFrame;
+use serde_json::Value;
 
 use crate::error::Result;
 use crate::events::Events;
 use crate::fields::Fields;
 use crate::layout::output_path;
 use crate::manifest::Manifest;
-use crate::pipeline::Pipeline;
 use crate::points::{PointStats, PointStore};
-use crate::stage::Stage;
-use crate::{table, Output};
+use crate::table;
 
 /// A stage kind: its parameters, and what it does with them.
 pub trait Kind: std::fmt::Debug + Send + Sync + Any {
@@ -131,12 +131,39 @@ pub fn no_inputs(stage: &Stage) -> KindCheck {
     }
 }
 
+/// A parsed stage file.
+#[derive(Debug, Clone)]
+pub struct Stage {
+    /// The name: the file stem.
+    pub name: String,
+    /// The file it came from.
+    pub file: PathBuf,
+    /// Free text for `woodpile status` and the README.
+    pub description: String,
+    /// Upstream stages, in the order given.
+    pub inputs: Vec<String>,
+    /// Its kind's name (one of the registry's).
+    pub kind: &'static str,
+    /// What it does: the kind's parameters and behaviour.
+    pub spec: Arc<dyn Kind>,
+    /// The file's content without `description`, as canonical JSON: what the key hashes.
+    pub params: Value,
+}
+
+impl Stage {
+    /// The stage's parameters as kind `K`, if it is one.
+    pub fn get<K: Kind>(&self) -> Option<&K> {
+        let any: &dyn std::any::Any = self.spec.as_ref();
+        any.downcast_ref::<K>()
+    }
+}
+
 /// What a running stage may use.
 pub struct Context<'a> {
     /// The stage.
     pub stage: &'a Stage,
-    /// The pipeline it belongs to (reached through [`Context::upstream`]).
-    pub(crate) pipeline: &'a Pipeline,
+    /// Every stage upstream of it (reached through [`Context::upstream`]).
+    pub(crate) upstream: Vec<&'a Stage>,
     /// The results tree.
     pub results: &'a Path,
     /// Where figures go.
@@ -156,13 +183,7 @@ impl Context<'_> {
     /// The definition of stage `name`, which must be upstream of this one (an input, or an
     /// input's input): a stage reads the parameters of what it depends on, nothing else.
     pub fn upstream(&self, name: &str) -> Result<&Stage> {
-        let upstream = self
-            .pipeline
-            .selection(std::slice::from_ref(&self.stage.name))?;
-        match upstream
-            .into_iter()
-            .find(|s| s.name == name && s.name != self.stage.name)
-        {
+        match self.upstream.iter().find(|s| s.name == name) {
             Some(stage) => Ok(stage),
             None => Err(crate::error::PipelineError::stage(
                 &self.stage.name,
@@ -180,4 +201,16 @@ impl Context<'_> {
     pub fn input_with_manifest(&self, name: &str) -> Result<(DataFrame, Manifest)> {
         table::read_with_manifest(&output_path(self.results, name))
     }
+}
+
+/// What a stage computed, before it is written with its manifest.
+pub struct Output {
+    /// The table.
+    pub frame: polars::prelude::DataFrame,
+    /// Kind-specific facts for the manifest.
+    pub summary: serde_json::Value,
+    /// What failed inside the stage without stopping it (a fit that did not converge, a
+    /// quote that could not be read): recorded in the table, and the run ends non-zero
+    /// naming them.
+    pub failures: Vec<String>,
 }

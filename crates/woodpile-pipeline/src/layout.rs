@@ -56,7 +56,10 @@ pub fn markdown_path(results: &Path, markdown: &str) -> PathBuf {
         .join(markdown)
 }
 
+/// The lock file's name inside a results tree.
+pub const LOCK_FILE: &str = ".woodpile.lock";
+
 /// The lock file of a results tree.
 pub fn lock_path(results: &Path) -> PathBuf {
-    results.join(crate::lock::LOCK_FILE)
+    results.join(LOCK_FILE)
 }

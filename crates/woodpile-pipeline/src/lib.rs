@@ -45,17 +45,6 @@ pub mod table;
 pub mod variant;
 
 pub use error::{PipelineError, Result};
+pub use kind::Output;
 pub use pipeline::Pipeline;
 pub use woodpile_scene::template;
-
-/// What a stage computed, before it is written with its manifest.
-pub struct Output {
-    /// The table.
-    pub frame: polars::prelude::DataFrame,
-    /// Kind-specific facts for the manifest.
-    pub summary: serde_json::Value,
-    /// What failed inside the stage without stopping it (a fit that did not converge, a
-    /// quote that could not be read): recorded in the table, and the run ends non-zero
-    /// naming them.
-    pub failures: Vec<String>,
-}

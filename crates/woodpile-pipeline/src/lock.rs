@@ -17,9 +17,6 @@ use crate::events::Events;
 use crate::layout::lock_path;
 use crate::regular;
 
-/// The lock file's name inside the results tree.
-pub const LOCK_FILE: &str = ".woodpile.lock";
-
 /// Held while a run writes; dropping it releases the lock.
 #[derive(Debug)]
 pub struct ResultsLock {

@@ -28,11 +28,11 @@ pub struct Manifest {
     pub summary: Value,
     /// Every file the stage wrote besides its table (figures, Markdown, a design's scene), by
     /// file name, with the blake3 of its bytes: `status` calls the stage fresh only if each
-    /// is exactly what this run wrote ([`crate::sealed_files`]).
+    /// is exactly what this run wrote (`sealed_files.rs`).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub files: BTreeMap<String, String>,
     /// The table's seal, set when it is written: blake3 of the whole file with the seal read as
-    /// a placeholder ([`crate::table::write`]). It is the last field, so it ends the manifest's
+    /// a placeholder (`table::write`). It is the last field, so it ends the manifest's
     /// text. `status` and every reader of the table check it before decoding anything.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub checksum: Option<String>,

@@ -367,9 +367,14 @@ fn execute(
     events: &dyn Events,
 ) -> Result<(String, Vec<String>)> {
     let results = &options.results;
+    let upstream = pipeline
+        .selection(std::slice::from_ref(&stage.name))?
+        .into_iter()
+        .filter(|s| s.name != stage.name)
+        .collect();
     let output = stage.spec.run(&Context {
         stage,
-        pipeline,
+        upstream,
         results,
         figures: &options.figures,
         store,

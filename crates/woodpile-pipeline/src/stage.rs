@@ -10,34 +10,16 @@
 //! The remaining keys belong to the kind (its module documents them); unknown keys anywhere
 //! are errors naming the file and key.
 
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::Path;
 
 use serde_json::Value;
 
 use crate::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
-use crate::kind::{Kind, Registry};
+use crate::kind::Registry;
 
-/// A parsed stage file.
-#[derive(Debug, Clone)]
-pub struct Stage {
-    /// The name: the file stem.
-    pub name: String,
-    /// The file it came from.
-    pub file: PathBuf,
-    /// Free text for `woodpile status` and the README.
-    pub description: String,
-    /// Upstream stages, in the order given.
-    pub inputs: Vec<String>,
-    /// Its kind's name (one of the registry's).
-    pub kind: &'static str,
-    /// What it does: the kind's parameters and behaviour.
-    pub spec: Arc<dyn Kind>,
-    /// The file's content without `description`, as canonical JSON: what the key hashes.
-    pub params: Value,
-}
+pub use crate::kind::Stage;
 
 impl Stage {
     /// Reads and parses the stage file at `file` of the project rooted at `root` (where a
@@ -102,12 +84,6 @@ impl Stage {
             spec,
             params,
         })
-    }
-
-    /// The stage's parameters as kind `K`, if it is one.
-    pub fn get<K: Kind>(&self) -> Option<&K> {
-        let any: &dyn std::any::Any = self.spec.as_ref();
-        any.downcast_ref::<K>()
     }
 }
 

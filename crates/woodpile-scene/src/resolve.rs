@@ -3,13 +3,14 @@
 //! Paper numbering: sites n = -N..N with N = `chain.n` (or `chain.sites = [first, last]`); the
 //! simulator's index is n - first.
 
-use woodpile_sim::budget::{OverBudget, StepSetBy, MAX_STEPS};
 use woodpile_sim::energy::Region;
+use woodpile_sim::integrate::MAX_STEPS;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::run::Scenario;
 use woodpile_sim::units::Scales;
 use woodpile_sim::SimError;
+use woodpile_sim::{OverBudget, StepSetBy};
 
 use crate::raw;
 
@@ -412,7 +413,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
 /// Refuses a scene whose run could never finish within the simulator's budgets, naming the key
 /// that makes it so (`t_end` when even the largest step of any method would be too many).
 fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Result<(), Invalid> {
-    let error = match woodpile_sim::budget::check(scenario) {
+    let error = match woodpile_sim::run::budget::check(scenario) {
         Ok(()) => return Ok(()),
         Err(SimError::OverBudget(over)) => over,
         Err(other) => return Err(invalid("run", other.to_string())),

@@ -136,5 +136,51 @@ pub enum SimError {
     BadRun(String),
     /// The run would exceed its step or sample budget: refused before it starts.
     #[error(transparent)]
-    OverBudget(#[from] crate::budget::OverBudget),
+    OverBudget(#[from] OverBudget),
+}
+
+/// What sets the step that makes a run too long.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StepSetBy {
+    /// The scene's explicit `dt`.
+    Dt,
+    /// The step the tolerance asks for.
+    Tolerance,
+    /// Resolving (or keeping stable) the fastest resonator, index into the model's resonators.
+    Resonator(usize),
+}
+
+/// A run refused before it starts.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum OverBudget {
+    /// `t_end / sample_every` samples.
+    #[error("{samples:.3e} samples (t_end / sample_every) would be recorded, more than the {limit} a run may keep")]
+    Samples {
+        /// How many.
+        samples: f64,
+        /// The most a run may keep (`run::budget::MAX_SAMPLES`).
+        limit: u64,
+    },
+    /// Too many steps.
+    #[error("about {steps:.3e} steps of dt = {dt:.3e} to reach t_end (set by {}), beyond the budget of {limit} steps", set_by.describe())]
+    Steps {
+        /// Estimated steps.
+        steps: f64,
+        /// The step the estimate assumes.
+        dt: f64,
+        /// What sets it.
+        set_by: StepSetBy,
+        /// The most a run may take (`integrate::MAX_STEPS`).
+        limit: u64,
+    },
+}
+
+impl StepSetBy {
+    fn describe(self) -> &'static str {
+        match self {
+            StepSetBy::Dt => "the run's dt",
+            StepSetBy::Tolerance => "the tolerance",
+            StepSetBy::Resonator(_) => "the fastest resonator's frequency",
+        }
+    }
 }

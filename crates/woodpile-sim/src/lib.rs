@@ -17,7 +17,6 @@
 //! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
 #![warn(missing_docs)]
 
-pub mod budget;
 pub mod energy;
 mod error;
 pub mod force;
@@ -29,5 +28,5 @@ pub mod run;
 pub mod testing;
 pub mod units;
 
-pub use error::{ModelError, SimError};
+pub use error::{ModelError, OverBudget, SimError, StepSetBy};
 pub use model::{Boundary, Coupling, Model, Resonator};

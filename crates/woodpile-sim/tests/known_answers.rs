@@ -5,8 +5,8 @@
 
 use woodpile_sim::energy::{total_energy, total_momentum};
 use woodpile_sim::integrate::{
-    drive, ContactMode, Dop853, DriveConfig, ExplicitRk, Rk4, Rkn, Rkn4, StepControl, Stepper,
-    SymplecticStepper, DPRKN6, VERLET, YOSHIDA4, YOSHIDA6,
+    drive, ContactMode, Dop853, DriveConfig, ExplicitRk, Rk4, Rkn, Rkn4, StepControl, StepSpan,
+    Stepper, SymplecticStepper, DPRKN6, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use woodpile_sim::model::{Model, Window};
 use woodpile_sim::testing::{fitted_order, linear_oscillator, two_bead_collision};
@@ -101,7 +101,15 @@ fn resonator_linear_frequency() {
     let mut t = 0.0;
     let mut prev = y[0] - y[1];
     while crossings.len() < 5 {
-        stepper.step(&model, t, &mut y, dt, Window::full(&model));
+        stepper.step(
+            &model,
+            &mut y,
+            StepSpan {
+                t,
+                h: dt,
+                window: Window::full(&model),
+            },
+        );
         t += dt;
         let x = y[0] - y[1];
         if prev.signum() != x.signum() {

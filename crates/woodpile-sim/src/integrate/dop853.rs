@@ -12,8 +12,8 @@
 #![allow(clippy::excessive_precision)]
 
 use super::rk::rk_stages;
-use super::{StepOutcome, Stepper};
-use crate::model::{Model, Window};
+use super::{StepOutcome, StepSpan, Stepper};
+use crate::model::Model;
 
 const STAGES: usize = 12;
 
@@ -208,14 +208,8 @@ impl Stepper for Dop853 {
     }
 
     #[allow(clippy::needless_range_loop)] // one pass over components, reading 12 stage rows
-    fn step(
-        &mut self,
-        model: &Model,
-        t: f64,
-        y: &mut [f64],
-        h: f64,
-        window: Window,
-    ) -> StepOutcome {
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        let StepSpan { t, h, window } = span;
         let len = y.len();
         let reuse = self.fsal_at == Some(t);
         rk_stages(

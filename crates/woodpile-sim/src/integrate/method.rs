@@ -33,7 +33,7 @@ pub enum Method {
 }
 
 impl Method {
-    /// Every method, in a stable order.
+    /// Every method, in a stable order (the order of [`FACTS`]).
     pub const ALL: [Method; 8] = [
         Method::Rk4,
         Method::Rk4Contact,
@@ -45,18 +45,13 @@ impl Method {
         Method::Dop853,
     ];
 
+    fn facts(self) -> &'static Facts {
+        &FACTS[self as usize]
+    }
+
     /// The name used in scene files.
     pub fn name(self) -> &'static str {
-        match self {
-            Method::Rk4 => "rk4",
-            Method::Rk4Contact => "rk4-contact",
-            Method::Rkn4Contact => "rkn4-contact",
-            Method::Rkn6Contact => "rkn6-contact",
-            Method::Verlet => "verlet",
-            Method::Yoshida4 => "yoshida4",
-            Method::Yoshida6 => "yoshida6",
-            Method::Dop853 => "dop853",
-        }
+        self.facts().name
     }
 
     /// Parses a scene-file name.
@@ -66,54 +61,145 @@ impl Method {
 
     /// Classical order on smooth problems.
     pub fn order(self) -> u32 {
-        match self {
-            Method::Verlet => 2,
-            Method::Rk4 | Method::Rk4Contact | Method::Rkn4Contact | Method::Yoshida4 => 4,
-            Method::Yoshida6 | Method::Rkn6Contact => 6,
-            Method::Dop853 => 8,
-        }
+        self.facts().order
     }
 
     /// The order its errors in the energy fractions show on Hertzian chains (the calibrated
     /// error model's): what `auto`'s Richardson estimate divides by, 2^order - 1.
     pub fn observed_order(self) -> f64 {
-        error_model(self).order
+        self.facts().error.order
     }
 
     /// Whether the method controls its own step.
     pub fn is_adaptive(self) -> bool {
-        matches!(self, Method::Dop853)
-    }
-
-    /// Force evaluations per step (per accepted step for the adaptive method).
-    pub fn evals_per_step(self) -> u32 {
-        match self {
-            Method::Rk4 | Method::Rk4Contact => 4,
-            Method::Verlet => 1,
-            Method::Yoshida4 | Method::Rkn4Contact => 3,
-            Method::Rkn6Contact => 6,
-            Method::Yoshida6 => 7,
-            Method::Dop853 => 12,
-        }
+        self.facts().adaptive
     }
 
     /// Largest dt * omega for which the method is stable on the linear oscillator
     /// x'' = -omega^2 x (its stability interval on the imaginary axis for RK; HLW Section I.5 for
     /// compositions), used to keep fixed steps safe for stiff resonators.
     pub fn stability_limit(self) -> f64 {
-        match self {
-            Method::Rk4 | Method::Rk4Contact => 2.0 * std::f64::consts::SQRT_2,
-            // The spectral radius of one step on the oscillator exceeds 1 past 2.5867 (computed).
-            Method::Rkn4Contact => 2.586,
-            // Computed the same way for DPRKN6.
-            Method::Rkn6Contact => RKN6_STABILITY_LIMIT,
-            Method::Verlet => 2.0,
-            Method::Yoshida4 => 1.57,
-            Method::Yoshida6 => 1.0,
-            Method::Dop853 => 3.5,
-        }
+        self.facts().stability_limit
     }
 }
+
+/// Everything known about one method, in one row: [`FACTS`].
+struct Facts {
+    name: &'static str,
+    order: u32,
+    adaptive: bool,
+    stability_limit: f64,
+    error: ErrorModel,
+}
+
+/// Calibrated error model of a fixed-step method: error in the energy fractions of the paper's
+/// linear scenes ~ `coef * dt^order`, measured against a reference run ten times finer on the
+/// single, L = 2, separated and ramp scenes. The observed order is 2.5 for the methods that
+/// integrate a contact's opening or closing with their ordinary quadrature, not the classical
+/// one: there the force is (t - t*)_+^{3/2}, whose integral over a step is only accurate to
+/// O(h^{5/2}). The contact-event methods integrate those steps along the contact's path and
+/// show order 3 or so (docs/methods.md). The coefficient of `auto`'s method sets its first
+/// step; the surveys (`make audit`, the `auto_accuracy` example) check the promise it serves.
+struct ErrorModel {
+    coef: f64,
+    order: f64,
+}
+
+/// One row per method, in the order of [`Method::ALL`] (a test checks it).
+const FACTS: [Facts; 8] = [
+    Facts {
+        name: "rk4",
+        order: 4,
+        adaptive: false,
+        stability_limit: 2.0 * std::f64::consts::SQRT_2,
+        error: ErrorModel {
+            coef: 1.5e-3,
+            order: 2.5,
+        },
+    },
+    Facts {
+        name: "rk4-contact",
+        order: 4,
+        adaptive: false,
+        stability_limit: 2.0 * std::f64::consts::SQRT_2,
+        error: ErrorModel {
+            coef: 1.56e-2,
+            order: 3.0,
+        },
+    },
+    Facts {
+        name: "rkn4-contact",
+        order: 4,
+        adaptive: false,
+        // The spectral radius of one step on the oscillator exceeds 1 past 2.5867 (computed).
+        stability_limit: 2.586,
+        // A third of rk4-contact's: its R and T errors on the standard scene are 3 to 4 times
+        // smaller at every step from 0.02 to 0.1.
+        error: ErrorModel {
+            coef: 5.2e-3,
+            order: 2.8,
+        },
+    },
+    Facts {
+        name: "rkn6-contact",
+        order: 6,
+        adaptive: false,
+        // DPRKN6 is not dissipative: on x'' = -ω² x one step grows the amplitude by 1.7e-8 at
+        // ωh = 0.5 and 4e-6 at 1 (computed), so its bound is the growth it may accumulate, not
+        // an edge.
+        stability_limit: 1.0,
+        // Order 6 between contact events; across them the fractions' errors fall about 7-fold
+        // per halving from 0.2 to 0.1 (worst over 25 sweep scenes: 1.7e-6 to 2.3e-7, the
+        // `error_split` example), so the Richardson estimate assumes order 3. The coefficient
+        // puts the first step at 0.1 for tolerance 1e-6, where the worst measured error is
+        // 2.3e-7, and 0.215 for 1e-5: a smaller first step costs more evaluations over the
+        // surveys at 1e-5 and 1e-6, where the sweeps run, and a larger one more halvings.
+        error: ErrorModel {
+            coef: 1e-3,
+            order: 3.0,
+        },
+    },
+    Facts {
+        name: "verlet",
+        order: 2,
+        adaptive: false,
+        stability_limit: 2.0,
+        error: ErrorModel {
+            coef: 1.5e-2,
+            order: 2.0,
+        },
+    },
+    Facts {
+        name: "yoshida4",
+        order: 4,
+        adaptive: false,
+        stability_limit: 1.57,
+        error: ErrorModel {
+            coef: 1.0e-2,
+            order: 2.5,
+        },
+    },
+    Facts {
+        name: "yoshida6",
+        order: 6,
+        adaptive: false,
+        stability_limit: 1.0,
+        error: ErrorModel {
+            coef: 3.0e-3,
+            order: 2.5,
+        },
+    },
+    Facts {
+        name: "dop853",
+        order: 8,
+        adaptive: true,
+        stability_limit: 3.5,
+        error: ErrorModel {
+            coef: 1.0,
+            order: 8.0,
+        },
+    },
+];
 
 /// The method a scene asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -154,68 +240,6 @@ pub struct Plan {
     /// Energy drift bound for conservative runs.
     pub drift_limit: f64,
 }
-
-/// Calibrated error model of a fixed-step method: error in the energy fractions of the paper's
-/// linear scenes ~ `coef * dt^order`. Measured against RK4 at dt = 0.001 on the single, L = 2,
-/// separated and ramp scenes (`cargo run --release -p woodpile-sim --example calibrate`). The
-/// observed order is 2.5 for every method, not the classical one: where a contact opens or closes
-/// the force is (t - t*)_+^{3/2}, whose integral over a step is only accurate to O(h^{5/2}).
-/// `rk4-contact` integrates those steps exactly and shows order 3 to 3.5; its coefficient puts
-/// `auto`'s first step at 0.04 for tolerance 1e-6, where the first Richardson pair passes on
-/// most of the paper's scenes (`cargo run --release -p woodpile-bench --example auto_accuracy`).
-struct ErrorModel {
-    coef: f64,
-    order: f64,
-}
-
-fn error_model(method: Method) -> ErrorModel {
-    match method {
-        Method::Rk4Contact => ErrorModel {
-            coef: 1.56e-2,
-            order: 3.0,
-        },
-        // A third of rk4-contact's: its R and T errors on the standard scene are 3 to 4 times
-        // smaller at every step from 0.02 to 0.1.
-        Method::Rkn4Contact => ErrorModel {
-            coef: 5.2e-3,
-            order: 2.8,
-        },
-        // Order 6 between contact events; across them the fractions' errors fall about 7-fold
-        // per halving from 0.2 to 0.1 (worst over 25 sweep scenes: 1.7e-6 to 2.3e-7, the
-        // `error_split` example), so the Richardson estimate assumes order 3. The coefficient
-        // puts the first step at 0.1 for tolerance 1e-6, where the worst measured error is
-        // 2.3e-7, and 0.215 for 1e-5; 5e-4 and 2e-3 were tried and cost more evaluations
-        // over the `auto_accuracy` and `auto_wide` surveys at 1e-5 and 1e-6, where the sweeps run.
-        Method::Rkn6Contact => ErrorModel {
-            coef: 1e-3,
-            order: 3.0,
-        },
-        Method::Verlet => ErrorModel {
-            coef: 1.5e-2,
-            order: 2.0,
-        },
-        Method::Rk4 => ErrorModel {
-            coef: 1.5e-3,
-            order: 2.5,
-        },
-        Method::Yoshida4 => ErrorModel {
-            coef: 1.0e-2,
-            order: 2.5,
-        },
-        Method::Yoshida6 => ErrorModel {
-            coef: 3.0e-3,
-            order: 2.5,
-        },
-        Method::Dop853 => ErrorModel {
-            coef: 1.0,
-            order: 8.0,
-        },
-    }
-}
-
-/// DPRKN6 is not dissipative: on x'' = -ω² x one step grows the amplitude by 1.7e-8 at ωh = 0.5
-/// and 4e-6 at 1 (computed), so its bound is the growth it may accumulate, not an edge.
-const RKN6_STABILITY_LIMIT: f64 = 1.0;
 
 /// Relative tolerance given to DOP853 per unit of requested fraction accuracy (measured: rtol
 /// 1e-12 gives |dE_tr| ~ 1e-8 on the single-defect scene).
@@ -313,7 +337,7 @@ impl Plan {
     /// The fixed step the calibrated error model predicts for `tol` with `method`, before any
     /// resonator caps it (never above 0.25). For an adaptive method, its step scale.
     pub fn tolerance_dt(method: Method, tol: f64) -> f64 {
-        let em = error_model(method);
+        let em = &method.facts().error;
         (tol / em.coef).powf(1.0 / em.order).min(0.25)
     }
 
@@ -376,7 +400,7 @@ impl Plan {
             t_end,
             sample_every,
             control: self.control,
-            max_steps: crate::budget::MAX_STEPS,
+            max_steps: super::MAX_STEPS,
             energy_drift_limit: Some(self.drift_limit),
             active_window,
         };
@@ -432,5 +456,30 @@ impl Plan {
                 observer,
             ),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_method_has_its_own_row_of_facts() {
+        let names = [
+            "rk4",
+            "rk4-contact",
+            "rkn4-contact",
+            "rkn6-contact",
+            "verlet",
+            "yoshida4",
+        ];
+        for (method, name) in Method::ALL.into_iter().zip(names) {
+            assert_eq!(method.name(), name);
+        }
+        for method in Method::ALL {
+            assert_eq!(Method::from_name(method.name()), Some(method));
+            assert_eq!(method.is_adaptive(), method == Method::Dop853);
+        }
+        assert_eq!(AUTO_METHOD.observed_order(), 3.0);
     }
 }

@@ -51,16 +51,27 @@ pub enum StepOutcome {
     },
 }
 
+/// One step's place: from time `t`, by `h`, on the sites of `window`.
+#[derive(Debug, Clone, Copy)]
+pub struct StepSpan {
+    /// The time the step starts at.
+    pub t: f64,
+    /// Its size.
+    pub h: f64,
+    /// The sites it works on.
+    pub window: Window,
+}
+
 /// One integration method. It advances the state; everything else belongs to [`drive`].
 pub trait Stepper {
     /// Short name, as used in scene files ("rk4", "verlet", ...).
     fn name(&self) -> &'static str;
 
-    /// Attempts a step of size `h` from `(t, y)`, updating `y` in place when accepted. Only
-    /// the sites of `window` are worked on: the caller guarantees that every site outside it
-    /// is at rest and stays so for the step (see [`Stepper::reach`]).
-    fn step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64, window: Window)
-        -> StepOutcome;
+    /// Attempts a step `span` (of size `h` from time `t`) from `y`, updating `y` in place
+    /// when accepted. Only the sites of `span.window` are worked on: the caller guarantees
+    /// that every site outside it is at rest and stays so for the step (see
+    /// [`Stepper::reach`]).
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome;
 
     /// How many sites a disturbance can travel in one step, at most: one per force evaluation
     /// (a site at rest moves only once a neighbour has moved in an earlier stage).
@@ -136,6 +147,11 @@ pub enum StepControl {
         h_min: f64,
     },
 }
+
+/// Most steps (accepted plus rejected) one run may take: about a minute of one core on the
+/// paper's chain. [`drive`] enforces it (as `DriveConfig::max_steps`, which plans set to it);
+/// `run::budget::check` refuses a run that would exceed it before it starts.
+pub const MAX_STEPS: u64 = 50_000_000;
 
 /// Everything the driver needs besides the model, stepper and state.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -292,7 +308,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                 for i in 0..n_steps {
                     let window = active.window();
                     stats.site_steps += window.len() as u64;
-                    stepper.step(model, t, y, h_eq, window);
+                    stepper.step(model, y, StepSpan { t, h: h_eq, window });
                     active.update(model, y, window);
                     t = if i + 1 == n_steps { target } else { t + h_eq };
                     stats.steps += 1;
@@ -319,7 +335,15 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                     }
                     let window = active.window();
                     stats.site_steps += window.len() as u64;
-                    match stepper.step(model, t, y, h_try, window) {
+                    match stepper.step(
+                        model,
+                        y,
+                        StepSpan {
+                            t,
+                            h: h_try,
+                            window,
+                        },
+                    ) {
                         StepOutcome::Accepted { h_next } => {
                             active.update(model, y, window);
                             t = if lands { target } else { t + h_try };

@@ -5,7 +5,7 @@
 
 use std::marker::PhantomData;
 
-use super::{StepOutcome, Stepper};
+use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
 
 /// A Butcher tableau with `STAGES` stages: `A` (strictly lower triangular, row i has i
@@ -62,14 +62,8 @@ impl<T: Tableau> Stepper for ExplicitRk<T> {
         T::NAME
     }
 
-    fn step(
-        &mut self,
-        model: &Model,
-        t: f64,
-        y: &mut [f64],
-        h: f64,
-        window: Window,
-    ) -> StepOutcome {
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        let StepSpan { t, h, window } = span;
         let len = y.len();
         rk_stages(
             model,

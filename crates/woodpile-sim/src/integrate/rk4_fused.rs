@@ -12,8 +12,8 @@
 
 use super::contact_event::rk4_quadrature;
 use super::event_correction::{finish_step, stage_accelerations, ContactEvents};
-use super::{StepOutcome, Stepper};
-use crate::model::{Model, Window};
+use super::{StepOutcome, StepSpan, Stepper};
+use crate::model::Model;
 
 const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
 /// a_{i+1, i} of the tableau: the weight of stage i in stage i + 1.
@@ -74,14 +74,8 @@ impl Stepper for Rk4Fused {
         }
     }
 
-    fn step(
-        &mut self,
-        model: &Model,
-        t: f64,
-        y: &mut [f64],
-        h: f64,
-        window: Window,
-    ) -> StepOutcome {
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        let StepSpan { t, h, window } = span;
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);

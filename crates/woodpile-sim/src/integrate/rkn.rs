@@ -6,11 +6,12 @@
 //! v+  = v + h Σ_i b'_i a(Q_i)
 //! ```
 //!
-//! Why a second, generic Nyström stepper next to the hand-written [`super::Rkn4`]: to measure
-//! what a method of higher smooth order buys on a Hertzian chain, where the contact kinks set
-//! the error (docs/performance.md, "Where the error comes from"). The tableau shipped is
-//! Dormand, El-Mikkawy and Prince's RKN6(4) (1987), six stages of which the last is the force at
-//! the new position.
+//! This is `auto`'s stepper: with [`DPRKN6`], Dormand, El-Mikkawy and Prince's RKN6(4)
+//! (1987), six stages of which the last is the force at the new position, it is
+//! `rkn6-contact`. It is generic over the tableau so that the contact treatments below are one
+//! piece of code for any order; [`NYSTROM4`] runs through it in the `error_split` example to
+//! compare treatments at order 4, where `rkn4-contact` itself is the hand-written
+//! [`super::Rkn4`] (faster; its doc comment has the figure).
 //!
 //! A contact that opens or closes inside a step can be treated in one of two ways
 //! ([`ContactMode`]): *corrected* as in `rk4-contact` (the method's quadrature of that bond's
@@ -21,7 +22,7 @@
 use super::event_correction::{
     copy_window, finish_step, stage_accelerations, ContactEvents, Quadrature,
 };
-use super::{StepOutcome, Stepper};
+use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
 
 /// An explicit Nyström tableau of `S` stages. `a` is strictly lower triangular.
@@ -308,14 +309,8 @@ impl<const S: usize> Stepper for Rkn<S> {
         self.tableau.names[self.mode as usize]
     }
 
-    fn step(
-        &mut self,
-        model: &Model,
-        t: f64,
-        y: &mut [f64],
-        h: f64,
-        window: Window,
-    ) -> StepOutcome {
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        let StepSpan { t, h, window } = span;
         match self.mode {
             ContactMode::Located => self.located_step(model, t, y, h, window),
             ContactMode::Plain | ContactMode::Corrected => {

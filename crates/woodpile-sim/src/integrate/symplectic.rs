@@ -10,8 +10,8 @@
 //! Each sub-step costs one force evaluation: the closing kick's acceleration is cached and opens
 //! the next sub-step (first-same-as-last).
 
-use super::{StepOutcome, Stepper};
-use crate::model::{Model, Window};
+use super::{StepOutcome, StepSpan, Stepper};
+use crate::model::Model;
 
 /// A symmetric composition of Verlet sub-steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -85,14 +85,8 @@ impl Stepper for SymplecticStepper {
         self.composition.name
     }
 
-    fn step(
-        &mut self,
-        model: &Model,
-        t: f64,
-        y: &mut [f64],
-        h: f64,
-        window: Window,
-    ) -> StepOutcome {
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        let StepSpan { t, h, window } = span;
         let n_dof = model.n_dof();
         let (q, v) = y.split_at_mut(n_dof);
         let ranges = window.dof_ranges(model);

@@ -7,66 +7,25 @@
 //! most a factor of about 3, and halvings only make it larger, so a scene refused here would
 //! also have been refused by the driver, only later.
 
-use crate::integrate::{intervals, MethodChoice, Plan};
-use crate::run::{auto_first_step, Scenario};
+use super::{auto_first_step, Scenario};
+use crate::error::{OverBudget, StepSetBy};
+use crate::integrate::{intervals, MethodChoice, Plan, MAX_STEPS};
 use crate::SimError;
-
-/// Most steps (accepted plus rejected) one run may take: about a minute of one core on the
-/// paper's chain. The driver enforces it during the run; [`check`] refuses earlier.
-pub const MAX_STEPS: u64 = 50_000_000;
 
 /// Most samples one run may record: each sample keeps five numbers per observer, so a
 /// million samples are 40 MB, far beyond any figure's resolution.
 pub const MAX_SAMPLES: u64 = 1_000_000;
-
-/// What sets the step that makes a run too long.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StepSetBy {
-    /// The scene's explicit `dt`.
-    Dt,
-    /// The step the tolerance asks for.
-    Tolerance,
-    /// Resolving (or keeping stable) the fastest resonator, index into the model's resonators.
-    Resonator(usize),
-}
-
-/// A run refused before it starts.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum OverBudget {
-    /// `t_end / sample_every` samples.
-    #[error("{samples:.3e} samples (t_end / sample_every) would be recorded, more than the {MAX_SAMPLES} a run may keep")]
-    Samples {
-        /// How many.
-        samples: f64,
-    },
-    /// Too many steps.
-    #[error("about {steps:.3e} steps of dt = {dt:.3e} to reach t_end (set by {}), beyond the budget of {MAX_STEPS} steps", set_by.describe())]
-    Steps {
-        /// Estimated steps.
-        steps: f64,
-        /// The step the estimate assumes.
-        dt: f64,
-        /// What sets it.
-        set_by: StepSetBy,
-    },
-}
-
-impl StepSetBy {
-    fn describe(self) -> &'static str {
-        match self {
-            StepSetBy::Dt => "the run's dt",
-            StepSetBy::Tolerance => "the tolerance",
-            StepSetBy::Resonator(_) => "the fastest resonator's frequency",
-        }
-    }
-}
 
 /// Refuses `scenario` when its samples or its steps exceed the budgets; the model, run
 /// settings and tolerance must already be valid (a [`SimError`] otherwise).
 pub fn check(scenario: &Scenario) -> Result<(), SimError> {
     let samples = (scenario.t_end / scenario.sample_every).ceil();
     if samples.is_nan() || samples > MAX_SAMPLES as f64 {
-        return Err(OverBudget::Samples { samples }.into());
+        return Err(OverBudget::Samples {
+            samples,
+            limit: MAX_SAMPLES,
+        }
+        .into());
     }
     let model = &scenario.model;
     let plan = Plan::choose(model, scenario.method, scenario.accuracy)?;
@@ -93,7 +52,13 @@ pub fn check(scenario: &Scenario) -> Result<(), SimError> {
     if steps <= MAX_STEPS as f64 {
         Ok(())
     } else {
-        Err(OverBudget::Steps { steps, dt, set_by }.into())
+        Err(OverBudget::Steps {
+            steps,
+            dt,
+            set_by,
+            limit: MAX_STEPS,
+        }
+        .into())
     }
 }
 

@@ -8,6 +8,8 @@
 //! otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
 //! without a stiffness model having to foresee them.
 
+pub mod budget;
+
 use crate::energy::{energy_density, Fractions, Region};
 use crate::error::SimError;
 use crate::integrate::{
@@ -77,7 +79,7 @@ pub fn simulate<O: Observer + ?Sized>(
     observer: &mut O,
 ) -> Result<Outcome, SimError> {
     let plan = Plan::choose(&scenario.model, scenario.method, scenario.accuracy)?;
-    crate::budget::check(scenario)?;
+    budget::check(scenario)?;
     match scenario.method {
         MethodChoice::Named(_) => run_plan(scenario, &plan, observer),
         MethodChoice::Auto => verified(scenario, plan, observer),
