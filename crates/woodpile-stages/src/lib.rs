@@ -24,6 +24,7 @@ pub mod schema;
 pub mod spacetime;
 pub mod stability;
 pub mod sweep;
+pub mod table;
 pub mod workprecision;
 
 /// Every kind, in pipeline order: its name in stage files, and its parser.
@@ -49,6 +50,7 @@ pub static KINDS: &Registry = &[
         Ok(Arc::new(stability::Stability::parse(f)?))
     }),
     ("design", |f, _| Ok(Arc::new(design::Design::parse(f)?))),
+    ("table", |f, _| Ok(Arc::new(table::Table::parse(f)?))),
 ];
 
 /// The name of every kind, in pipeline order.
