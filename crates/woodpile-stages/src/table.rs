@@ -183,15 +183,19 @@ mod tests {
     #[test]
     fn rows_and_columns_are_selected_by_name() {
         let mut columns = Columns::new();
-        columns
-            .f64("a", vec![Some(1.0), Some(2.0), Some(3.0)])
-            .str("b", vec![Some("x".into()), Some("y".into()), Some("x".into())]);
+        columns.f64("a", vec![Some(1.0), Some(2.0), Some(3.0)]).str(
+            "b",
+            vec![Some("x".into()), Some("y".into()), Some("x".into())],
+        );
         let frame = columns.into_frame().unwrap();
         let table = Table {
             columns: vec!["a".into()],
             filter: vec![("b".into(), Match::Text("x".into()))],
         };
-        assert_eq!(csv(&table.select(&frame).unwrap()).unwrap(), "a\n1.0\n3.0\n");
+        assert_eq!(
+            csv(&table.select(&frame).unwrap()).unwrap(),
+            "a\n1.0\n3.0\n"
+        );
         let missing = Table {
             columns: vec!["c".into()],
             filter: Vec::new(),

@@ -5,24 +5,9 @@
 
 mod common;
 
-use common::Project;
+use common::{Project, SWEEP};
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::table;
-
-const SWEEP: &str = r#"
-kind = "sweep"
-[axes]
-L = [0, 1]
-eps = { from = 0.5, to = 1.5, step = 0.5 }
-[scene]
-chain = { n = 12 }
-impulse = { site = -6 }
-run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
-[[scene.defect]]
-site = 0
-through = "$L"
-eps = "$eps"
-"#;
 
 const REDUCE: &str = r#"
 kind = "reduce"
@@ -65,7 +50,10 @@ fn a_table_stage_writes_the_chosen_rows_and_columns_as_csv_that_reads_back_exact
     std::fs::write(p.results().join("export.csv"), text.replace(',', ";")).unwrap();
     assert_ne!(p.state("export"), State::Fresh);
     p.run(&[]).unwrap();
-    assert_eq!(std::fs::read_to_string(p.results().join("export.csv")).unwrap(), text);
+    assert_eq!(
+        std::fs::read_to_string(p.results().join("export.csv")).unwrap(),
+        text
+    );
 }
 
 #[test]
@@ -75,11 +63,18 @@ kind = "table"
 inputs = ["fractions"]
 columns = ["nope"]
 "#;
-    let p = Project::new(&[("sweep", SWEEP), ("fractions", REDUCE), ("export", list_column)]);
+    let p = Project::new(&[
+        ("sweep", SWEEP),
+        ("fractions", REDUCE),
+        ("export", list_column),
+    ]);
     let e = p.run(&[]).unwrap_err().to_string();
     assert!(e.contains("nope"), "{e}");
     let twice = TABLE.replace(r#"["eps", "R", "E_tr"]"#, r#"["eps", "eps"]"#);
     let p = Project::new(&[("sweep", SWEEP), ("fractions", REDUCE), ("export", &twice)]);
     let e = p.run(&[]).unwrap_err().to_string();
-    assert!(e.contains("listed twice") && e.contains("export.toml"), "{e}");
+    assert!(
+        e.contains("listed twice") && e.contains("export.toml"),
+        "{e}"
+    );
 }

@@ -3,9 +3,11 @@
 #![allow(dead_code, clippy::unwrap_used)]
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use woodpile_stages::KINDS;
 
-use woodpile_pipeline::events::Silent;
+use woodpile_pipeline::events::{Events, Silent};
 use woodpile_pipeline::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::{state, State};
@@ -65,4 +67,135 @@ impl Project {
     pub fn output(&self, name: &str) -> PathBuf {
         output_path(&self.results(), name)
     }
+    /// The pipeline as it is on disk.
+    pub fn load(&self) -> Pipeline {
+        Pipeline::load(&self.pipeline(), KINDS).unwrap()
+    }
+    /// Runs `targets` (all when empty), which must succeed, and says what ran.
+    pub fn counted(&self, targets: &[&str]) -> Counter {
+        self.counted_with(targets, false)
+    }
+    /// [`Project::counted`], re-running the targets even when fresh if `force`.
+    pub fn counted_with(&self, targets: &[&str], force: bool) -> Counter {
+        let events = Counter::default();
+        let options = RunOptions {
+            targets: targets.iter().map(|s| s.to_string()).collect(),
+            force,
+            dry_run: false,
+            results: self.results(),
+            figures: self.figures(),
+        };
+        run(&self.load(), &options, &events).unwrap();
+        events
+    }
 }
+
+/// Counts what a run did.
+#[derive(Default)]
+pub struct Counter {
+    pub points: AtomicUsize,
+    pub started: Mutex<Vec<String>>,
+    pub warnings: Mutex<Vec<String>>,
+}
+
+impl Events for Counter {
+    fn stage_started(&self, stage: &str, _: &str) {
+        self.started.lock().unwrap().push(stage.to_string());
+    }
+    fn point_done(&self) {
+        self.points.fetch_add(1, Ordering::SeqCst);
+    }
+    fn warn(&self, message: &str) {
+        self.warnings.lock().unwrap().push(message.to_string());
+    }
+}
+
+/// Why a project of these stage files does not load.
+pub fn load_error(stages: &[(&str, &str)]) -> String {
+    let project = Project::new(stages);
+    Pipeline::load(&project.pipeline(), KINDS)
+        .unwrap_err()
+        .to_string()
+}
+
+/// A sweep over L in {0, 1} and eps in {0.5, 1, 1.5} on a chain of 25 sites, to t = 12.
+pub const SWEEP: &str = r#"
+kind = "sweep"
+[axes]
+L = [0, 1]
+eps = { from = 0.5, to = 1.5, step = 0.5 }
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
+[[scene.defect]]
+site = 0
+through = "$L"
+eps = "$eps"
+"#;
+
+pub const REDUCE: &str = r#"
+kind = "reduce"
+inputs = ["sweep"]
+at = 12.0
+"#;
+
+pub const BEST: &str = r#"
+kind = "reduce"
+inputs = ["sweep"]
+[maximize]
+over = ["eps"]
+"#;
+
+pub const REPORT: &str = r#"
+kind = "report"
+inputs = ["sweep", "at_end"]
+markdown = "REPORT.md"
+title = "Tiny report"
+
+[[quote]]
+figure = "X1"
+quantity = "E_tr at L = 0, eps = 1, end"
+paper = PAPER
+agree = 1e-12
+as_run = "t = 12"
+ours = { stage = "at_end", column = "E_tr", where = { L = 0, eps = 1.0 } }
+[[quote.convention]]
+name = "read-out time"
+source = { stage = "sweep", column = "E_tr", where = { L = 0, eps = 1.0 }, scan = "t" }
+[[quote.convention]]
+name = "largest over the grid"
+source = { stage = "at_end", column = "E_tr", max = "E_tr", locate = ["L", "eps"] }
+"#;
+
+pub const WORK_PRECISION: &str = r#"
+kind = "workprecision"
+repeats = 1
+reference_tolerance = 1e-12
+[[scene]]
+name = "tiny"
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0 }
+defect = [{ site = 0, eps = 2.0 }]
+[[method]]
+name = "rk4"
+dt = [0.2, 0.1, 0.05]
+[[method]]
+name = "dop853"
+tolerance = [1e-6]
+"#;
+
+pub const WORK_PRECISION_CHART: &str = r#"
+kind = "render"
+inputs = ["wp"]
+title = "work-precision"
+where = { scene = 0 }
+[lines]
+x = "log10_wall_ms"
+y = ["log10_error"]
+series = "method_index"
+series_label = "method"
+x_label = "log10 ms"
+y_label = "log10 error"
+"#;

@@ -1,0 +1,285 @@
+//! The other kinds end to end: optimize, report, kinetic series, work-precision and design.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+
+use std::path::Path;
+use std::sync::atomic::Ordering;
+
+use common::{
+    load_error, Project, BEST, REDUCE, REPORT, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
+};
+use woodpile_pipeline::layout::points_dir;
+use woodpile_pipeline::status::State;
+use woodpile_pipeline::table;
+
+#[test]
+fn optimize_refines_a_grid_maximum_between_grid_points() {
+    let coarse = SWEEP.replace("L = [0, 1]", "L = [0]").replace(
+        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
+        "eps = { from = 0.5, to = 3.0, step = 0.5 }",
+    );
+    let optimum = r#"
+kind = "optimize"
+inputs = ["at_end"]
+over = ["eps"]
+tolerance = 1e-7
+"#;
+    let p = Project::new(&[("sweep", &coarse), ("at_end", REDUCE), ("optimum", optimum)]);
+    p.counted(&[]);
+    let out = table::read(&p.output("optimum")).unwrap();
+    let e_tr = table::f64_column(&out, "E_tr").unwrap();
+    let eps = table::f64_column(&out, "eps").unwrap();
+    let (grid, refined) = (e_tr[0].unwrap(), e_tr[1].unwrap());
+    assert!(
+        refined >= grid,
+        "the search never ends below its start: {grid} -> {refined}"
+    );
+    assert!(
+        (0.5..=3.0).contains(&eps[1].unwrap()),
+        "stays inside the grid's box"
+    );
+    // Only float axes can be searched, and only through a plain reduce.
+    let e = load_error(&[
+        ("sweep", &coarse),
+        ("at_end", REDUCE),
+        ("optimum", &optimum.replace("[\"eps\"]", "[\"L\"]")),
+    ]);
+    assert!(
+        e.contains("optimum.toml") && e.contains("integer axis"),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("sweep", &coarse),
+        ("best", BEST),
+        ("optimum", &optimum.replace("at_end", "best")),
+    ]);
+    assert!(e.contains("maximises already"), "{e}");
+}
+
+/// The report reads numbers where its sources say, finds by scanning the read-out time where a
+/// quoted number is met, and writes its Markdown beside `results/`.
+#[test]
+fn a_report_reads_and_scans_the_quoted_numbers() {
+    // The "paper's" number: E_tr at t = 8, which the end-time read-out misses.
+    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE)]);
+    p.counted(&[]);
+    let sweep = table::read(&p.output("sweep")).unwrap();
+    let column = |name: &str| table::f64_column(&sweep, name).unwrap();
+    let (l, eps, t, e_tr) = (column("L"), column("eps"), column("t"), column("E_tr"));
+    let row = |time: f64| {
+        (0..sweep.height())
+            .find(|&r| l[r] == Some(0.0) && eps[r] == Some(1.0) && t[r] == Some(time))
+            .unwrap()
+    };
+    let at_8 = e_tr[row(8.0)].unwrap();
+    let at_12 = e_tr[row(12.0)].unwrap();
+    assert!(
+        (at_8 - at_12).abs() > 1e-6,
+        "the test needs two distinct read-outs"
+    );
+
+    p.write("report", &REPORT.replace("PAPER", &format!("{at_8:e}")));
+    p.counted(&["report"]);
+    let report = table::read(&p.output("report")).unwrap();
+    assert_eq!(report.height(), 3);
+    let value = table::f64_column(&report, "value").unwrap();
+    let reproduces = table::f64_column(&report, "reproduces").unwrap();
+    let closest = table::f64_column(&report, "scan_closest").unwrap();
+    assert_eq!(value[0], Some(at_12));
+    assert_eq!(reproduces[0], Some(0.0));
+    assert_eq!(value[1], Some(at_8));
+    assert_eq!(reproduces[1], Some(1.0));
+    assert_eq!(closest[1], Some(8.0));
+    let best = (0..sweep.height())
+        .filter(|&r| t[r] == Some(12.0))
+        .filter_map(|r| e_tr[r])
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert_eq!(value[2], Some(best));
+
+    let markdown = p.results().parent().unwrap().join("REPORT.md");
+    let text = std::fs::read_to_string(&markdown).unwrap();
+    assert!(
+        text.starts_with("# Tiny report") && text.contains("| X1 |"),
+        "{text}"
+    );
+    assert_eq!(p.state("report"), State::Fresh);
+    std::fs::remove_file(&markdown).unwrap();
+    assert!(matches!(p.state("report"), State::Stale(_)));
+}
+
+#[test]
+fn a_report_source_must_be_an_input() {
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("at_end", REDUCE),
+        (
+            "report",
+            &REPORT
+                .replace("PAPER", "0.1")
+                .replace("inputs = [\"sweep\", \"at_end\"]", "inputs = [\"sweep\"]"),
+        ),
+    ]);
+    assert!(
+        e.contains("report.toml") && e.contains("quote[0].ours.stage") && e.contains("at_end"),
+        "{e}"
+    );
+}
+
+/// A kinetic sweep divides kinetic energy by the impact energy: at t = 0 all of it is the
+/// striker's, left of the region. Its points are cached apart from the energy sweep's.
+#[test]
+fn a_kinetic_sweep_starts_with_the_impact_energy_left_of_the_region() {
+    let kinetic = SWEEP.replace("kind = \"sweep\"", "kind = \"sweep\"\nseries = \"kinetic\"");
+    let p = Project::new(&[("sweep", SWEEP), ("kinetic", &kinetic)]);
+    let events = p.counted(&[]);
+    assert_eq!(events.points.load(Ordering::SeqCst), 12);
+    let frame = table::read(&p.output("kinetic")).unwrap();
+    let t = table::f64_column(&frame, "t").unwrap();
+    let r = table::f64_column(&frame, "R").unwrap();
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    for row in (0..frame.height()).filter(|&i| t[i] == Some(0.0)) {
+        assert_eq!(r[row], Some(1.0));
+        assert_eq!(e_tr[row], Some(0.0));
+    }
+    let energy = table::read(&p.output("sweep")).unwrap();
+    let r_energy = table::f64_column(&energy, "R").unwrap();
+    // Later on potential energy exists, so the two series differ.
+    assert!((0..frame.height()).any(|i| (r[i].unwrap() - r_energy[i].unwrap()).abs() > 1e-3));
+}
+
+/// A work-precision stage measures every setting against its reference: RK4's error falls
+/// with its step at about its order on a smooth enough scene, and the chart draws one curve per
+/// method.
+#[test]
+fn work_precision_measures_error_against_the_reference() {
+    let p = Project::new(&[("wp", WORK_PRECISION), ("chart", WORK_PRECISION_CHART)]);
+    p.counted(&[]);
+    let frame = table::read(&p.output("wp")).unwrap();
+    assert_eq!(frame.height(), 4);
+    let error = table::f64_column(&frame, "error").unwrap();
+    let wall = table::f64_column(&frame, "wall_ms").unwrap();
+    let e = |i: usize| error[i].unwrap();
+    assert!(e(0) > e(1) && e(1) > e(2), "{error:?}");
+    // Halving dt divides RK4's error by at least 2^2.5 (the contact-limited order) on this scene.
+    assert!(e(1) / e(2) > 5.0, "{error:?}");
+    assert!(wall.iter().all(|w| w.is_some_and(|w| w > 0.0)));
+    let manifest = table::read_manifest(&p.output("wp")).unwrap().unwrap();
+    let reference = manifest.summary["references"][0]["E_tr"].as_f64().unwrap();
+    let e_tr = table::f64_column(&frame, "E_tr").unwrap();
+    assert!(((e_tr[2].unwrap() - reference).abs() - e(2)).abs() < 1e-15);
+    assert_eq!(manifest.summary["runs"].as_u64(), Some(4));
+    assert!(p.figures().join("chart.png").exists());
+    assert_eq!(p.state("chart"), State::Fresh);
+}
+
+const DESIGN: &str = r#"
+kind = "design"
+seed = 7
+budget = 40
+refine = 10
+objective = "E_tr"
+verify_tolerance = 1e-8
+robustness = { samples = 6, spreads = [0.01, 0.05] }
+[scene]
+chain = { n = 12 }
+impulse = { site = -6 }
+run = { t_end = 12.0, method = "auto", tolerance = 1e-6 }
+fractions = { region = [-1, 4] }
+[space]
+resonators = [1, 2]
+sites = [0, 3]
+eps = { min = 0.1, max = 10.0, log = true }
+kappa = { min = 0.5, max = 2.0 }
+"#;
+
+fn count_files(dir: &Path) -> usize {
+    std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .flatten()
+                .map(|e| {
+                    if e.path().is_dir() {
+                        count_files(&e.path())
+                    } else {
+                        1
+                    }
+                })
+                .sum()
+        })
+        .unwrap_or(0)
+}
+
+/// The design stage searches, verifies its best design, and writes it as a scene file that
+/// loads as it is and gives the verified number; the search depends on the seed alone (any
+/// thread count), and a repeated search finds every trial in the point cache.
+#[test]
+fn a_design_stage_finds_verifies_and_writes_its_best_design() {
+    let outputs: Vec<Vec<u8>> = [1, 2]
+        .into_iter()
+        .map(|threads| {
+            let p = Project::new(&[("trap", DESIGN)]);
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| p.counted(&[]));
+            // The table and its manifest, but not the best file's checksum: the file names
+            // its own path, which differs between the two projects.
+            let checked = table::read_checked(&p.output("trap")).unwrap();
+            let mut manifest = checked.manifest.unwrap();
+            manifest.files.clear();
+            manifest.checksum = None;
+            let mut frame = checked.frame;
+            let mut bytes = Vec::new();
+            polars::prelude::ParquetWriter::new(&mut bytes)
+                .finish(&mut frame)
+                .unwrap();
+            bytes.extend(manifest.to_json_text().into_bytes());
+            bytes
+        })
+        .collect();
+    assert!(
+        outputs[0] == outputs[1],
+        "the search depends on the seed alone"
+    );
+
+    let p = Project::new(&[("trap", DESIGN)]);
+    p.counted(&[]);
+    let table = table::read(&p.output("trap")).unwrap();
+    let search = table::str_column(&table, "search").unwrap();
+    let e_tr = table::f64_column(&table, "E_tr").unwrap();
+    let count = |s: &str| search.iter().filter(|x| x.as_deref() == Some(s)).count();
+    assert_eq!(count("differential evolution"), 40);
+    assert_eq!(count("random"), 40);
+    assert_eq!(count("verification"), 1);
+    assert_eq!(count("robustness ±5%"), 6);
+    let verified = (0..table.height())
+        .find(|&r| search[r].as_deref() == Some("verification"))
+        .unwrap();
+    let best_searched = (0..table.height())
+        .filter(|&r| search[r].as_deref().is_some_and(|s| s != "verification"))
+        .filter_map(|r| e_tr[r])
+        .fold(f64::NEG_INFINITY, f64::max);
+    // The verified design is the best any evaluation found (the baseline's and the
+    // robustness samples' included).
+    assert!((e_tr[verified].unwrap() - best_searched).abs() < 1e-5);
+
+    let best = p.results().join("trap.best.toml");
+    let scene = woodpile_scene::load(&best).unwrap();
+    assert_eq!(scene.region_paper, [-1, 4]);
+    let again = woodpile_sim::run::simulate(&scene.scenario, &mut ()).unwrap();
+    assert_eq!(Some(again.fractions.trapped), e_tr[verified]);
+
+    let points = count_files(&points_dir(&p.results()));
+    p.counted_with(&["trap"], true);
+    assert_eq!(
+        count_files(&points_dir(&p.results())),
+        points,
+        "nothing simulated twice"
+    );
+
+    // A missing best design makes the stage stale.
+    std::fs::remove_file(&best).unwrap();
+    assert!(matches!(p.state("trap"), State::Stale(_)));
+}
