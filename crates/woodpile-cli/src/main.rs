@@ -22,6 +22,7 @@ macro_rules! say {
         }
     }};
 }
+mod diff_cmd;
 mod new_study;
 mod pipeline_cmd;
 mod progress;
@@ -53,7 +54,7 @@ enum Command {
     /// Write SLURM scripts for a sharded sweep: an array job and a merge job after it.
     Slurm(pipeline_cmd::SlurmArgs),
     /// Compare two result files or trees; exit 1 when they differ beyond tolerance.
-    Diff(pipeline_cmd::DiffArgs),
+    Diff(diff_cmd::DiffArgs),
     /// Make a new study folder that runs as written: `woodpile new study NAME`.
     New(new_study::Args),
 }
@@ -116,7 +117,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => pipeline_cmd::merge_command(&args),
         Command::Slurm(args) => pipeline_cmd::slurm_command(&args),
         Command::New(args) => new_study::run(&args),
-        Command::Diff(args) => match pipeline_cmd::diff_command(&args) {
+        Command::Diff(args) => match diff_cmd::diff_command(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
             Err(f) => Err(f),

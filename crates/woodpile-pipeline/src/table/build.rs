@@ -1,0 +1,233 @@
+//! Building a table: columns by name (`Columns`), or rows of a kind's own type (`Row`) whose
+//! cells are collected into typed columns (`rows_frame`).
+
+use polars::prelude::*;
+
+use crate::error::{PipelineError, Result};
+
+/// Columns of a table under construction, in output order: for tables whose columns are
+/// computed whole (a grid, a field); tables built row by row use [`Row`] and [`rows_frame`].
+#[derive(Default)]
+pub struct Columns(Vec<Column>);
+
+impl Columns {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Appends a float column (nulls allowed).
+    pub fn f64(&mut self, name: &str, values: Vec<Option<f64>>) -> &mut Self {
+        self.0.push(Column::new(name.into(), values));
+        self
+    }
+
+    /// Appends an integer column (nulls allowed).
+    pub fn i64(&mut self, name: &str, values: Vec<Option<i64>>) -> &mut Self {
+        self.0.push(Column::new(name.into(), values));
+        self
+    }
+
+    /// Appends a string column (nulls allowed).
+    pub fn str(&mut self, name: &str, values: Vec<Option<String>>) -> &mut Self {
+        self.0.push(Column::new(name.into(), values));
+        self
+    }
+
+    /// Appends a column of float lists (one list per row: pandas and polars read them as
+    /// lists).
+    pub fn f64_list(&mut self, name: &str, values: Vec<Vec<f64>>) -> &mut Self {
+        self.list(name, values)
+    }
+
+    /// Appends a column of integer lists.
+    pub fn i64_list(&mut self, name: &str, values: Vec<Vec<i64>>) -> &mut Self {
+        self.list(name, values)
+    }
+
+    fn list<T>(&mut self, name: &str, values: Vec<Vec<T>>) -> &mut Self
+    where
+        Series: NamedFrom<Vec<T>, [T]>,
+    {
+        let rows: Vec<Series> = values
+            .into_iter()
+            .map(|v| Series::new(PlSmallStr::EMPTY, v))
+            .collect();
+        let column = <Series as NamedFrom<Vec<Series>, ListType>>::new(name.into(), rows);
+        self.0.push(column.into());
+        self
+    }
+
+    /// The finished frame.
+    pub fn into_frame(self) -> Result<DataFrame> {
+        DataFrame::new_infer_height(self.0)
+            .map_err(|e| PipelineError::stage("table", e.to_string()))
+    }
+}
+
+/// One cell of an output row.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cell {
+    /// A float (or null).
+    F64(Option<f64>),
+    /// An integer (or null).
+    I64(Option<i64>),
+    /// A string (or null).
+    Str(Option<String>),
+    /// A list of floats.
+    F64List(Vec<f64>),
+    /// A list of integers.
+    I64List(Vec<i64>),
+}
+
+impl From<f64> for Cell {
+    fn from(x: f64) -> Self {
+        Cell::F64(Some(x))
+    }
+}
+impl From<Option<f64>> for Cell {
+    fn from(x: Option<f64>) -> Self {
+        Cell::F64(x)
+    }
+}
+impl From<i64> for Cell {
+    fn from(x: i64) -> Self {
+        Cell::I64(Some(x))
+    }
+}
+impl From<Option<i64>> for Cell {
+    fn from(x: Option<i64>) -> Self {
+        Cell::I64(x)
+    }
+}
+impl From<String> for Cell {
+    fn from(x: String) -> Self {
+        Cell::Str(Some(x))
+    }
+}
+impl From<&str> for Cell {
+    fn from(x: &str) -> Self {
+        Cell::Str(Some(x.to_string()))
+    }
+}
+impl From<Option<String>> for Cell {
+    fn from(x: Option<String>) -> Self {
+        Cell::Str(x)
+    }
+}
+
+/// A row of an output table: its cells, each under its column's name, in column order. A
+/// kind describes its rows once, as a type, and [`rows_frame`] makes the table.
+pub trait Row {
+    /// The cells of this row.
+    fn cells(&self) -> Vec<(&str, Cell)>;
+}
+
+/// The table of `rows`: one column per cell name, in the first row's order. Every row must
+/// give the same names with the same kinds of cell (an error names the first that does not).
+pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
+    let bad = |reason: String| PipelineError::stage("table", reason);
+    let Some(first) = rows.first() else {
+        return Ok(DataFrame::empty());
+    };
+    let names: Vec<String> = first.cells().iter().map(|(n, _)| n.to_string()).collect();
+    let mut columns: Vec<Vec<Cell>> = vec![Vec::with_capacity(rows.len()); names.len()];
+    for (r, row) in rows.iter().enumerate() {
+        let cells = row.cells();
+        if cells.len() != names.len() {
+            return Err(bad(format!(
+                "row {r} has {} cells, not {}",
+                cells.len(),
+                names.len()
+            )));
+        }
+        for (k, (name, cell)) in cells.into_iter().enumerate() {
+            if name != names[k] {
+                return Err(bad(format!(
+                    "row {r}: column {k} is `{name}`, not `{}`",
+                    names[k]
+                )));
+            }
+            columns[k].push(cell);
+        }
+    }
+    let mut out = Columns::new();
+    for (name, cells) in names.iter().zip(columns) {
+        // One kind of value per column: the first cell's.
+        fn unpack<T>(
+            cells: Vec<Cell>,
+            pick: fn(Cell) -> Option<Option<T>>,
+            mismatch: impl Fn() -> PipelineError,
+        ) -> Result<Vec<Option<T>>> {
+            cells
+                .into_iter()
+                .map(|c| pick(c).ok_or_else(&mismatch))
+                .collect()
+        }
+        let mismatch = || bad(format!("column `{name}` mixes kinds of values"));
+        match cells.first() {
+            Some(Cell::F64(_)) | None => out.f64(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::F64(x) => Some(x),
+                        _ => None,
+                    },
+                    mismatch,
+                )?,
+            ),
+            Some(Cell::I64(_)) => out.i64(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::I64(x) => Some(x),
+                        _ => None,
+                    },
+                    mismatch,
+                )?,
+            ),
+            Some(Cell::Str(_)) => out.str(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::Str(x) => Some(x),
+                        _ => None,
+                    },
+                    mismatch,
+                )?,
+            ),
+            Some(Cell::F64List(_)) => out.f64_list(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::F64List(x) => Some(Some(x)),
+                        _ => None,
+                    },
+                    mismatch,
+                )?
+                .into_iter()
+                .flatten()
+                .collect(),
+            ),
+            Some(Cell::I64List(_)) => out.i64_list(
+                name,
+                unpack(
+                    cells,
+                    |c| match c {
+                        Cell::I64List(x) => Some(Some(x)),
+                        _ => None,
+                    },
+                    mismatch,
+                )?
+                .into_iter()
+                .flatten()
+                .collect(),
+            ),
+        };
+    }
+    out.into_frame()
+}

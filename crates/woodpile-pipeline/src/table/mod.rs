@@ -1,0 +1,234 @@
+//! Parquet in and out through polars, with the stage's [`Manifest`] in the file's key-value
+//! metadata (key `woodpile`), so that every result file explains itself to any reader
+//! (`pyarrow.parquet.read_metadata(path).metadata[b"woodpile"]`).
+
+use std::path::Path;
+
+use polars::prelude::*;
+
+use crate::atomic;
+use crate::error::{PipelineError, Result};
+use crate::manifest::{Manifest, METADATA_KEY};
+use crate::regular;
+
+mod build;
+mod columns;
+
+pub use build::{rows_frame, Cell, Columns, Row};
+pub use columns::{f64_column, matching_rows, missing_column, str_column, Match};
+
+/// Writes `frame` to `path` atomically, with `manifest` in the metadata, sealed: the manifest's
+/// `checksum` is the blake3 of the whole file's bytes with the seal itself replaced by a
+/// placeholder ([`seal`]), so that every byte is checked before a reader decodes any.
+pub fn write(path: &Path, mut frame: DataFrame, manifest: &Manifest) -> Result<()> {
+    let placeholder = Manifest {
+        checksum: Some(UNSEALED.into()),
+        ..manifest.clone()
+    }
+    .to_json_text();
+    let mut bytes = encode(&mut frame, placeholder)?;
+    let at = seal_position(&bytes)
+        .filter(|&at| &bytes[at..at + SEAL_LEN] == UNSEALED.as_bytes())
+        .ok_or_else(|| {
+            PipelineError::io(path, "the parquet writer lost the manifest: cannot seal")
+        })?;
+    let sealed = seal(&bytes, at);
+    bytes[at..at + SEAL_LEN].copy_from_slice(sealed.as_bytes());
+    atomic::write(path, &bytes)
+}
+
+/// The seal's placeholder while it is computed: 64 characters, as the seal itself.
+const UNSEALED: &str = "unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-u";
+const SEAL_LEN: usize = 64;
+/// What precedes the seal in the manifest's text (its last field).
+const SEAL_MARK: &[u8] = b"\"checksum\":\"";
+
+/// The largest table woodpile reads: a thousand times its largest result. A file beyond it is
+/// refused unread, so no decoder is asked to allocate for it.
+pub const MAX_TABLE_BYTES: u64 = 1 << 30;
+
+fn encode(frame: &mut DataFrame, manifest_text: String) -> Result<Vec<u8>> {
+    let metadata = KeyValueMetadata::from_static(vec![(METADATA_KEY.to_string(), manifest_text)]);
+    let mut bytes = Vec::new();
+    ParquetWriter::new(&mut bytes)
+        .with_compression(ParquetCompression::Zstd(None))
+        .with_key_value_metadata(Some(metadata))
+        .finish(frame)
+        .map_err(|e| PipelineError::stage("table", e.to_string()))?;
+    Ok(bytes)
+}
+
+/// Where the seal's 64 characters start in a sealed file: after the last `"checksum":"`
+/// (the manifest's last field, in the footer near the end of the file).
+fn seal_position(bytes: &[u8]) -> Option<usize> {
+    let at = bytes
+        .windows(SEAL_MARK.len())
+        .rposition(|w| w == SEAL_MARK)?
+        + SEAL_MARK.len();
+    (at + SEAL_LEN <= bytes.len()).then_some(at)
+}
+
+/// The seal of a file whose seal starts at `at`: blake3 of every byte, with the seal's own
+/// 64 characters read as [`UNSEALED`]. A changed byte anywhere (data, footer, manifest) breaks it.
+fn seal(bytes: &[u8], at: usize) -> String {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(b"woodpile table seal 2\n");
+    hasher.update(&bytes[..at]);
+    hasher.update(UNSEALED.as_bytes());
+    hasher.update(&bytes[at + SEAL_LEN..]);
+    hasher.finalize().to_hex().to_string()
+}
+
+/// Whether a table's bytes still match the seal its manifest recorded.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Integrity {
+    /// They do.
+    Intact,
+    /// They do not: the file was damaged (or edited) after it was written. It is not decoded.
+    Damaged,
+    /// There is no seal to check against: not a woodpile table.
+    Unchecked,
+}
+
+/// A table as read, with its manifest and whether its bytes match the manifest's seal.
+#[derive(Debug)]
+pub struct Checked {
+    /// The table (empty when damaged: a damaged file is never decoded).
+    pub frame: DataFrame,
+    /// Its manifest, if it has one (none when damaged).
+    pub manifest: Option<Manifest>,
+    /// The bytes against the manifest's seal.
+    pub integrity: Integrity,
+}
+
+/// The bytes of the table at `path` (a regular file of at most [`MAX_TABLE_BYTES`]) and
+/// whether they match their seal, checked before anything decodes them. A file that carries
+/// woodpile's marks (the `woodpile` metadata key or a seal field) but no matching seal is
+/// damaged; only a file with neither is unchecked (a foreign parquet file).
+fn sealed_bytes(path: &Path) -> Result<(Vec<u8>, Integrity)> {
+    let bytes = regular::read(path, MAX_TABLE_BYTES).map_err(|e| PipelineError::io(path, e))?;
+    let integrity = match seal_position(&bytes) {
+        Some(at) if bytes[at..at + SEAL_LEN] == *seal(&bytes, at).as_bytes() => Integrity::Intact,
+        Some(_) => Integrity::Damaged,
+        None if contains(&bytes, METADATA_KEY.as_bytes()) => Integrity::Damaged,
+        None => Integrity::Unchecked,
+    };
+    Ok((bytes, integrity))
+}
+
+fn contains(haystack: &[u8], needle: &[u8]) -> bool {
+    haystack.windows(needle.len()).any(|w| w == needle)
+}
+
+/// Runs a polars decoder on bytes: some damaged files make it panic rather than return an
+/// error (sealed files never reach it damaged; foreign ones may).
+fn decode<T>(path: &Path, work: impl FnOnce() -> PolarsResult<T>) -> Result<T> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(work)) {
+        Ok(result) => result.map_err(|e| PipelineError::io(path, e)),
+        Err(_) => Err(PipelineError::io(path, "the parquet decoder failed on it")),
+    }
+}
+
+/// Reads the whole table at `path`, after checking its bytes against its manifest's seal.
+pub fn read_checked(path: &Path) -> Result<Checked> {
+    let (bytes, integrity) = sealed_bytes(path)?;
+    if integrity == Integrity::Damaged {
+        return Ok(Checked {
+            frame: DataFrame::empty(),
+            manifest: None,
+            integrity,
+        });
+    }
+    let (metadata, frame) = decode(path, || {
+        let mut reader = ParquetReader::new(std::io::Cursor::new(&bytes));
+        let metadata = reader.get_metadata()?.clone();
+        reader.finish().map(|frame| (metadata, frame))
+    })?;
+    let manifest = manifest_text(&metadata)
+        .map(|t| parse_manifest(path, &t))
+        .transpose()?;
+    Ok(Checked {
+        frame,
+        manifest,
+        integrity,
+    })
+}
+
+/// The manifest of the table at `path` and the table's integrity, from its footer alone (no
+/// data page is decoded): what `status` needs. `Ok(None)` when the file does not exist.
+pub fn read_checked_manifest(path: &Path) -> Result<Option<(Option<Manifest>, Integrity)>> {
+    if std::fs::symlink_metadata(path).is_err() {
+        return Ok(None);
+    }
+    let (bytes, integrity) = sealed_bytes(path)?;
+    if integrity == Integrity::Damaged {
+        return Ok(Some((None, integrity)));
+    }
+    let metadata = decode(path, || {
+        ParquetReader::new(std::io::Cursor::new(&bytes))
+            .get_metadata()
+            .cloned()
+    })?;
+    let manifest = manifest_text(&metadata)
+        .map(|t| parse_manifest(path, &t))
+        .transpose()?;
+    Ok(Some((manifest, integrity)))
+}
+
+/// Reads the whole table at `path` (a stage's input): an error if its bytes no longer
+/// match the seal in its manifest, so a damaged table never flows downstream.
+pub fn read(path: &Path) -> Result<DataFrame> {
+    let checked = read_checked(path)?;
+    if checked.integrity == Integrity::Damaged {
+        return Err(PipelineError::io(path, DAMAGED));
+    }
+    Ok(checked.frame)
+}
+
+/// [`read`], with the table's manifest (for a stage that quotes its inputs' parameters).
+pub fn read_with_manifest(path: &Path) -> Result<(DataFrame, Manifest)> {
+    let checked = read_checked(path)?;
+    match (checked.integrity, checked.manifest) {
+        (Integrity::Damaged, _) => Err(PipelineError::io(path, DAMAGED)),
+        (_, None) => Err(PipelineError::io(
+            path,
+            "no `woodpile` manifest in the metadata",
+        )),
+        (_, Some(manifest)) => Ok((checked.frame, manifest)),
+    }
+}
+
+/// What a table that fails its seal is told.
+pub const DAMAGED: &str = "damaged: its bytes no longer match the seal in its manifest";
+
+/// Reads only the manifest of the table at `path`: `Ok(None)` when the file does not exist,
+/// an error when it is damaged or has no manifest.
+pub fn read_manifest(path: &Path) -> Result<Option<Manifest>> {
+    match read_checked_manifest(path)? {
+        None => Ok(None),
+        Some((_, Integrity::Damaged)) => Err(PipelineError::io(path, DAMAGED)),
+        Some((None, _)) => Err(PipelineError::io(
+            path,
+            "no `woodpile` manifest in the metadata",
+        )),
+        Some((Some(manifest), _)) => Ok(Some(manifest)),
+    }
+}
+
+/// The manifest's text in a parquet footer, `None` when it has none.
+fn manifest_text(metadata: &FileMetadataRef) -> Option<String> {
+    metadata
+        .key_value_metadata()
+        .iter()
+        .flatten()
+        .find(|kv| kv.key == METADATA_KEY)
+        .and_then(|kv| kv.value.clone())
+}
+
+fn parse_manifest(path: &Path, text: &str) -> Result<Manifest> {
+    Manifest::from_json_text(text)
+        .map_err(|e| PipelineError::io(path, format!("unreadable manifest: {e}")))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,160 @@
+//! Scene files resolved to scenes: the paper's defaults and numbering, regions, physical
+//! units, and the errors that name the key (endless runs, impossible tolerances, defects).
+#![allow(clippy::unwrap_used)]
+
+use std::path::Path;
+
+use woodpile_scene::{parse, SceneError};
+
+fn invalid_key(text: &str) -> String {
+    match parse(text, Path::new("s.toml")) {
+        Err(SceneError::Invalid { key, .. }) => key,
+        other => panic!("expected an invalid key, got {other:?}"),
+    }
+}
+
+/// The paper's defaults and numbering: site n is index n + N.
+#[test]
+fn defaults_and_numbering() {
+    let scene = parse("[[defect]]\nsite = 0\neps = 10.0\n", Path::new("s.toml")).unwrap();
+    let s = &scene.scenario;
+    assert_eq!(s.model.n_sites(), 201);
+    assert_eq!(s.impulse_site, 75);
+    assert_eq!(s.t_end, 150.0);
+    assert_eq!(s.model.resonators()[0].site, 100);
+    assert_eq!(scene.region_paper, [-1, 1]);
+    assert_eq!((s.region.lo(), s.region.hi()), (99, 101));
+}
+
+/// `chain.sites` numbers an asymmetric chain: the woodpile's 40 rods -20..19.
+#[test]
+fn asymmetric_chain_numbering() {
+    let text =
+        "[chain]\nsites = [-20, 19]\n[impulse]\nsite = -20\n[[defect]]\nsite = 0\neps = 1.0\n";
+    let scene = parse(text, Path::new("s.toml")).unwrap();
+    let s = &scene.scenario;
+    assert_eq!(s.model.n_sites(), 40);
+    assert_eq!((scene.first_site, scene.last_site), (-20, 19));
+    assert_eq!(s.impulse_site, 0);
+    assert_eq!(s.model.resonators()[0].site, 20);
+    assert_eq!(
+        invalid_key("[chain]\nsites = [-20, 19]\n[impulse]\nsite = 20\n"),
+        "impulse.site"
+    );
+    assert_eq!(
+        invalid_key("[chain]\nn = 5\nsites = [-5, 5]\n"),
+        "chain.sites"
+    );
+    assert_eq!(invalid_key("[chain]\nsites = [3, 3]\n"), "chain.sites");
+    assert_eq!(invalid_key("[chain]\nsites = [1, 2, 3]\n"), "chain.sites");
+    assert_eq!(
+        invalid_key(&format!("[chain]\nsites = [{}, {}]\n", i64::MIN, i64::MAX)),
+        "chain.sites"
+    );
+}
+
+/// The default region spans the defects plus one site each side (paper Eqs. 10 and 11).
+#[test]
+fn default_region_spans_the_defects() {
+    let text = "[[defect]]\nsite = 20\neps = 1.0\n[[defect]]\nsite = 0\neps = 1.0\n";
+    assert_eq!(
+        parse(text, Path::new("s.toml")).unwrap().region_paper,
+        [-1, 21]
+    );
+}
+
+#[test]
+fn physical_and_dimensionless_keys_do_not_mix() {
+    let physical = "[physical]\ncontact = 2.47e9\nmass = 1e-3\nvelocity = 2.0\n";
+    assert_eq!(
+        invalid_key(&format!("{physical}[[defect]]\nsite = 0\neps = 1.0\n")),
+        "defect[0].eps"
+    );
+    assert_eq!(
+        invalid_key("[[defect]]\nsite = 0\neps = 1.0\nstiffness = 5.0\n"),
+        "defect[0].stiffness"
+    );
+    assert_eq!(
+        invalid_key(&format!("{physical}[impulse]\nvelocity = 2.0\n")),
+        "impulse.velocity"
+    );
+}
+
+/// Runs that could never finish are refused before they start, naming the key that makes
+/// them too long; the reason carries the estimate.
+#[test]
+fn endless_runs_are_refused_up_front_naming_the_key() {
+    let cases = [
+        ("[run]\nt_end = 1e12\n", "run.t_end"),
+        ("[run]\nt_end = 1e8\nsample_every = 1e3\n", "run.t_end"),
+        ("[run]\nmethod = \"rk4\"\ndt = 1e-300\n", "run.dt"),
+        ("[run]\ntolerance = 1e-12\nt_end = 1e5\n", "run.tolerance"),
+        ("[run]\nsample_every = 1e-12\n", "run.sample_every"),
+        ("[[defect]]\nsite = 0\neps = 1e-300\n", "defect[0]"),
+        (
+            "[[defect]]\nsite = 0\neps = 1.0\n[[defect]]\nsite = 3\neps = 1e-300\n",
+            "defect[1]",
+        ),
+        (
+            "[[defect]]\nsite = 0\neps = 1e-300\n[run]\nmethod = \"dop853\"\n",
+            "defect[0]",
+        ),
+    ];
+    for (text, key) in cases {
+        assert_eq!(invalid_key(text), key, "{text}");
+    }
+    match parse(
+        "[run]\nmethod = \"rk4\"\ndt = 1e-300\n",
+        Path::new("s.toml"),
+    ) {
+        Err(SceneError::Invalid { reason, .. }) => {
+            assert!(reason.contains("1.500e302 steps"), "{reason}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // The budget is generous: the paper's tightest scenes pass.
+    assert!(parse("[run]\ntolerance = 1e-10\n", Path::new("s.toml")).is_ok());
+}
+
+#[test]
+fn tolerances_below_what_doubles_can_verify_are_refused() {
+    assert_eq!(invalid_key("[run]\ntolerance = 1e-30\n"), "run.tolerance");
+}
+
+#[test]
+fn a_standing_impulse_has_no_fractions() {
+    assert_eq!(
+        invalid_key("[impulse]\nvelocity = 0.0\n"),
+        "impulse.velocity"
+    );
+    assert!(parse("[impulse]\nvelocity = -1.0\n", Path::new("s.toml")).is_ok());
+}
+
+#[test]
+fn defects_are_capped_at_the_chains_sites() {
+    let mut text = String::from("[chain]\nn = 2\n");
+    for _ in 0..6 {
+        text.push_str("[[defect]]\nsite = 0\neps = 1.0\n");
+    }
+    assert_eq!(invalid_key(&text), "defect");
+}
+
+#[test]
+fn two_defects_on_one_site_are_refused() {
+    let text = "[[defect]]\nsite = 3\neps = 1.0\n[[defect]]\nsite = 3\neps = 2.0\n";
+    assert_eq!(invalid_key(text), "defect[1].site");
+}
+
+#[test]
+fn dt_needs_a_fixed_step_method() {
+    assert_eq!(invalid_key("[run]\ndt = 0.01\n"), "run.dt");
+    assert_eq!(
+        invalid_key("[run]\nmethod = \"dop853\"\ndt = 0.01\n"),
+        "run.dt"
+    );
+    assert!(parse(
+        "[run]\nmethod = \"verlet\"\ndt = 0.01\n",
+        Path::new("s.toml")
+    )
+    .is_ok());
+}

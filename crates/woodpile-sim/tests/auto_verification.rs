@@ -1,0 +1,147 @@
+//! `auto` on the scenes that make a verification pair lie: a stiff nonlinear resonator, a
+//! first step that blows up, a loose tolerance on a strongly nonlinear coupling, and an error
+//! plateau where two runs agree while both miss.
+#![allow(clippy::unwrap_used)]
+
+use woodpile_sim::integrate::{Method, MethodChoice, Plan};
+use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+
+/// A stiff nonlinear resonator (p = 13, eps = 0.01): `auto`'s answer agrees with an
+/// independent tighter Yoshida-6 run.
+#[test]
+fn auto_on_a_stiff_nonlinear_resonator_agrees_with_yoshida6() {
+    use woodpile_sim::integrate::MethodChoice;
+    use woodpile_sim::run::simulate;
+    use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
+    let defect = PaperDefect {
+        p: 13,
+        ..PaperDefect::linear(0, 0.01, 1.0)
+    };
+    let auto = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-6));
+    let out = simulate(&auto, &mut ()).expect("auto converges");
+    assert!(out.error_estimate.unwrap() <= 0.5e-6);
+    let reference = paper_scene(
+        &[defect],
+        MethodChoice::Named(Method::Yoshida6),
+        fixed_dt(5e-4),
+    );
+    let exact = simulate(&reference, &mut ()).unwrap();
+    assert!(
+        (out.fractions.trapped - exact.fractions.trapped).abs() < 2e-6,
+        "auto {} vs yoshida6 {}",
+        out.fractions.trapped,
+        exact.fractions.trapped
+    );
+}
+
+/// At a loose tolerance the calibrated first step is the largest allowed (0.25), and the
+/// verification pair's coarse run takes twice that, where `auto`'s method loses the energy of
+/// a strong impact (velocity 3): `auto` must treat that as "halve the step", not as a failed
+/// scene, and still meet the tolerance.
+#[test]
+fn auto_halves_past_a_first_step_that_blows_up() {
+    use woodpile_sim::integrate::{MethodChoice, AUTO_METHOD};
+    use woodpile_sim::run::{auto_first_step, simulate, Scenario};
+    use woodpile_sim::testing::{
+        fixed_dt, paper_scene, reference_fractions, tolerance, PaperDefect,
+    };
+    let defects = [PaperDefect::linear(0, 10.0, 1.0)];
+    let strong = |method, accuracy| Scenario {
+        impulse_velocity: 3.0,
+        ..paper_scene(&defects, method, accuracy)
+    };
+    let auto = strong(MethodChoice::Auto, tolerance(1e-2));
+    let first = auto_first_step(
+        &auto,
+        &Plan::choose(&auto.model, MethodChoice::Auto, auto.accuracy).unwrap(),
+    );
+    assert_eq!(first, 0.25);
+    let blown = simulate(
+        &strong(MethodChoice::Named(AUTO_METHOD), fixed_dt(2.0 * first)),
+        &mut (),
+    );
+    assert!(blown.is_err(), "the coarse run should blow up: {blown:?}");
+    let out = simulate(&auto, &mut ()).expect("auto converges by halving");
+    assert!(out.plan.dt().unwrap() <= 0.5 * first);
+    let exact = reference_fractions(&auto, 0.01).unwrap();
+    assert!(out.fractions.largest_difference(&exact) <= 1e-2);
+}
+
+/// A strongly nonlinear resonator (p = 19, eps = 0.09) is stiffest at its largest stretch. Before
+/// `auto` capped its first step by the stiffness the impact's energy allows
+/// (`Plan::resolving_dt`), both runs of its verification pair at tolerance 1e-5 missed those
+/// moments by the same 3e-5 and agreed with each other: the run passed, 3 times off.
+#[test]
+fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
+    use woodpile_sim::integrate::MethodChoice;
+    use woodpile_sim::run::simulate;
+    use woodpile_sim::testing::{paper_scene, reference_fractions, tolerance, PaperDefect};
+    let defect = PaperDefect {
+        p: 19,
+        ..PaperDefect::linear(0, 0.09, 1.0)
+    };
+    let scene = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-5));
+    let out = simulate(&scene, &mut ()).expect("auto converges");
+    let exact = reference_fractions(&scene, 5e-4).unwrap();
+    let error = out.fractions.largest_difference(&exact);
+    assert!(
+        error <= 1e-5,
+        "auto is off by {error:.1e} at tolerance 1e-5"
+    );
+}
+
+/// A scene from a survey of random scenes (two sharply ramped couplings, one of them cubic, and
+/// a heavy linear resonator; fixed walls; 207 sites). Its runs at 0.136, 0.068 and 0.034 sit on
+/// a plateau, 6e-4, 4.5e-4 and 3.4e-4 off, so the last two agree well enough for Richardson's
+/// estimate (1.8e-5) to pass tolerance 1e-4. `auto` must see that the changes between its runs
+/// are not shrinking as an order-3 method's do, and keep halving.
+#[test]
+fn auto_does_not_accept_a_pair_on_an_error_plateau() {
+    use woodpile_sim::energy::Region;
+    use woodpile_sim::run::{simulate, Scenario};
+    use woodpile_sim::testing::{reference_fractions, tolerance};
+    let ramp = |k2, t0, tau| Coupling::Ramp {
+        k1: 0.0,
+        k2,
+        t0,
+        tau,
+    };
+    let resonators = vec![
+        Resonator {
+            site: 112,
+            eps: 2.197850221683016,
+            coupling: ramp(2.3897265767851934, 37.13215431508864, 0.2300273676325668),
+            p: 1,
+        },
+        Resonator {
+            site: 115,
+            eps: 1.7022321072623756,
+            coupling: ramp(2.6810316232832903, 45.63277177607065, 1.0667503192452776),
+            p: 3,
+        },
+        Resonator {
+            site: 130,
+            eps: 93.09645542646219,
+            coupling: Coupling::Constant(0.8957921281524939),
+            p: 1,
+        },
+    ];
+    let model = Model::new(207, Boundary::Fixed, resonators).unwrap();
+    let scene = Scenario {
+        model,
+        impulse_site: 85,
+        impulse_velocity: 1.2181064632981897,
+        t_end: 177.7013121837715,
+        region: Region::new(111, 131, 207).unwrap(),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(1e-4),
+        sample_every: 1.0,
+    };
+    let out = simulate(&scene, &mut ()).unwrap();
+    let reference = reference_fractions(&scene, 0.002).unwrap();
+    let error = out.fractions.largest_difference(&reference);
+    assert!(
+        error <= 1e-4,
+        "auto is off by {error:.1e} at tolerance 1e-4"
+    );
+}
