@@ -22,8 +22,11 @@ use crate::table;
 /// A stage kind: its parameters, and what it does with them.
 pub trait Kind: std::fmt::Debug + Send + Sync + Any {
     /// Checks the stage's inputs against their kinds (`inputs` reaches them by name). The
-    /// error is (key, reason); the caller names the stage file.
-    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck;
+    /// error is (key, reason); the caller names the stage file. By default a kind reads no
+    /// other stage: it computes from its own parameters ([`no_inputs`]).
+    fn check_inputs(&self, stage: &Stage, _inputs: &Inputs<'_>) -> KindCheck {
+        no_inputs(stage)
+    }
 
     /// Computes the stage's table (and writes any files of its own).
     fn run(&self, ctx: &Context<'_>) -> Result<Output>;

@@ -35,8 +35,7 @@ use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::kind::{Context, Kind};
 use woodpile_pipeline::table::Columns;
 use woodpile_pipeline::Output;
 
@@ -366,10 +365,6 @@ struct Run {
 impl Kind for Stability {
     fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
         woodpile_pipeline::kind::Sharing::Parallel
-    }
-
-    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
-        no_inputs(stage)
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {

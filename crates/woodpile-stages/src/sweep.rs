@@ -38,11 +38,10 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{parse_axes, point, point_count, Axis, AxisValue};
-use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck, PointGrid};
+use woodpile_pipeline::kind::{Context, Kind, PointGrid};
 use woodpile_pipeline::points::{
     point_key, PointData, PointResult, PointStats, PointStore, Series,
 };
-use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{rows_frame, Cell, Row};
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
@@ -363,10 +362,6 @@ impl PointGrid for Sweep {
 impl Kind for Sweep {
     fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
         woodpile_pipeline::kind::Sharing::Parallel
-    }
-
-    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
-        no_inputs(stage)
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {

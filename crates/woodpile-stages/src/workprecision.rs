@@ -36,8 +36,7 @@ use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
-use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::kind::{Context, Kind};
 use woodpile_pipeline::table::{rows_frame, Cell, Row};
 use woodpile_pipeline::Output;
 
@@ -308,10 +307,6 @@ impl Row for Run<'_> {
 impl Kind for WorkPrecision {
     fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
         woodpile_pipeline::kind::Sharing::Alone
-    }
-
-    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
-        no_inputs(stage)
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {

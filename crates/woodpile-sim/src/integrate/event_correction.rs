@@ -271,6 +271,23 @@ fn block_changes<const S: usize, const N: usize>(
     mask
 }
 
+/// The name of a stepper that keeps contact events in `contact` (`names[1]`) or does not
+/// (`names[0]`).
+pub(crate) fn named<const S: usize>(
+    contact: &Option<ContactEvents<S>>,
+    [plain, corrected]: [&'static str; 2],
+) -> &'static str {
+    match contact {
+        Some(_) => corrected,
+        None => plain,
+    }
+}
+
+/// Bonds whose contact changed state inside a step and were corrected (0 without events).
+pub(crate) fn events_of<const S: usize>(contact: &Option<ContactEvents<S>>) -> u64 {
+    contact.as_ref().map_or(0, ContactEvents::events)
+}
+
 /// Stage `stage`'s accelerations `acc` at positions `q`, recording every bond force into
 /// `contact` when a contact-event method keeps them.
 pub(crate) fn stage_accelerations<const S: usize>(

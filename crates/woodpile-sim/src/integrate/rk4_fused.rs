@@ -11,7 +11,7 @@
 //! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
 use super::contact_event::rk4_quadrature;
-use super::event_correction::{finish_step, stage_accelerations, ContactEvents};
+use super::event_correction::{events_of, finish_step, named, stage_accelerations, ContactEvents};
 use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
@@ -61,17 +61,13 @@ impl Rk4Fused {
 
     /// Bonds whose contact changed state inside a step and were corrected (0 for plain RK4).
     pub fn contact_events(&self) -> u64 {
-        self.contact.as_ref().map_or(0, ContactEvents::events)
+        events_of(&self.contact)
     }
 }
 
 impl Stepper for Rk4Fused {
     fn name(&self) -> &'static str {
-        if self.contact.is_some() {
-            "rk4-contact"
-        } else {
-            "rk4"
-        }
+        named(&self.contact, ["rk4", "rk4-contact"])
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {

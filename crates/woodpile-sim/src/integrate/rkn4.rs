@@ -22,7 +22,7 @@
 //! where the tableau stepper takes 6.7 ms (1.18x; best of 15, `cargo run --release -p
 //! woodpile-bench --example nystrom4`).
 
-use super::event_correction::{finish_step, stage_accelerations, ContactEvents};
+use super::event_correction::{events_of, finish_step, named, stage_accelerations, ContactEvents};
 use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
@@ -77,17 +77,13 @@ impl Rkn4 {
 
     /// Bonds whose contact changed state inside a step and were corrected (0 for plain RKN4).
     pub fn contact_events(&self) -> u64 {
-        self.contact.as_ref().map_or(0, ContactEvents::events)
+        events_of(&self.contact)
     }
 }
 
 impl Stepper for Rkn4 {
     fn name(&self) -> &'static str {
-        if self.contact.is_some() {
-            "rkn4-contact"
-        } else {
-            "rkn4"
-        }
+        named(&self.contact, ["rkn4", "rkn4-contact"])
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {

@@ -54,10 +54,9 @@ use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{Context, Kind};
 use woodpile_pipeline::layout::best_path;
 use woodpile_pipeline::points::{PointResult, PointStore};
-use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::Output;
 
 use crate::schema::Fraction;
@@ -451,10 +450,6 @@ impl Design {
 impl Kind for Design {
     fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
         woodpile_pipeline::kind::Sharing::Parallel
-    }
-
-    fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
-        no_inputs(stage)
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
