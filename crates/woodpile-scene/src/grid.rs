@@ -246,7 +246,7 @@ fn stepped(from: f64, to: f64, step: f64, all_int: bool) -> Result<Vec<AxisValue
             if all_int {
                 AxisValue::Int(from as i64 + i * step as i64)
             } else {
-                AxisValue::Float(round_sig(from + i as f64 * step))
+                AxisValue::Float(round_sig(from + i as f64 * step, GRID_DIGITS))
             }
         })
         .collect();
@@ -275,7 +275,7 @@ fn counted(from: f64, to: f64, count: usize, log: bool) -> Result<Vec<AxisValue>
         }
     };
     let values: Vec<AxisValue> = (0..count)
-        .map(|i| AxisValue::Float(round_sig(at(i))))
+        .map(|i| AxisValue::Float(round_sig(at(i), GRID_DIGITS)))
         .collect();
     if values.windows(2).any(|w| w[0] == w[1]) {
         return Err(error(
@@ -286,10 +286,15 @@ fn counted(from: f64, to: f64, count: usize, log: bool) -> Result<Vec<AxisValue>
     Ok(values)
 }
 
-/// `x` rounded to 12 significant digits (through its decimal form, so it is the nearest double
-/// to what a user would type).
-fn round_sig(x: f64) -> f64 {
-    format!("{x:.11e}").parse().unwrap_or(x)
+/// Significant digits of a grid value: what a user would type, far finer than any physics.
+const GRID_DIGITS: usize = 12;
+
+/// `x` rounded to `digits` significant digits through its decimal form, so that it is the
+/// nearest double to what a user would type: the one rounding of every generated parameter
+/// (grid values here, a design's eps and kappa).
+pub fn round_sig(x: f64, digits: usize) -> f64 {
+    let places = digits.saturating_sub(1);
+    format!("{x:.places$e}").parse().unwrap_or(x)
 }
 
 fn is_identifier(name: &str) -> bool {

@@ -173,12 +173,7 @@ impl Space {
 /// 10 significant digits: a design file states its numbers exactly as they were simulated,
 /// and nearby genomes share cached points.
 pub(super) fn round_sig(x: f64) -> f64 {
-    if x == 0.0 || !x.is_finite() {
-        return x;
-    }
-    let digits = 9 - x.abs().log10().floor() as i32;
-    let scale = 10f64.powi(digits);
-    (x * scale).round() / scale
+    woodpile_scene::grid::round_sig(x, 10)
 }
 
 pub(super) fn parse_space(mut f: Fields<'_>) -> Result<Space> {
