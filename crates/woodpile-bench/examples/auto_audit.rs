@@ -13,7 +13,7 @@
 //! error bound, reported per scene.
 //!
 //! ```text
-//! cargo run --release -p woodpile-bench --example auto_audit [-- SCENES [SEED [TOLERANCES]]]
+//! cargo run --release -p woodpile-bench --example auto_audit [-- SCENES [SEED [TOLERANCES [ONLY]]]]
 //! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
@@ -128,8 +128,15 @@ fn main() {
     let tolerances: Vec<f64> = args.next().map_or(vec![1e-5, 1e-6, 1e-7, 1e-8], |s| {
         s.split(',').map(|t| t.parse().unwrap()).collect()
     });
+    // Optionally only these scene indices (the rest are drawn and dropped): a miss's scene.
+    let only: Option<Vec<usize>> = args
+        .next()
+        .map(|s| s.split(',').map(|k| k.parse().unwrap()).collect());
     let mut rng = Lcg(seed);
-    let scenes: Vec<(usize, Scenario)> = (0..n).map(|k| (k, random_scene(&mut rng))).collect();
+    let scenes: Vec<(usize, Scenario)> = (0..n)
+        .map(|k| (k, random_scene(&mut rng)))
+        .filter(|(k, _)| only.as_ref().is_none_or(|o| o.contains(k)))
+        .collect();
     let audits = on_two_cores(&scenes, |(k, scene)| audit(*k, scene, &tolerances));
     for a in &audits {
         println!("{}", a.line);

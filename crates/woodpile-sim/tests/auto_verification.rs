@@ -145,3 +145,43 @@ fn auto_does_not_accept_a_pair_on_an_error_plateau() {
         "auto is off by {error:.1e} at tolerance 1e-4"
     );
 }
+
+/// Two scenes the audit (`make audit`, seed 2026) once caught `auto` passing with an estimate
+/// 10 and 4.5 times below its true error, both with p = 5 or 7 resonators: each must now be
+/// within its tolerance of an independent `rk4-contact` run ten times finer than any step
+/// `auto` takes, or refused.
+#[test]
+fn auto_holds_its_tolerance_on_the_audits_former_misses() {
+    use woodpile_sim::integrate::{Method, MethodChoice};
+    use woodpile_sim::run::{simulate, Scenario};
+    use woodpile_sim::testing::{audit_scene_at, fixed_dt, tolerance, AUDIT_REFERENCE_DT};
+    use woodpile_sim::SimError;
+    for (k, tol) in [(149, 1e-7), (186, 1e-8)] {
+        let scene = audit_scene_at(2026, k);
+        let reference = simulate(
+            &Scenario {
+                method: MethodChoice::Named(Method::Rk4Contact),
+                accuracy: fixed_dt(AUDIT_REFERENCE_DT),
+                ..scene.clone()
+            },
+            &mut (),
+        )
+        .unwrap()
+        .fractions;
+        let auto = Scenario {
+            accuracy: tolerance(tol),
+            ..scene
+        };
+        match simulate(&auto, &mut ()) {
+            Ok(out) => {
+                let error = out.fractions.largest_difference(&reference);
+                assert!(
+                    error <= tol,
+                    "scene {k}: error {error:.2e} at tolerance {tol:e}"
+                );
+            }
+            Err(SimError::NotConverged { .. }) => {}
+            Err(e) => panic!("scene {k}: {e}"),
+        }
+    }
+}

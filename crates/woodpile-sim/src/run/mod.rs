@@ -4,8 +4,8 @@
 //! `method = "auto"` is verified, not trusted: it runs the calibrated step `dt` and its double
 //! `2 dt`, estimates the finer run's error by Richardson's rule for the method's observed order q
 //! (3 for `rkn6-contact`, auto's method), |F(dt) - F(2 dt)| / (2^q - 1), and
-//! accepts when that estimate is at most half the tolerance;
-//! otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
+//! accepts when that estimate is at most half the tolerance (a sixteenth when a resonator is
+//! nonlinear: [`acceptance`]); otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
 //! without a stiffness model having to foresee them.
 
 pub mod budget;
@@ -119,6 +119,7 @@ fn verified<O: Observer + ?Sized>(
     // made them: the asymptotic-regime check below.
     let mut previous_change: Option<f64> = None;
     let mut why = String::from("no run kept its energy");
+    let accept = acceptance(&scenario.model, tol);
     for _ in 0..=MAX_HALVINGS {
         observer.reset();
         let fine = match run_plan(scenario, &guarded.with_dt(dt), observer) {
@@ -146,7 +147,7 @@ fn verified<O: Observer + ?Sized>(
             (order, f64::from(plan.method.order())),
             tol,
         );
-        if estimate <= 0.5 * tol && drift_ok && regular {
+        if estimate <= accept && drift_ok && regular {
             return Ok(Outcome {
                 plan: Plan {
                     drift_limit: plan.drift_limit,
@@ -159,10 +160,9 @@ fn verified<O: Observer + ?Sized>(
         }
         why = if change.is_none() {
             "the run at twice the step blew up, so there is no pair to compare".to_string()
-        } else if estimate > 0.5 * tol {
+        } else if estimate > accept {
             format!(
-                "the error estimate {estimate:.2e} is above the half tolerance {:.1e} it must meet",
-                0.5 * tol
+                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e})"
             )
         } else if !drift_ok {
             format!(
@@ -186,6 +186,22 @@ fn verified<O: Observer + ?Sized>(
         dt: 2.0 * dt,
         why,
     })
+}
+
+/// The largest error estimate `auto` accepts at tolerance `tol`: half of it, or a sixteenth
+/// when a resonator is nonlinear (p >= 3). Such a resonator's stiffness grows with its
+/// stretch, so a pair of runs can pass its stiff moments alike and agree far better than
+/// either is accurate: on the audit's misses (seed 2026) the estimate was 4 to 16 times below
+/// the error. With a sixteenth the audit's held-out seed 7 went from 12 silent misses to 3, for
+/// 3% more force evaluations on the paper's nonlinear sweep (F6) (docs/methods.md, "The
+/// audit").
+fn acceptance(model: &Model, tol: f64) -> f64 {
+    let nonlinear = model.resonators().iter().any(|r| r.p >= 3);
+    if nonlinear {
+        tol / 16.0
+    } else {
+        0.5 * tol
+    }
 }
 
 /// Whether three runs at 4 dt, 2 dt and dt look like the asymptotic regime that Richardson's
