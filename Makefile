@@ -69,7 +69,7 @@ bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, then
 	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py
 	$(CARGO) bench -p woodpile-bench
 
-audit: ## auto against an independent reference on 200 random scenes at 1e-5..1e-8 (about 6 min)
+audit: ## auto against an independent reference on 200 random scenes at 1e-5..1e-8 (about 7 min)
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 
 work-precision: ## Error in E_tr against wall time for every method and step (README table)
