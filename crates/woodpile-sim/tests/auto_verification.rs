@@ -148,8 +148,10 @@ fn auto_does_not_accept_a_pair_on_an_error_plateau() {
 
 /// Scenes the audit (`make audit`) once caught `auto` passing with an estimate 4.5 to 190
 /// times below its true error: two of seed 2026 with p = 5 or 7 resonators, one of seed 7
-/// that adds a ramped coupling, and one of seed 11 whose error jumps with the step. Each must now be within its tolerance of an independent
-/// `rk4-contact` run ten times finer than any step `auto` takes, or refused.
+/// that adds a ramped coupling, one of seed 11 whose error jumps with the step, and one of
+/// seed 2027 whose wave bounces between the walls of a short chain. Each must now be within
+/// its tolerance of an independent `rk4-contact` run ten times finer than any step `auto`
+/// takes, or refused.
 #[test]
 fn auto_holds_its_tolerance_on_the_audits_former_misses() {
     use woodpile_sim::integrate::{Method, MethodChoice};
@@ -161,6 +163,7 @@ fn auto_holds_its_tolerance_on_the_audits_former_misses() {
         (2026, 186, 1e-8),
         (7, 138, 1e-5),
         (11, 138, 1e-8),
+        (2027, 23, 1e-7),
     ];
     for (seed, k, tol) in former_misses {
         let scene = audit_scene_at(seed, k);
@@ -190,4 +193,33 @@ fn auto_holds_its_tolerance_on_the_audits_former_misses() {
             Err(e) => panic!("scene {k}: {e}"),
         }
     }
+}
+
+/// The run notes when its wave first reaches a chain end (what makes `auto` check a bouncing
+/// scene off its ladder): the paper's scene ends before the reflected and transmitted waves
+/// arrive, the same scene run on does not, and an impulse on an end site is not an arrival.
+#[test]
+fn a_run_notes_when_its_wave_reaches_an_end_of_the_chain() {
+    use woodpile_sim::integrate::{Method, MethodChoice};
+    use woodpile_sim::run::{simulate, Scenario};
+    use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
+    let paper = paper_scene(
+        &[PaperDefect::linear(0, 10.0, 1.0)],
+        MethodChoice::Named(Method::Rkn4Contact),
+        fixed_dt(0.02),
+    );
+    let arrival = |s: &Scenario| simulate(s, &mut ()).unwrap().stats.end_reached_at;
+    assert_eq!(arrival(&paper), None);
+    let longer = Scenario {
+        t_end: 400.0,
+        ..paper.clone()
+    };
+    let t = arrival(&longer).expect("the waves reach the walls by t = 400");
+    assert!((150.0..400.0).contains(&t), "reached at {t}");
+    let struck_at_the_end = Scenario {
+        impulse_site: 0,
+        t_end: 20.0,
+        ..paper
+    };
+    assert_eq!(arrival(&struck_at_the_end), None);
 }

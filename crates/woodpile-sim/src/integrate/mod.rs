@@ -265,6 +265,47 @@ pub struct Stats {
     /// model's count is `n_sites × attempts`; the ratio is what the active window saves, as a
     /// machine-independent number.
     pub site_steps: u64,
+    /// The first sample time at which a chain end that was at rest at t = 0 moves at more
+    /// than [`END_ARRIVAL_SPEED`] of the impact's speed: when the wave reached a wall or a
+    /// free end. `None`: it never did (the paper's scenes end before it does).
+    pub end_reached_at: Option<f64>,
+}
+
+/// An end site counts as reached when it moves at this fraction of sqrt(2 E(0)), the speed
+/// the whole impact energy gives a unit mass. A solitary wave's precursor falls off faster
+/// than exponentially, so an end moves at a thousandth of that speed only once the wave is
+/// there.
+pub const END_ARRIVAL_SPEED: f64 = 1e-3;
+
+/// The chain's end sites that were at rest at t = 0 (an impulse on an end site starts there,
+/// and says nothing about a wave arriving).
+struct WatchedEnds {
+    sites: Vec<usize>,
+    n_dof: usize,
+    speed: f64,
+}
+
+impl WatchedEnds {
+    fn new(model: &Model, y: &[f64], e0: f64) -> Self {
+        let n_dof = model.n_dof();
+        let last = model.n_sites() - 1;
+        let mut sites = vec![0, last];
+        sites.dedup();
+        sites.retain(|&i| y[i] == 0.0 && y[n_dof + i] == 0.0);
+        Self {
+            sites,
+            n_dof,
+            speed: END_ARRIVAL_SPEED * (2.0 * e0.max(0.0)).sqrt(),
+        }
+    }
+
+    fn reached(&self, y: &[f64]) -> bool {
+        self.speed > 0.0
+            && self
+                .sites
+                .iter()
+                .any(|&i| y[self.n_dof + i].abs() > self.speed)
+    }
 }
 
 /// Integrates `y` from t = 0 to `cfg.t_end` with `stepper`, calling `observer` at the samples.
@@ -292,6 +333,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
     };
     check_finite(y, t)?;
     observer.observe(model, t, y);
+    let ends = WatchedEnds::new(model, y, e0);
     let mut active = ActiveSites::new(model, y, stepper.reach(), cfg.active_window);
 
     for k in 1..=n_intervals {
@@ -372,6 +414,9 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                     return Err(SimError::EnergyDrift { t, drift, limit });
                 }
             }
+        }
+        if stats.end_reached_at.is_none() && ends.reached(y) {
+            stats.end_reached_at = Some(t);
         }
         observer.observe(model, t, y);
         if observer.cancelled() {
