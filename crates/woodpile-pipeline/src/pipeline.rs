@@ -11,7 +11,7 @@ use serde_json::json;
 use crate::canonical::{code_version, Key};
 use crate::error::{PipelineError, Result};
 use crate::kind::{Inputs, Registry};
-use crate::stage::Stage;
+use crate::stage::{Defaults, Stage};
 use crate::variant::Set;
 
 /// A loaded, validated pipeline.
@@ -44,14 +44,16 @@ impl Pipeline {
             ));
         }
         let root = project_root(dir);
+        let defaults = Defaults::load(dir)?;
         let mut files = Vec::new();
         stage_files(dir, &mut files)?;
+        files.retain(|f| *f != dir.join(Defaults::FILE));
         files.sort();
         let mut stages = files
             .iter()
-            .map(|f| Stage::load(f, &root, kinds))
+            .map(|f| Stage::load(f, &root, kinds, &defaults))
             .collect::<Result<Vec<_>>>()?;
-        stages.extend(crate::variant::variants(&stages, sets, &root, kinds)?);
+        stages.extend(crate::variant::variants(&stages, sets, &root, kinds, &defaults)?);
         let mut seen: HashMap<&str, &Path> = HashMap::new();
         for stage in &stages {
             if let Some(other) = seen.insert(&stage.name, &stage.file) {

@@ -23,20 +23,26 @@ pub use crate::kind::Stage;
 
 impl Stage {
     /// Reads and parses the stage file at `file` of the project rooted at `root` (where a
-    /// `scene = "scenes/x.toml"` reference is found), with the kinds of `kinds`.
-    pub fn load(file: &Path, root: &Path, kinds: &'static Registry) -> Result<Stage> {
+    /// `scene = "scenes/x.toml"` reference is found), with the kinds of `kinds` and the
+    /// project's `defaults` ([`Defaults`]).
+    pub fn load(
+        file: &Path,
+        root: &Path,
+        kinds: &'static Registry,
+        defaults: &Defaults,
+    ) -> Result<Stage> {
         let text = woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
             reason: format!("cannot read: {e}"),
             source: None,
         })?;
-        Stage::parse_in(&text, file, root, kinds)
+        Stage::parse_in(&text, file, root, kinds, defaults)
     }
 
     /// Parses stage TOML `text`; `file` names it (and gives the stage its name); scene files
     /// are found relative to the current directory.
     pub fn parse(text: &str, file: &Path, kinds: &'static Registry) -> Result<Stage> {
-        Stage::parse_in(text, file, Path::new("."), kinds)
+        Stage::parse_in(text, file, Path::new("."), kinds, &Defaults::default())
     }
 
     /// [`Stage::parse`] in the project rooted at `root`.
@@ -45,6 +51,7 @@ impl Stage {
         file: &Path,
         root: &Path,
         kinds: &'static Registry,
+        defaults: &Defaults,
     ) -> Result<Stage> {
         let mut table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
             file: file.to_path_buf(),
@@ -52,6 +59,7 @@ impl Stage {
             source: Some(Box::new(e)),
         })?;
         include_scene_file(&mut table, file, root)?;
+        defaults.lay_under(&mut table);
         Stage::from_table(table, file, kinds)
     }
 
@@ -84,6 +92,54 @@ impl Stage {
             spec,
             params,
         })
+    }
+}
+
+/// Keys every stage of a kind starts from: `defaults.toml` in the stage folder, one table per
+/// kind (`[render.style]`, say). A stage's own keys override them, tables merging key by key;
+/// they are laid in before parsing, so they are part of each stage's key and manifest, and
+/// editing them makes exactly the stages of that kind stale. The engine reads the file without
+/// knowing any kind: it only matches table names against each stage's `kind`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Defaults(toml::Table);
+
+impl Defaults {
+    /// The name of the defaults file in a stage folder; it is not a stage.
+    pub const FILE: &'static str = "defaults.toml";
+
+    /// The defaults in `dir` (none when it has no defaults file).
+    pub fn load(dir: &Path) -> Result<Defaults> {
+        let file = dir.join(Defaults::FILE);
+        if !file.exists() {
+            return Ok(Defaults::default());
+        }
+        let text = woodpile_scene::read_input(&file).map_err(|e| PipelineError::Syntax {
+            file: file.clone(),
+            reason: format!("cannot read: {e}"),
+            source: None,
+        })?;
+        let table: toml::Table = toml::from_str(&text).map_err(|e| PipelineError::Syntax {
+            file: file.clone(),
+            reason: e.to_string().trim_end().to_string(),
+            source: Some(Box::new(e)),
+        })?;
+        if let Some((key, _)) = table.iter().find(|(_, v)| !v.is_table()) {
+            return Err(definition(
+                &file,
+                key,
+                "expected a table of defaults named after a kind ([render], say)",
+            ));
+        }
+        Ok(Defaults(table))
+    }
+
+    /// Lays the defaults of `table`'s kind under it: its own keys win.
+    fn lay_under(&self, table: &mut toml::Table) {
+        let kind = table.get("kind").and_then(|k| k.as_str());
+        if let Some(toml::Value::Table(defaults)) = kind.and_then(|k| self.0.get(k)) {
+            let own = std::mem::replace(table, defaults.clone());
+            merge(table, own);
+        }
     }
 }
 

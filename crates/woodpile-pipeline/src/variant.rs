@@ -77,6 +77,7 @@ pub fn variants(
     sets: &[Set],
     root: &Path,
     kinds: &'static Registry,
+    defaults: &crate::stage::Defaults,
 ) -> Result<Vec<Stage>> {
     let mut names: Vec<&str> = sets.iter().map(|s| s.stage.as_str()).collect();
     names.sort_unstable();
@@ -124,7 +125,7 @@ pub fn variants(
                 reason: e.to_string(),
                 source: None,
             })?;
-            Stage::parse_in(&text, &file, root, kinds)
+            Stage::parse_in(&text, &file, root, kinds, defaults)
         })
         .collect()
 }

@@ -27,25 +27,135 @@ const DIVERGING: [(u8, u8, u8); 7] = [
     (103, 0, 31),
 ];
 
-/// Line colours (matplotlib's tab10, which prints and projects well). Its grey is left out:
-/// it is too close to the grey of missing values.
-pub const PALETTE: [RGBColor; 9] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
+/// Line colours: Okabe and Ito's palette, told apart by red-green colour-blind readers, in an
+/// order that starts with the pairs that differ most in grey (blue, vermillion, green, orange).
+/// Its yellow, too light on white, is left out.
+pub const PALETTE: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(230, 159, 0),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
 ];
 
-/// Colours for categories, the palette's in the order green, orange, red, blue, purple, brown:
-/// three classes such as "meets", "misses", "unstable" read as go, caution, stop.
+/// Colours for categories, from the same palette: green, yellow, vermillion, then blue, purple
+/// and sky blue; three classes such as "meets", "misses", "unstable" read as go, caution, stop.
 pub const CATEGORIES: [RGBColor; 6] = [
-    PALETTE[2], PALETTE[3], PALETTE[1], PALETTE[0], PALETTE[4], PALETTE[5],
+    RGBColor(0, 158, 115),
+    RGBColor(240, 228, 66),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 114, 178),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 180, 233),
 ];
+
+/// How a curve is stroked.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dash {
+    /// Unbroken.
+    Solid,
+    /// Long dashes.
+    Dashed,
+    /// Dots.
+    Dotted,
+    /// Dashes and dots.
+    DashDot,
+}
+
+impl Dash {
+    /// The on-off lengths in points (empty: solid).
+    pub(crate) fn pattern(self) -> &'static [f64] {
+        match self {
+            Dash::Solid => &[],
+            Dash::Dashed => &[4.0, 2.5],
+            Dash::Dotted => &[1.0, 1.6],
+            Dash::DashDot => &[4.0, 1.6, 1.0, 1.6],
+        }
+    }
+
+    /// The dash called `name`: "solid", "dashed", "dotted" or "dashdot".
+    pub fn named(name: &str) -> Option<Dash> {
+        match name {
+            "solid" => Some(Dash::Solid),
+            "dashed" => Some(Dash::Dashed),
+            "dotted" => Some(Dash::Dotted),
+            "dashdot" => Some(Dash::DashDot),
+            _ => None,
+        }
+    }
+}
+
+/// The symbol drawn on a curve's points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Marker {
+    /// No symbol.
+    None,
+    /// A filled circle.
+    Circle,
+    /// A filled square.
+    Square,
+    /// A filled triangle.
+    Triangle,
+    /// A filled diamond.
+    Diamond,
+    /// A cross.
+    Cross,
+}
+
+impl Marker {
+    /// The marker called `name`: "none", "circle", "square", "triangle", "diamond" or "cross".
+    pub fn named(name: &str) -> Option<Marker> {
+        match name {
+            "none" => Some(Marker::None),
+            "circle" => Some(Marker::Circle),
+            "square" => Some(Marker::Square),
+            "triangle" => Some(Marker::Triangle),
+            "diamond" => Some(Marker::Diamond),
+            "cross" => Some(Marker::Cross),
+            _ => None,
+        }
+    }
+}
+
+/// A curve's look; what is `None` follows the curve's place in its panel, so that every curve
+/// differs from the others in colour, dash and marker and reads in greyscale.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SeriesStyle {
+    /// Line colour.
+    pub colour: Option<RGBColor>,
+    /// Stroke pattern.
+    pub dash: Option<Dash>,
+    /// Point symbol.
+    pub marker: Option<Marker>,
+}
+
+impl SeriesStyle {
+    /// The look of the `k`-th curve of a panel: this style's choices, the defaults elsewhere.
+    pub(crate) fn resolve(&self, k: usize) -> (RGBColor, Dash, Marker) {
+        const DASHES: [Dash; 4] = [Dash::Solid, Dash::Dashed, Dash::Dotted, Dash::DashDot];
+        const MARKERS: [Marker; 5] = [
+            Marker::Circle,
+            Marker::Square,
+            Marker::Triangle,
+            Marker::Diamond,
+            Marker::Cross,
+        ];
+        (
+            self.colour.unwrap_or(PALETTE[k % PALETTE.len()]),
+            self.dash.unwrap_or(DASHES[k % DASHES.len()]),
+            self.marker.unwrap_or(MARKERS[k % MARKERS.len()]),
+        )
+    }
+}
+
+/// The colour written `#rrggbb`.
+pub fn hex_colour(text: &str) -> Option<RGBColor> {
+    let hex = text.strip_prefix('#').filter(|h| h.len() == 6)?;
+    let byte = |k: usize| u8::from_str_radix(hex.get(k..k + 2)?, 16).ok();
+    Some(RGBColor(byte(0)?, byte(2)?, byte(4)?))
+}
 
 /// The viridis colour at `t` in [0, 1] (clamped).
 pub fn viridis(t: f64) -> RGBColor {
@@ -83,5 +193,23 @@ mod tests {
         assert_eq!(viridis(f64::NAN), viridis(0.0));
         assert_eq!(diverging(0.5), RGBColor(247, 247, 247));
         assert_eq!(diverging(0.0), RGBColor(5, 48, 97));
+        assert_eq!(hex_colour("#0072b2"), Some(RGBColor(0, 114, 178)));
+        assert_eq!(hex_colour("0072b2"), None);
+        assert_eq!(hex_colour("#00zz00"), None);
+    }
+
+    #[test]
+    fn curves_differ_in_colour_dash_and_marker_by_default() {
+        let looks: Vec<_> = (0..3).map(|k| SeriesStyle::default().resolve(k)).collect();
+        for (a, b) in [(0, 1), (0, 2), (1, 2)] {
+            assert_ne!(looks[a].0, looks[b].0);
+            assert_ne!(looks[a].1, looks[b].1);
+            assert_ne!(looks[a].2, looks[b].2);
+        }
+        let chosen = SeriesStyle {
+            dash: Some(Dash::Dotted),
+            ..SeriesStyle::default()
+        };
+        assert_eq!(chosen.resolve(0).1, Dash::Dotted);
     }
 }

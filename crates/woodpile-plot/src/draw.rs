@@ -1,80 +1,232 @@
-//! The drawing itself, generic over the backend so PNG and SVG are the same picture.
+//! The figure and its line panels, generic over the backend so PNG and SVG are one picture.
+//! Heat maps are [`crate::heat`]'s; curves, markers and legends in pixels [`crate::legend`]'s.
 
-use plotters::coord::types::RangedCoordf64;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::colour::{diverging, viridis, CATEGORIES, PALETTE};
-use crate::{Colours, Figure, HeatPanel, LinePanel, Mark, MarkAt, Panel};
+use crate::axis::Scale;
+use crate::colour::{Dash, Marker};
+use crate::legend::{self, Entry, Glyph, Rect};
+use crate::style::{Corner, Legend, Style};
+use crate::{Figure, LinePanel, Mark, MarkAt, Panel};
 
-/// Height of the figure title strip in pixels.
-pub(crate) const TITLE_HEIGHT: u32 = 36;
-const FONT: &str = "sans-serif";
-const MISSING: RGBColor = RGBColor(190, 190, 190);
+pub(crate) const FONT: &str = "sans-serif";
 
-fn text<E: std::fmt::Debug>(e: E) -> String {
+/// A chart whose axes tick where [`Scale::ticks`] says.
+pub(crate) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Ticked, Ticked>>;
+
+/// A plot-space axis from `lo` to `hi` with its tick positions chosen in advance (plotters'
+/// own would tick a log axis at log10 values).
+#[derive(Debug, Clone)]
+pub(crate) struct Ticked {
+    lo: f64,
+    hi: f64,
+    major: Vec<f64>,
+    minor: Vec<f64>,
+}
+
+impl Ticked {
+    pub(crate) fn new(lo: f64, hi: f64, (major, minor): (Vec<f64>, Vec<f64>)) -> Ticked {
+        Ticked { lo, hi, major, minor }
+    }
+}
+
+impl Ranged for Ticked {
+    type FormatOption = DefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        let f = (value - self.lo) / (self.hi - self.lo);
+        limit.0 + (f * f64::from(limit.1 - limit.0)).round() as i32
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            self.minor.clone()
+        } else {
+            self.major.clone()
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.lo..self.hi
+    }
+}
+
+pub(crate) fn text<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
 
-/// The legend of every labelled series, framed on a translucent white box at `position`.
-fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-) -> Result<(), String> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FONT, 12))
-        .draw()
-        .map_err(text)
+/// Ranges every panel of a kind shares (plot space), when the style asks for it.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Shared {
+    pub x: Option<(f64, f64)>,
+    pub y: Option<(f64, f64)>,
 }
 
+/// Draws `fig` on `root`; returns, per panel, how many plotted points its legend covers.
 pub(crate) fn figure<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     fig: &Figure,
-) -> Result<(), String> {
+) -> Result<Vec<usize>, String> {
+    let style = &fig.style;
     root.fill(&WHITE).map_err(text)?;
-    let (top, body) = root.split_vertically(TITLE_HEIGHT);
-    // Shrink a long title to the width rather than cut it (DejaVu Sans averages ~0.55 em).
     let width = root.dim_in_pixel().0 as f64;
-    let chars = fig.title.chars().count().max(1) as f64;
-    let size = (width - 20.0) / (0.55 * chars);
-    top.draw(&Text::new(
-        fig.title.clone(),
-        (10, 8),
-        (FONT, size.clamp(10.0, 20.0)).into_font().color(&BLACK),
-    ))
-    .map_err(text)?;
-    let columns = fig.columns.max(1);
+    let title_font = (FONT, style.font(1.2)).into_font().color(&BLACK);
+    let lines = wrap(root, &fig.title, width - style.pt(8.0), &title_font);
+    let strip = (lines.len() as f64 * style.font(1.2) * 1.3 + style.pt(4.0)).round() as u32;
+    let (top, body) = root.split_vertically(strip);
+    for (k, line) in lines.iter().enumerate() {
+        let y = style.pt(2.0) + k as f64 * style.font(1.2) * 1.3;
+        top.draw(&Text::new(line.clone(), (style.pt(4.0) as i32, y as i32), title_font.clone()))
+            .map_err(text)?;
+    }
+    let heat_maps: Vec<_> = fig.panels.iter().filter_map(Panel::as_heat).collect();
+    let shared_bar = fig.shared_colour_bar && !heat_maps.is_empty();
+    let (body, bar) = if shared_bar {
+        let bar_width = match heat_maps.first().map(|h| &h.colours) {
+            Some(crate::Colours::Categories(names)) => {
+                legend::measure(root, &crate::heat::category_entries(names), style).0 + style.pt(6.0)
+            }
+            _ => style.mm(17.0),
+        }
+        .round() as u32;
+        let (body, bar) = body.split_horizontally(body.dim_in_pixel().0.saturating_sub(bar_width));
+        (body, Some(bar))
+    } else {
+        (body, None)
+    };
+    let columns = fig.columns.clamp(1, fig.panels.len().max(1));
     let rows = fig.panels.len().div_ceil(columns).max(1);
     let areas = body.split_evenly((rows, columns));
-    for (panel, area) in fig.panels.iter().zip(areas.iter()) {
-        match panel {
-            Panel::Lines(p) => lines(area, p)?,
-            Panel::Heat(h) => heat(area, h)?,
+    let shared_lines = shared_ranges(fig, |p| match p {
+        Panel::Lines(l) => Some(line_ranges(l)),
+        Panel::Heat(_) => None,
+    });
+    let shared_heat = shared_ranges(fig, |p| p.as_heat().map(crate::heat::ranges));
+    // Every panel's title strip holds as many lines as the longest title needs, so the
+    // panels of a row stay aligned.
+    let title_font = (FONT, style.font(1.1)).into_font().color(&BLACK);
+    let title_lines: Vec<Vec<String>> = fig
+        .panels
+        .iter()
+        .zip(areas.iter())
+        .map(|(p, a)| wrap(a, p.title(), a.dim_in_pixel().0 as f64 - style.pt(24.0), &title_font))
+        .collect();
+    let strip_lines = title_lines.iter().map(Vec::len).max().unwrap_or(1);
+    let mut covered = Vec::with_capacity(fig.panels.len());
+    for (k, (panel, area)) in fig.panels.iter().zip(areas.iter()).enumerate() {
+        let letter = style
+            .panel_letters
+            .then(|| format!("({})", char::from(b'a' + (k % 26) as u8)));
+        let plot_area = panel_title(area, (&title_lines[k], strip_lines), letter.as_deref(), style)?;
+        covered.push(match panel {
+            Panel::Lines(p) => lines_panel(&plot_area, p, style, shared_lines)?,
+            Panel::Heat(h) => crate::heat::panel(&plot_area, h, style, shared_heat, !shared_bar)?,
+        });
+    }
+    if let (Some(bar), Some(first)) = (bar, heat_maps.first()) {
+        let strip_top = (style.font(1.1) * 1.6).round() as u32;
+        let (_, bar) = bar.split_vertically(strip_top);
+        match &first.colours {
+            crate::Colours::Categories(names) => crate::heat::category_legend(&bar, names, style)?,
+            _ => crate::heat::colour_bar(&bar, first, style)?,
         }
     }
-    Ok(())
+    Ok(covered)
 }
 
-/// The finite range of `values`, padded by 5%, or (0, 1).
-fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+/// `text` broken at spaces into lines no wider than `width` pixels.
+pub(crate) fn wrap<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    text: &str,
+    width: f64,
+    font: &TextStyle<'_>,
+) -> Vec<String> {
+    let fits = |s: &str| area.estimate_text_size(s, font).map_or(true, |(w, _)| w as f64 <= width);
+    let mut lines: Vec<String> = Vec::new();
+    for word in text.split(' ') {
+        match lines.last_mut() {
+            Some(line) if fits(&format!("{line} {word}")) => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    lines
+}
+
+/// Draws a panel's title lines (and letter) over it, in a strip of `strip_lines` lines; returns
+/// the area left for the plot.
+fn panel_title<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (lines, strip_lines): (&[String], usize),
+    letter: Option<&str>,
+    style: &Style,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    let line = style.font(1.1) * 1.25;
+    let height = (strip_lines as f64 * line + style.font(1.1) * 0.4).round() as u32;
+    let (top, rest) = area.split_vertically(height);
+    let font = (FONT, style.font(1.1)).into_font().color(&BLACK);
+    let width = top.dim_in_pixel().0 as i32;
+    let bold = (FONT, style.font(1.1), FontStyle::Bold).into_font().color(&BLACK);
+    // A centred title moves right of the panel's letter rather than run into it.
+    let letter_end = letter.map_or(0, |l| {
+        top.estimate_text_size(l, &bold).map_or(0, |s| s.0) as i32 + style.pt(6.0) as i32
+    });
+    for (k, title) in lines.iter().enumerate() {
+        let text_width = top.estimate_text_size(title, &font).map_or(0, |s| s.0) as i32;
+        let y = (style.pt(2.0) + k as f64 * line) as i32;
+        let x = ((width - text_width) / 2).max(letter_end);
+        top.draw(&Text::new(title.clone(), (x, y), font.clone()))
+            .map_err(text)?;
+    }
+    if let Some(letter) = letter {
+        top.draw(&Text::new(letter.to_string(), (style.pt(3.0) as i32, style.pt(2.0) as i32), bold))
+            .map_err(text)?;
+    }
+    Ok(rest)
+}
+
+/// The union of every panel's ranges, on the axes the style shares.
+fn shared_ranges(fig: &Figure, ranges: impl Fn(&Panel) -> Option<((f64, f64), (f64, f64))>) -> Shared {
+    let all: Vec<_> = fig.panels.iter().filter_map(ranges).collect();
+    let union = |pick: fn(&((f64, f64), (f64, f64))) -> (f64, f64)| {
+        all.iter().map(pick).filter(|(l, h)| l.is_finite() && h.is_finite()).fold(None, |acc: Option<(f64, f64)>, (l, h)| {
+            Some(acc.map_or((l, h), |(a, b)| (a.min(l), b.max(h))))
+        })
+    };
+    Shared {
+        x: if fig.style.share_x { union(|r| r.0) } else { None },
+        y: if fig.style.share_y { union(|r| r.1) } else { None },
+    }
+}
+
+/// A line panel's own ranges in plot space: x at the data, y padded by 5%.
+fn line_ranges(p: &LinePanel) -> ((f64, f64), (f64, f64)) {
+    let (sx, sy) = (p.view.x_scale, p.view.y_scale);
+    let all = || p.series.iter().flat_map(|s| s.points.iter());
+    let x = p.view.x.map(|(a, b)| (sx.to_plot(a), sx.to_plot(b))).unwrap_or_else(|| range(all().map(|q| sx.to_plot(q.0)), 0.0));
+    let y = p.view.y.map(|(a, b)| (sy.to_plot(a), sy.to_plot(b))).unwrap_or_else(|| range(all().map(|q| sy.to_plot(q.1)), 0.05));
+    (x, y)
+}
+
+/// The finite range of `values` padded by `pad` of its width, or (0, 1).
+pub(crate) fn range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
-            (l.min(v), h.max(v))
-        });
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
-    let pad = if hi > lo {
-        0.05 * (hi - lo)
+    if hi > lo {
+        (lo - pad * (hi - lo), hi + pad * (hi - lo))
     } else {
-        0.5 * lo.abs().max(1e-3)
-    };
-    (lo - pad, hi + pad)
+        let half = 0.5 * lo.abs().max(1e-3);
+        (lo - half, hi + half)
+    }
 }
 
 /// A tick label: integers without a decimal point (`10`, not `10.0`), other values with at
@@ -98,341 +250,235 @@ pub fn tick(v: &f64) -> String {
     }
 }
 
+/// Builds a chart on `area` over plot-space ranges, ticked by the scales, with its mesh drawn.
+pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
+    area: &'a DrawingArea<DB, Shift>,
+    (x0, x1, sx): (f64, f64, Scale),
+    (y0, y1, sy): (f64, f64, Scale),
+    style: &Style,
+    draw_mesh: Option<(&str, &str, bool)>,
+) -> Result<Chart<'a, DB>, String> {
+    let (w, h) = area.dim_in_pixel();
+    let keep_minor = |(major, minor): (Vec<f64>, Vec<f64>)| {
+        (major, if style.minor_grid { minor } else { Vec::new() })
+    };
+    let xticks = keep_minor(sx.ticks(x0, x1, ((w as f64 / style.pt(48.0)) as usize).clamp(3, 8)));
+    let yticks = keep_minor(sy.ticks(y0, y1, ((h as f64 / style.pt(28.0)) as usize).clamp(3, 8)));
+    let mut chart = ChartBuilder::on(area)
+        .margin(style.pt(4.0) as u32)
+        .x_label_area_size(style.font(2.9) as u32)
+        .y_label_area_size(style.font(4.4) as u32)
+        .build_cartesian_2d(Ticked::new(x0, x1, xticks), Ticked::new(y0, y1, yticks))
+        .map_err(text)?;
+    if let Some((x_label, y_label, grid)) = draw_mesh {
+        let xf = move |u: &f64| sx.label(*u);
+        let yf = move |u: &f64| sy.label(*u);
+        let mut mesh = chart.configure_mesh();
+        mesh.x_desc(x_label)
+            .y_desc(y_label)
+            .x_label_formatter(&xf)
+            .y_label_formatter(&yf)
+            .label_style((FONT, style.font(1.0)))
+            .axis_desc_style((FONT, style.font(1.0)))
+            .set_all_tick_mark_size(style.pt(2.0) as u32)
+            .axis_style(ShapeStyle::from(&BLACK).stroke_width(style.stroke(0.5)))
+            .bold_line_style(RGBColor(226, 226, 226).stroke_width(style.stroke(0.3)))
+            .light_line_style(RGBColor(244, 244, 244).stroke_width(style.stroke(0.25)));
+        if !grid {
+            mesh.disable_mesh();
+        }
+        mesh.draw().map_err(text)?;
+    }
+    Ok(chart)
+}
+
+/// The plotting rectangle of `chart` in backend pixels.
+pub(crate) fn plot_rect<DB: DrawingBackend, CT: CoordTranslate>(chart: &ChartContext<'_, DB, CT>) -> Rect {
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    Rect { x0: xr.start as f64, y0: yr.start as f64, x1: xr.end as f64, y1: yr.end as f64 }
+}
+
+/// `(x, y)` in plot space as backend pixels.
+pub(crate) fn pixel<DB: DrawingBackend>(chart: &Chart<'_, DB>, (x, y): (f64, f64)) -> (f64, f64) {
+    let (px, py) = chart.backend_coord(&(x, y));
+    (px as f64, py as f64)
+}
+
 /// Mark colours: dark grey and black read on white and on every map colour.
 const MARK_COLOURS: [RGBColor; 2] = [RGBColor(60, 60, 60), BLACK];
 
-/// Draws `marks` across the visible ranges, one legend entry per distinct label.
-fn draw_marks<'a, DB: DrawingBackend + 'a>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+/// Draws `marks` across the plot (in plot space, scaled), and returns their legend entries,
+/// one per distinct label.
+pub(crate) fn marks<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    chart: &Chart<'_, DB>,
     marks: &[Mark],
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Result<(), String> {
-    let mut labels: Vec<&str> = Vec::new();
+    (sx, sy): (Scale, Scale),
+    style: &Style,
+) -> Result<(Vec<Entry>, Vec<Vec<(f64, f64)>>), String> {
+    let rect = plot_rect(chart);
+    let mut entries: Vec<Entry> = Vec::new();
+    let mut drawn = Vec::new();
     for mark in marks {
-        let k = match labels.iter().position(|l| *l == mark.label) {
+        let k = match entries.iter().position(|e| e.label == mark.label) {
             Some(k) => k,
             None => {
-                labels.push(&mark.label);
-                labels.len() - 1
+                entries.push(Entry {
+                    label: mark.label.clone(),
+                    glyph: Glyph::Line {
+                        colour: MARK_COLOURS[entries.len() % MARK_COLOURS.len()],
+                        dash: Dash::Dashed,
+                        marker: Marker::None,
+                        width_pt: 0.9,
+                    },
+                });
+                entries.len() - 1
             }
         };
-        let colour = MARK_COLOURS[k % MARK_COLOURS.len()];
-        let style = ShapeStyle::from(&colour).stroke_width(2);
-        let points = match mark.at {
-            MarkAt::X(x) => vec![(x, y0), (x, y1)],
-            MarkAt::Y(y) => vec![(x0, y), (x1, y)],
+        let line = match mark.at {
+            MarkAt::X(x) => {
+                let px = pixel(chart, (sx.to_plot(x), 0.0)).0;
+                vec![(px, rect.y0), (px, rect.y1)]
+            }
+            MarkAt::Y(y) => {
+                let py = pixel(chart, (0.0, sy.to_plot(y))).1;
+                vec![(rect.x0, py), (rect.x1, py)]
+            }
         };
-        let drawn = chart
-            .draw_series(DashedLineSeries::new(points, 8, 5, style))
-            .map_err(text)?;
-        if first_of(marks, mark) {
-            drawn
-                .label(mark.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-        }
+        legend::polyline(area, &line, &rect, (MARK_COLOURS[k % 2], Dash::Dashed, 0.9), style)?;
+        drawn.push(line);
     }
-    Ok(())
+    Ok((entries, drawn))
 }
 
-/// Whether `mark` is the first of `marks` with its label.
-fn first_of(marks: &[Mark], mark: &Mark) -> bool {
-    marks
-        .iter()
-        .find(|m| m.label == mark.label)
-        .is_some_and(|m| std::ptr::eq(m, mark))
-}
-
-fn lines<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &LinePanel) -> Result<(), String> {
-    let all = || p.series.iter().flat_map(|s| s.points.iter());
-    let (x0, x1) = p.view.x.unwrap_or_else(|| range(all().map(|q| q.0)));
-    let (y0, y1) = p.view.y.unwrap_or_else(|| range(all().map(|q| q.1)));
-    let mut chart = ChartBuilder::on(area)
-        .caption(&p.title, (FONT, 16))
-        .margin(10)
-        .x_label_area_size(42)
-        .y_label_area_size(58)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(text)?;
-    chart
-        .configure_mesh()
-        .x_desc(&p.x_label)
-        .y_desc(&p.y_label)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
-        .light_line_style(RGBColor(235, 235, 235))
-        .draw()
-        .map_err(text)?;
-    for (k, series) in p.series.iter().enumerate() {
-        let colour = PALETTE[k % PALETTE.len()];
-        let style = ShapeStyle::from(&colour).stroke_width(2);
-        // A non-finite value (a failed point) breaks the line rather than bridging the gap.
-        let segments: Vec<Vec<(f64, f64)>> = series
-            .points
-            .split(|q| !(q.0.is_finite() && q.1.is_finite()))
-            .filter(|s| !s.is_empty())
-            .map(|s| s.to_vec())
-            .collect();
-        let sparse = series.points.len() <= 40;
-        for (i, segment) in segments.into_iter().enumerate() {
-            if sparse {
-                // Few points: mark each, so a reader sees where the data are.
-                let dots = segment.iter().map(|&q| Circle::new(q, 3, colour.filled()));
-                chart.draw_series(dots).map_err(text)?;
-            }
-            let drawn = chart
-                .draw_series(LineSeries::new(segment, style))
-                .map_err(text)?;
-            if i == 0 {
-                drawn
-                    .label(series.label.clone())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
-            }
-        }
-    }
-    draw_marks(&mut chart, &p.marks, (x0, x1), (y0, y1))?;
-    // One curve is named by the y label; a legend would only hide data.
-    if p.series.len() > 1 || !p.marks.is_empty() {
-        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
-    }
-    Ok(())
-}
-
-/// Cell edges around increasing centres: midpoints inside, half a spacing beyond the ends.
-pub fn cell_edges(centres: &[f64]) -> Vec<f64> {
-    match centres {
-        [] => vec![0.0, 1.0],
-        [c] => vec![c - 0.5, c + 0.5],
-        _ => {
-            let n = centres.len();
-            let mut e = Vec::with_capacity(n + 1);
-            e.push(centres[0] - 0.5 * (centres[1] - centres[0]));
-            e.extend(centres.windows(2).map(|w| 0.5 * (w[0] + w[1])));
-            e.push(centres[n - 1] + 0.5 * (centres[n - 1] - centres[n - 2]));
-            e
-        }
-    }
-}
-
-/// The colour of each value of a heat map, and the range its scale spans.
-struct Scale<'a> {
-    colours: &'a Colours,
-    lo: f64,
-    hi: f64,
-}
-
-impl Scale<'_> {
-    fn of(h: &HeatPanel) -> Scale<'_> {
-        let (lo, hi) = h.z_range.unwrap_or_else(|| {
-            let (lo, hi) = h.value_range();
-            match (&h.colours, lo.is_finite()) {
-                (_, false) => (0.0, 1.0),
-                (Colours::Diverging, true) => {
-                    let m = lo.abs().max(hi.abs()).max(f64::MIN_POSITIVE);
-                    (-m, m)
-                }
-                (_, true) if hi > lo => (lo, hi),
-                (_, true) => (lo - 0.5, lo + 0.5),
-            }
-        });
-        Scale {
-            colours: &h.colours,
-            lo,
-            hi,
-        }
-    }
-
-    fn colour(&self, v: Option<f64>) -> RGBColor {
-        let Some(v) = v.filter(|v| v.is_finite()) else {
-            return MISSING;
-        };
-        let t = (v - self.lo) / (self.hi - self.lo);
-        match self.colours {
-            Colours::Sequential => viridis(t),
-            Colours::Diverging => diverging(t),
-            Colours::Categories(_) => {
-                let k = v.round();
-                if k >= 0.0 && (k as usize) < CATEGORIES.len() {
-                    CATEGORIES[k as usize]
-                } else {
-                    MISSING
-                }
-            }
-        }
-    }
-}
-
-/// The heat map's cells as an RGB raster of `(w, h)` pixels covering the visible ranges: one
-/// image instead of a rectangle per cell, so a fine space-time map stays small in SVG.
-fn raster(
-    h: &HeatPanel,
-    scale: &Scale<'_>,
-    (w, hgt): (u32, u32),
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-) -> Vec<u8> {
-    let (ex, ey) = (cell_edges(&h.xs), cell_edges(&h.ys));
-    let cell = |edges: &[f64], v: f64| -> Option<usize> {
-        let k = edges.partition_point(|&e| e <= v);
-        (k >= 1 && k < edges.len()).then(|| k - 1)
-    };
-    let columns: Vec<Option<usize>> = (0..w)
-        .map(|px| cell(&ex, x0 + (px as f64 + 0.5) / w as f64 * (x1 - x0)))
-        .collect();
-    let mut buf = Vec::with_capacity((w * hgt * 3) as usize);
-    for py in 0..hgt {
-        // Pixel rows run top down; y runs bottom up.
-        let row = cell(&ey, y1 - (py as f64 + 0.5) / hgt as f64 * (y1 - y0));
-        for column in &columns {
-            let colour = match (column, row) {
-                (Some(i), Some(j)) => scale.colour(h.z.get(j * h.xs.len() + i).copied().flatten()),
-                _ => WHITE,
-            };
-            buf.extend_from_slice(&[colour.0, colour.1, colour.2]);
-        }
-    }
-    buf
-}
-
-fn heat<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, h: &HeatPanel) -> Result<(), String> {
-    let width = area.dim_in_pixel().0;
-    let (main, bar) = area.split_horizontally(width.saturating_sub(112));
-    let (ex, ey) = (cell_edges(&h.xs), cell_edges(&h.ys));
-    let scale = Scale::of(h);
-    let (x0, x1) = h.view.x.unwrap_or((ex[0], ex[ex.len() - 1]));
-    let (y0, y1) = h.view.y.unwrap_or((ey[0], ey[ey.len() - 1]));
-    let mut chart = ChartBuilder::on(&main)
-        .caption(&h.title, (FONT, 16))
-        .margin(10)
-        .x_label_area_size(42)
-        .y_label_area_size(58)
-        .build_cartesian_2d(x0..x1, y0..y1)
-        .map_err(text)?;
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .disable_y_mesh()
-        .x_desc(&h.x_label)
-        .y_desc(&h.y_label)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .label_style((FONT, 12))
-        .axis_desc_style((FONT, 14))
-        .draw()
-        .map_err(text)?;
-    let size = chart.plotting_area().dim_in_pixel();
-    if size.0 > 0 && size.1 > 0 {
-        let pixels = raster(h, &scale, size, (x0, x1), (y0, y1));
-        let image = BitMapElement::with_owned_buffer((x0, y1), size, pixels)
-            .ok_or("heat-map raster of the wrong size")?;
-        chart.draw_series([image]).map_err(text)?;
-    }
-    if let Some((x, y, label)) = &h.marker {
-        // The label goes above the circle, or below it near the top edge (the title's place).
-        let offset = if *y > y1 - 0.12 * (y1 - y0) {
-            (8, 4)
-        } else {
-            (8, -16)
-        };
-        chart
-            .draw_series([EmptyElement::at((*x, *y))
-                + Circle::new((0, 0), 6, ShapeStyle::from(&WHITE).stroke_width(2))
-                + Text::new(label.clone(), offset, (FONT, 13).into_font().color(&WHITE))])
-            .map_err(text)?;
-    }
-    // Overlay lines, clamped to the view, in colours that read on every map, with a legend.
-    let overlay_colours = match h.colours {
-        Colours::Sequential => OVERLAY_COLOURS,
-        Colours::Diverging | Colours::Categories(_) => OVERLAY_COLOURS_ON_COLOUR,
-    };
-    for (k, overlay) in h.overlays.iter().enumerate() {
-        let colour = overlay_colours[k % overlay_colours.len()];
-        let points: Vec<(f64, f64)> = overlay
-            .points
+/// Where the legend goes for `placement`: inside at a corner (or `None` when it must go
+/// outside), choosing for `Best` the first place that hides none of `points`.
+pub(crate) fn inside_place(
+    placement: Legend,
+    plot: &Rect,
+    size: (f64, f64),
+    points: &[(f64, f64)],
+    style: &Style,
+) -> Option<(f64, f64)> {
+    match placement {
+        Legend::Inside(corner) => Some(legend::inside(corner, plot, size, style)),
+        Legend::Best => Corner::TRIED
             .iter()
-            .filter(|(x, y)| x.is_finite() && y.is_finite())
-            .map(|&(x, y)| (x.clamp(x0, x1), y.clamp(y0, y1)))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(
-                points,
-                ShapeStyle::from(&colour).stroke_width(3),
-            ))
-            .map_err(text)?
-            .label(overlay.label.clone())
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], colour.stroke_width(3)));
-    }
-    draw_marks(&mut chart, &h.marks, (x0, x1), (y0, y1))?;
-    if !h.overlays.is_empty() || !h.marks.is_empty() {
-        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
-    }
-    match &h.colours {
-        Colours::Categories(names) => category_legend(&bar, names),
-        _ => colour_bar(&bar, h, &scale),
+            .map(|&c| legend::inside(c, plot, size, style))
+            .find(|&at| legend::covered(points, at, size, style) == 0),
+        _ => None,
     }
 }
 
-/// Overlay line colours: red and white stand out on every viridis shade.
-const OVERLAY_COLOURS: [RGBColor; 3] = [RGBColor(230, 30, 40), WHITE, RGBColor(255, 140, 0)];
-/// Overlay line colours on red-blue maps and category colours (whose red would hide red).
-const OVERLAY_COLOURS_ON_COLOUR: [RGBColor; 3] = [BLACK, WHITE, RGBColor(148, 103, 189)];
-
-/// The map's scale as a strip with its own labelled axis.
-fn colour_bar<DB: DrawingBackend>(
-    bar: &DrawingArea<DB, Shift>,
-    h: &HeatPanel,
-    scale: &Scale<'_>,
-) -> Result<(), String> {
-    let (z0, z1) = (scale.lo, scale.hi);
-    let mut bar_chart = ChartBuilder::on(bar)
-        .margin_top(40)
-        .margin_bottom(52)
-        .margin_right(22)
-        .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..1.0, z0..z1)
-        .map_err(text)?;
-    bar_chart
-        .configure_mesh()
-        .disable_x_axis()
-        .disable_x_mesh()
-        .disable_y_mesh()
-        .y_desc(&h.z_label)
-        .y_label_formatter(&tick)
-        .label_style((FONT, 11))
-        .axis_desc_style((FONT, 13))
-        .draw()
-        .map_err(text)?;
-    let steps = 120;
-    let strip = (0..steps).map(|k| {
-        let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
-        let (va, vb) = (z0 + a * (z1 - z0), z0 + b * (z1 - z0));
-        let mid = z0 + 0.5 * (a + b) * (z1 - z0);
-        Rectangle::new([(0.0, va), (1.0, vb)], scale.colour(Some(mid)).filled())
-    });
-    bar_chart.draw_series(strip).map_err(text)?;
-    Ok(())
+fn lines_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &LinePanel,
+    style: &Style,
+    shared: Shared,
+) -> Result<usize, String> {
+    let (sx, sy) = (p.view.x_scale, p.view.y_scale);
+    let ((mut x0, mut x1), (mut y0, mut y1)) = line_ranges(p);
+    if let Some(x) = shared.x.filter(|_| p.view.x.is_none()) {
+        (x0, x1) = x;
+    }
+    if let Some(y) = shared.y.filter(|_| p.view.y.is_none()) {
+        (y0, y1) = y;
+    }
+    if !(x1 > x0) {
+        (x0, x1) = (x0 - 0.5, x0 + 0.5);
+    }
+    let curves: Vec<Vec<(f64, f64)>> = p
+        .series
+        .iter()
+        .map(|s| s.points.iter().map(|&(x, y)| (sx.to_plot(x), sy.to_plot(y))).collect())
+        .collect();
+    let mut entries: Vec<Entry> = p
+        .series
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let (colour, dash, marker) = s.style.resolve(k);
+            Entry { label: s.label.clone(), glyph: Glyph::Line { colour, dash, marker, width_pt: 1.2 } }
+        })
+        .collect();
+    // One curve is named by the y label; a legend would only hide data.
+    let wants_legend = (p.series.len() > 1 || !p.marks.is_empty()) && style.legend != Legend::None;
+    let mark_labels = p.marks.iter().filter(|m| !entries.iter().any(|e| e.label == m.label)).count();
+    let size = legend::measure(area, &entries, style);
+    let size = (size.0, size.1 + mark_labels as f64 * style.font(1.35));
+    // Where the legend goes decides the chart's area, so place it on a trial chart first.
+    let mut placement = if wants_legend { style.legend } else { Legend::None };
+    if placement == Legend::Best {
+        let trial = chart(area, (x0, x1, sx), (y0, y1, sy), style, None)?;
+        let points = pixel_curves(&trial, &curves);
+        if inside_place(Legend::Best, &plot_rect(&trial), size, &legend::dense(&points, 2.0), style).is_none() {
+            placement = Legend::OutsideRight;
+        }
+    }
+    let gap = style.pt(4.0);
+    let (main, side) = match placement {
+        Legend::OutsideRight => {
+            let w = area.dim_in_pixel().0 as f64 - size.0 - 2.0 * gap;
+            let (main, side) = area.split_horizontally(w.max(1.0) as u32);
+            (main, Some(side))
+        }
+        Legend::Below => {
+            let h = area.dim_in_pixel().1 as f64 - size.1 - gap;
+            let (main, side) = area.split_vertically(h.max(1.0) as u32);
+            (main, Some(side))
+        }
+        _ => (area.clone(), None),
+    };
+    let chart = chart(&main, (x0, x1, sx), (y0, y1, sy), style, Some((&p.x_label, &p.y_label, true)))?;
+    let rect = plot_rect(&chart);
+    let points = pixel_curves(&chart, &curves);
+    for (k, (series, line)) in p.series.iter().zip(&points).enumerate() {
+        let (colour, dash, marker) = series.style.resolve(k);
+        // A non-finite value (a failed point, or <= 0 on a log axis) breaks the line.
+        for segment in line.split(|q| !(q.0.is_finite() && q.1.is_finite())) {
+            legend::polyline(area, segment, &rect, (colour, dash, 1.2), style)?;
+        }
+        // Every point when there are few; otherwise about eight per curve, staggered so that
+        // curves sharing an x do not stack their markers.
+        let every = if line.len() <= 40 { 1 } else { line.len() / 8 };
+        let start = if every == 1 { 0 } else { (k * every) / p.series.len().max(1) / 2 };
+        for &q in line.iter().skip(start).step_by(every.max(1)) {
+            if q.0.is_finite() && q.1.is_finite() && rect.contains_point(q) {
+                legend::marker(area, q, marker, colour, style)?;
+            }
+        }
+    }
+    let (mark_entries, mark_lines) = marks(area, &chart, &p.marks, (sx, sy), style)?;
+    entries.extend(mark_entries.into_iter().filter(|m| !p.series.iter().any(|s| s.label == m.label)));
+    let all: Vec<Vec<(f64, f64)>> = points.into_iter().chain(mark_lines).collect();
+    let dense = legend::dense(&all, 2.0);
+    let at = match (placement, &side) {
+        (Legend::None, _) => return Ok(0),
+        (Legend::OutsideRight, Some(side)) => {
+            let (bx, by) = side.get_base_pixel();
+            (bx as f64 + gap, by as f64 + rect.y0 - main.get_base_pixel().1 as f64)
+        }
+        (Legend::Below, Some(side)) => {
+            let (bx, by) = side.get_base_pixel();
+            (bx as f64 + 0.5 * (side.dim_in_pixel().0 as f64 - size.0), by as f64)
+        }
+        _ => inside_place(placement, &rect, size, &dense, style)
+            .unwrap_or_else(|| legend::inside(Corner::UpperRight, &rect, size, style)),
+    };
+    legend::draw(area, &entries, at, style)?;
+    Ok(legend::covered(&dense, at, size, style))
 }
 
-/// A legend of named categories in place of a colour bar: a swatch and a name each.
-fn category_legend<DB: DrawingBackend>(
-    bar: &DrawingArea<DB, Shift>,
-    names: &[String],
-) -> Result<(), String> {
-    for (k, name) in names.iter().enumerate() {
-        let y = 50 + 24 * k as i32;
-        let colour = CATEGORIES[k % CATEGORIES.len()];
-        bar.draw(&Rectangle::new([(6, y), (20, y + 14)], colour.filled()))
-            .map_err(text)?;
-        bar.draw(&Text::new(
-            name.clone(),
-            (26, y),
-            (FONT, 12).into_font().color(&BLACK),
-        ))
-        .map_err(text)?;
-    }
-    Ok(())
+/// Each curve (plot space) as backend pixels; non-finite points stay non-finite.
+pub(crate) fn pixel_curves<DB: DrawingBackend>(chart: &Chart<'_, DB>, curves: &[Vec<(f64, f64)>]) -> Vec<Vec<(f64, f64)>> {
+    curves
+        .iter()
+        .map(|c| {
+            c.iter()
+                .map(|&q| if q.0.is_finite() && q.1.is_finite() { pixel(chart, q) } else { (f64::NAN, f64::NAN) })
+                .collect()
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -440,10 +486,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn edges_surround_the_centres() {
-        assert_eq!(cell_edges(&[1.0, 2.0, 4.0]), vec![0.5, 1.5, 3.0, 5.0]);
-        assert_eq!(cell_edges(&[3.0]), vec![2.5, 3.5]);
-        assert_eq!(range([1.0, f64::NAN, 3.0].into_iter()), (0.9, 3.1));
+    fn ranges_pad_only_where_asked() {
+        assert_eq!(range([1.0, f64::NAN, 3.0].into_iter(), 0.05), (0.9, 3.1));
+        assert_eq!(range([1.0, 3.0].into_iter(), 0.0), (1.0, 3.0));
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Shaping scattered (x, y, z) rows into the rectangular grid a heat map draws, and lines over
 //! such a grid: the table-to-picture step that every caller of [`crate::HeatPanel`] needs.
 
-use crate::draw::cell_edges;
+use crate::heat::cell_edges;
 
 /// A heat map's grid: the distinct x and y values, increasing, and z row by row (y outer).
 #[derive(Debug, Clone, PartialEq)]

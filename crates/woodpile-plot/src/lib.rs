@@ -6,17 +6,26 @@
 //! This crate knows nothing about simulations or parquet: it draws the numbers it is given.
 #![warn(missing_docs)]
 
+mod axis;
 mod colour;
 mod draw;
 mod grid;
+mod heat;
+mod legend;
+mod markup;
+mod style;
 
 use std::sync::OnceLock;
 
 use plotters::prelude::*;
 
-pub use colour::{diverging, viridis};
-pub use draw::{cell_edges, tick};
+pub use axis::Scale;
+pub use colour::{diverging, hex_colour, viridis, Dash, Marker, SeriesStyle};
+pub use draw::tick;
 pub use grid::Grid;
+pub use heat::cell_edges;
+pub use markup::markup;
+pub use style::{Corner, Legend, Style};
 
 /// Drawing failed.
 #[derive(Debug, thiserror::Error)]
@@ -35,6 +44,8 @@ pub struct Series {
     pub label: String,
     /// Points in drawing order; a non-finite y breaks the line.
     pub points: Vec<(f64, f64)>,
+    /// Colour, dash and marker; unset ones follow the curve's place in its panel.
+    pub style: SeriesStyle,
 }
 
 /// One line-plot panel.
@@ -128,13 +139,17 @@ pub enum MarkAt {
     Y(f64),
 }
 
-/// The visible ranges of a panel; `None` keeps the data's own.
+/// The visible ranges of a panel (`None` keeps the data's own) and how its axes scale.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct View {
     /// x from, to.
     pub x: Option<(f64, f64)>,
     /// y from, to.
     pub y: Option<(f64, f64)>,
+    /// Linear or log x axis.
+    pub x_scale: Scale,
+    /// Linear or log y axis.
+    pub y_scale: Scale,
 }
 
 /// A panel of either kind.
@@ -146,6 +161,36 @@ pub enum Panel {
     Heat(HeatPanel),
 }
 
+impl Panel {
+    /// The heat map, if this is one.
+    pub fn as_heat(&self) -> Option<&HeatPanel> {
+        match self {
+            Panel::Heat(h) => Some(h),
+            Panel::Lines(_) => None,
+        }
+    }
+
+    /// The panel's title.
+    pub fn title(&self) -> &str {
+        match self {
+            Panel::Lines(p) => &p.title,
+            Panel::Heat(h) => &h.title,
+        }
+    }
+}
+
+/// A drawn figure: its PNG and SVG, and per panel how many plotted points its legend covers
+/// (zero unless a stage forced the legend onto the data).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Drawn {
+    /// The PNG file's bytes.
+    pub png: Vec<u8>,
+    /// The SVG text, sized in millimetres.
+    pub svg: String,
+    /// Curve samples under each panel's legend box.
+    pub legend_covers: Vec<usize>,
+}
+
 /// A figure: a title over a grid of panels.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Figure {
@@ -153,10 +198,12 @@ pub struct Figure {
     pub title: String,
     /// Panels, row by row.
     pub panels: Vec<Panel>,
-    /// Panels per row.
+    /// Panels per row (at most the number of panels: a single panel fills the figure).
     pub columns: usize,
-    /// Size of one panel in pixels.
-    pub panel_size: (u32, u32),
+    /// Printed size, type and conventions.
+    pub style: Style,
+    /// One colour bar for the figure (its heat maps share one scale) instead of one per map.
+    pub shared_colour_bar: bool,
 }
 
 fn register_font() -> Result<(), String> {
@@ -171,48 +218,75 @@ fn register_font() -> Result<(), String> {
 }
 
 impl Figure {
-    /// Total size in pixels.
+    /// Total size in pixels, from the style's millimetres and DPI.
     pub fn size(&self) -> (u32, u32) {
-        let columns = self.columns.max(1) as u32;
-        let rows = self.panels.len().div_ceil(self.columns.max(1)) as u32;
-        (
-            self.panel_size.0 * columns,
-            self.panel_size.1 * rows.max(1) + draw::TITLE_HEIGHT,
-        )
+        self.style.pixels()
     }
 
     /// The figure as a PNG file's bytes. The caller writes them (atomically, under the name
     /// it chooses): this crate draws, it does not manage files.
     pub fn png(&self) -> Result<Vec<u8>, PlotError> {
+        Ok(self.png_and_covers()?.0)
+    }
+
+    fn png_and_covers(&self) -> Result<(Vec<u8>, Vec<usize>), PlotError> {
         register_font().map_err(fail("png"))?;
         let (width, height) = self.size();
         let mut rgb = vec![0u8; width as usize * height as usize * 3];
+        let covers;
         {
             let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
-            draw::figure(&root, self).map_err(fail("png"))?;
+            covers = draw::figure(&root, self).map_err(fail("png"))?;
             root.present().map_err(|e| fail("png")(e.to_string()))?;
         }
         let mut bytes = Vec::new();
         let mut encoder = png::Encoder::new(&mut bytes, width, height);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
+        // The PNG states its resolution, so a layout program places it at its printed size.
+        let per_metre = (self.style.dpi / 0.0254).round() as u32;
+        encoder.set_pixel_dims(Some(png::PixelDimensions {
+            xppu: per_metre,
+            yppu: per_metre,
+            unit: png::Unit::Meter,
+        }));
         encoder
             .write_header()
             .and_then(|mut writer| writer.write_image_data(&rgb))
             .map_err(|e| fail("png")(e.to_string()))?;
-        Ok(bytes)
+        Ok((bytes, covers))
     }
 
-    /// The figure as SVG text.
+    /// The figure as SVG text whose width and height are stated in millimetres, so LaTeX and
+    /// Inkscape place it at its printed size.
     pub fn svg(&self) -> Result<String, PlotError> {
         register_font().map_err(fail("svg"))?;
         let mut text = String::new();
+        let (width, height) = self.size();
         {
-            let root = SVGBackend::with_string(&mut text, self.size()).into_drawing_area();
+            let root = SVGBackend::with_string(&mut text, (width, height)).into_drawing_area();
             draw::figure(&root, self).map_err(fail("svg"))?;
             root.present().map_err(|e| fail("svg")(e.to_string()))?;
         }
-        Ok(text)
+        let pixels = format!("width=\"{width}\" height=\"{height}\"");
+        let printed = format!(
+            "width=\"{:.1}mm\" height=\"{:.1}mm\"",
+            self.style.width_mm, self.style.height_mm
+        );
+        if !text.contains(&pixels) {
+            return Err(fail("svg")("the SVG header has no pixel size to restate".into()));
+        }
+        Ok(text.replacen(&pixels, &printed, 1))
+    }
+
+    /// PNG, SVG, and how much each legend covers.
+    pub fn draw(&self) -> Result<Drawn, PlotError> {
+        let (png, legend_covers) = self.png_and_covers()?;
+        Ok(Drawn {
+            png,
+            svg: self.svg()?,
+            legend_covers,
+        })
     }
 }
 
@@ -229,7 +303,13 @@ mod tests {
         let figure = Figure {
             title: "test".into(),
             columns: 2,
-            panel_size: (400, 300),
+            style: Style {
+                width_mm: 120.0,
+                height_mm: 80.0,
+                dpi: 100.0,
+                ..Style::default()
+            },
+            shared_colour_bar: false,
             panels: vec![
                 Panel::Lines(LinePanel {
                     title: "L = 0".into(),
@@ -238,6 +318,7 @@ mod tests {
                     series: vec![Series {
                         label: "E_tr".into(),
                         points: vec![(0.0, 0.1), (1.0, 0.3), (2.0, f64::NAN), (3.0, 0.2)],
+                        style: SeriesStyle::default(),
                     }],
                     marks: vec![Mark {
                         at: MarkAt::X(1.5),
@@ -257,6 +338,7 @@ mod tests {
                     overlays: vec![Series {
                         label: "bound".into(),
                         points: vec![(1.5, 0.5), (1.5, 3.5)],
+                        style: SeriesStyle::default(),
                     }],
                     colours: Colours::Diverging,
                     z_range: None,
@@ -291,6 +373,7 @@ mod tests {
         assert_eq!(&bytes[1..4], b"PNG");
         let text = figure.svg().unwrap();
         assert!(text.contains("<svg") && text.contains("E_tr") && text.contains("test"));
+        assert!(text.contains(r#"width="120.0mm" height="80.0mm""#), "the SVG states its printed size");
         assert!(text.contains("bound"), "the overlay has a legend entry");
         assert!(
             text.contains("switch-on") && text.contains("defect"),

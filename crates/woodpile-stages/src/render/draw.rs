@@ -3,12 +3,12 @@
 //! the `panels` column. The grid shaping of heat maps is `woodpile_plot::Grid`'s.
 
 use polars::prelude::DataFrame;
-use woodpile_plot::{Grid, HeatPanel, LinePanel, Panel, Series};
+use woodpile_plot::{Grid, HeatPanel, LinePanel, Panel, Series, SeriesStyle};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::table::{f64_column, matching_rows, str_column};
 
-use super::spec::{PanelSpec, Plot};
+use super::spec::{PanelSpec, Plot, ZRange};
 use super::MAX_PANELS;
 
 /// A column's values on the kept rows.
@@ -125,7 +125,11 @@ impl PanelSpec {
                     .find(|&r| panel_values[r] == Some(key))
                     .and_then(|r| labels[r].clone())
             });
-            labelled.unwrap_or_else(|| {
+            let titled = self
+                .panel_title
+                .as_ref()
+                .map(|t| t.replace("{value}", &woodpile_plot::tick(&key)));
+            labelled.or(titled).unwrap_or_else(|| {
                 panel_name
                     .map(|p| format!("{p} = {}", woodpile_plot::tick(&key)))
                     .unwrap_or_default()
@@ -152,6 +156,7 @@ impl PanelSpec {
             x_label,
             y_label,
             series: series_name,
+            styles,
             ..
         } = &self.plot
         else {
@@ -159,7 +164,7 @@ impl PanelSpec {
         };
         let point =
             |y: &Values, r: usize| (data.x[r].unwrap_or(f64::NAN), y[r].unwrap_or(f64::NAN));
-        let series = match (&data.series, series_name) {
+        let series: Vec<Series> = match (&data.series, series_name) {
             (Some(ids), Some(name)) => {
                 let mut curves: Vec<(f64, Vec<usize>)> = Vec::new();
                 for &r in rows {
@@ -178,6 +183,7 @@ impl PanelSpec {
                             .and_then(|l| l[members[0]].clone())
                             .unwrap_or_else(|| format!("{name} = {}", woodpile_plot::tick(&id))),
                         points: members.iter().map(|&r| point(&data.y[0], r)).collect(),
+                        style: SeriesStyle::default(),
                     })
                     .collect()
             }
@@ -187,9 +193,20 @@ impl PanelSpec {
                 .map(|(name, y)| Series {
                     label: name.clone(),
                     points: rows.iter().map(|&r| point(y, r)).collect(),
+                    style: SeriesStyle::default(),
                 })
                 .collect(),
         };
+        let series = series
+            .into_iter()
+            .map(|s: Series| Series {
+                style: styles
+                    .iter()
+                    .find(|c| c.name == s.label)
+                    .map_or(SeriesStyle::default(), |c| c.style),
+                ..s
+            })
+            .collect();
         Panel::Lines(LinePanel {
             title,
             x_label: x_label.clone(),
@@ -224,6 +241,7 @@ impl PanelSpec {
             .map(|((_, label), at)| Series {
                 label: label.clone(),
                 points: grid.row_steps(&y, &on(at, rows)),
+                style: SeriesStyle::default(),
             })
             .collect();
         Panel::Heat(HeatPanel {
@@ -240,7 +258,10 @@ impl PanelSpec {
             ys: grid.ys,
             z: grid.z,
             colours: colours.clone(),
-            z_range: *z_range,
+            z_range: match *z_range {
+                ZRange::Fixed(lo, hi) => Some((lo, hi)),
+                ZRange::Full | ZRange::Robust => None,
+            },
             marks: self.marks.clone(),
             view: self.view,
         })

@@ -40,12 +40,68 @@
 //!   line over each panel through (that column's value, y) for every row of the map.
 //!
 //! `same_colour_scale = true` gives every heat map of the figure one colour scale, the union of
-//! their ranges, so that panels compare by colour (the paper's Fig. 9).
+//! their ranges, so that panels compare by colour (the paper's Fig. 9), and draws its colour
+//! bar (or category legend) once, beside the panels.
 //!
 //! Titles (the figure's and fixed panel titles) may quote an input's manifest:
 //! `{stage.params.at}`, `{stage.summary.tolerance}` or `{stage.params.scene.defect.0.eps}` (a
 //! number indexes an array) is replaced by that value, so a title follows the parameters it
 //! states.
+//!
+//! Axes and panels:
+//! - `x_scale = "log"`, `y_scale = "log"` (panel keys, beside `x_range`): a log axis, for lines
+//!   and heat maps; values at or below zero are not drawn. A heat map's cells meet halfway
+//!   between their neighbours (geometric midpoints on a log axis) and the map, and its axis,
+//!   end at the outermost data.
+//! - `panel_title = "ε = {value}"` (in `[lines]` or `[heatmap]`): each panel's title, `{value}`
+//!   its `panels` value.
+//! - `series_style = { E_tr = { colour = "#009e73", dash = "dashed", marker = "circle", label =
+//!   "E_{tr}" } }` (in `[lines]`): a curve's look by its name. Unset curves take the next of a
+//!   colour-blind-safe palette (Okabe-Ito), a dash (solid, dashed, dotted, dash-dot) and a
+//!   marker (circle, square, triangle, diamond, cross), so every figure reads in greyscale.
+//! - `z_range = "robust"` (the default of diverging maps: symmetric, to the 99th percentile of
+//!   |z|, said in the colour bar's label), `"full"` (the data's range) or `[lo, hi]`.
+//!
+//! Text: every title and label may use a small markup, drawn as Unicode in PNG and SVG:
+//! `E_{tr}` (a subscript group), `u'_n` (a prime and a one-letter subscript), `10^{-3}`,
+//! `\varepsilon_1`, `\kappa`. A one-character `_x` or `^x` applies only when it ends a word, so
+//! column names such as `E_tr` pass as typed. `labels = { E_tr = "E_{tr}" }` writes a name (a
+//! curve's column, a colour bar's label, any whole label) as a label; the stage's table keeps
+//! the names.
+//!
+//! `[style]`: the printed figure.
+//! - `width_mm` (default 86 for one panel, 178 for more: a journal's column and page),
+//!   `height_mm` or `aspect` (a panel's height over its width: 0.72 for lines, 0.8 for maps),
+//!   `dpi` of the PNG (300), `font_pt` (8: ticks, axis labels and legends; titles 1.1 to 1.2
+//!   times it). The SVG states its size in mm and the PNG its DPI, so LaTeX, Inkscape and
+//!   layout programs place them at that size with text at `font_pt`.
+//! - `legend = "best"` (the inside place that covers no curve, else outside on the right; on a
+//!   heat map, under it), `"upper left"`, `"upper center"`, `"upper right"`, `"lower left"`,
+//!   `"lower center"`, `"lower right"`, `"center left"`, `"center right"`, `"outside right"`,
+//!   `"below"` or `"none"`. The manifest's `legend_covers_points` counts, per panel, the curve
+//!   samples under the legend box: zero unless a stage forces a place.
+//! - `panel_letters = true`: (a), (b), (c) in each panel's top-left corner.
+//! - `share_x = true`, `share_y = true`: one range on that axis across the panels of a kind.
+//! - `minor_grid = true`: a light grid between the ticks (off by default).
+//!
+//! Project-wide values go in `pipeline/defaults.toml` as `[render.style]` and
+//! `[render.labels]`; a stage's keys override them. Before and after, for Fig. 4:
+//!
+//! ```toml
+//! # before: 1,120 x 820 px, 9.7-px ticks (under 2 pt at print size), legend over T
+//! columns = 2
+//! [lines]
+//! x = "eps"
+//! y = ["R", "T", "E_tr"]
+//!
+//! # after: 178 mm at 300 DPI, 8-pt text, legend where no curve is, eps on a log axis,
+//! # E_tr drawn as E with a subscript "tr" (labels in defaults.toml), panels (a) to (d)
+//! columns = 2
+//! x_scale = "log"
+//! [lines]
+//! x = "eps"
+//! y = ["R", "T", "E_tr"]
+//! ```
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -61,12 +117,15 @@ use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::Output;
 
+mod display;
 mod draw;
 mod plotted;
 mod spec;
+mod style;
 mod title;
 
-pub use spec::{PanelSpec, Plot};
+pub use spec::{CurveStyle, PanelSpec, Plot, ZRange};
+pub use style::{Labels, StyleSpec};
 
 use plotted::plotted;
 use spec::{flag, parse_panel};
@@ -86,6 +145,10 @@ pub struct Render {
     pub panels: Vec<PanelSpec>,
     /// One colour scale for every heat map of the figure.
     pub same_colour_scale: bool,
+    /// Printed size, type, legends and panel conventions (`[style]`).
+    pub style: StyleSpec,
+    /// How names are written in the figure (`labels`).
+    pub labels: Labels,
 }
 
 impl Render {
@@ -98,6 +161,8 @@ impl Render {
             return Err(fields.error("columns", "expected 1 to 8 panels per row"));
         }
         let same_colour_scale = flag(fields, "same_colour_scale")?;
+        let style = StyleSpec::parse(fields)?;
+        let labels = Labels::parse(fields)?;
         check_quotes(&title, inputs).map_err(|reason| fields.error("title", reason))?;
         let panel_tables = fields.table_array("panel", "[[panel]]")?;
         let panels = match panel_tables.is_empty() {
@@ -131,11 +196,26 @@ impl Render {
                 vec![parse_panel(fields, input.clone(), None)?]
             }
         };
+        for panel in &panels {
+            let (key, texts) = match &panel.plot {
+                Plot::Lines { x_label, y_label, .. } => ("lines", vec![("x_label", x_label), ("y_label", y_label)]),
+                Plot::Heatmap { x_label, y_label, z_label, .. } => {
+                    ("heatmap", vec![("x_label", x_label), ("y_label", y_label), ("z_label", z_label)])
+                }
+            };
+            for (name, text) in texts {
+                labels
+                    .show(text)
+                    .map_err(|reason| fields.error(&format!("{key}.{name}"), reason))?;
+            }
+        }
         Ok(Render {
             title,
             columns: columns as usize,
             panels,
             same_colour_scale,
+            style,
+            labels,
         })
     }
 
@@ -156,6 +236,7 @@ impl Render {
         let quote = |text: &str| quoted(text, inputs).map_err(|r| PipelineError::stage(stage, r));
         let mut panels = Vec::new();
         let mut names = Vec::new();
+        let mut specs: Vec<&PanelSpec> = Vec::new();
         for spec in &self.panels {
             let (frame, _) = &inputs[&spec.input];
             spec.check_columns(frame)
@@ -163,6 +244,7 @@ impl Render {
             let title = spec.title.as_deref().map(quote).transpose()?;
             let drawn = spec.draw(frame, title).map_err(fail)?;
             names.extend(std::iter::repeat_n(spec.columns(), drawn.len()));
+            specs.extend(std::iter::repeat_n(spec, drawn.len()));
             panels.extend(drawn);
             if panels.len() > MAX_PANELS {
                 return Err(PipelineError::stage(
@@ -171,29 +253,39 @@ impl Render {
                 ));
             }
         }
+        display::robust_ranges(&mut panels, &specs);
         if self.same_colour_scale {
             share_colour_scale(&mut panels);
         }
+        // The table keeps the names; the drawing shows the labels.
+        let frame = plotted(&panels, &names).into_frame()?;
+        for (panel, spec) in panels.iter_mut().zip(&specs) {
+            display::show(panel, spec, &self.labels).map_err(|r| PipelineError::stage(stage, r))?;
+        }
+        let maps = matches!(panels.first(), Some(Panel::Heat(_)));
         let figure = Figure {
-            title: quote(&self.title)?,
+            title: self.labels.show(&quote(&self.title)?).map_err(|r| PipelineError::stage(stage, r))?,
             columns: self.columns,
-            panel_size: match panels.first() {
-                Some(Panel::Heat(_)) => (620, 500),
-                _ => (560, 400),
-            },
+            style: self.style.resolve(panels.len(), self.columns, maps),
+            shared_colour_bar: self.same_colour_scale,
             panels,
         };
         let [png, svg] = Render::files(figures, stage);
         let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
-        woodpile_pipeline::atomic::write(&png, &figure.png().map_err(drawing)?)?;
-        woodpile_pipeline::atomic::write(&svg, figure.svg().map_err(drawing)?.as_bytes())?;
+        let drawn = figure.draw().map_err(drawing)?;
+        woodpile_pipeline::atomic::write(&png, &drawn.png)?;
+        woodpile_pipeline::atomic::write(&svg, drawn.svg.as_bytes())?;
         Ok(Output {
             failures: Vec::new(),
-            frame: plotted(&figure.panels, &names).into_frame()?,
+            frame,
             summary: json!({
                 "figures": [format!("{stage}.png"), format!("{stage}.svg")],
                 "panels": figure.panels.len(),
                 "title": figure.title,
+                "size_mm": [figure.style.width_mm, figure.style.height_mm],
+                "dpi": figure.style.dpi,
+                "font_pt": figure.style.font_pt,
+                "legend_covers_points": drawn.legend_covers,
             }),
         })
     }

@@ -2,7 +2,7 @@
 //! under which filter, with which marks and visible ranges.
 
 use polars::prelude::DataFrame;
-use woodpile_plot::{Colours, Mark, MarkAt, View};
+use woodpile_plot::{hex_colour, markup, Colours, Dash, Mark, MarkAt, Marker, Scale, SeriesStyle, View};
 
 use woodpile_pipeline::error::Result;
 use woodpile_pipeline::fields::{Ends, Fields};
@@ -15,8 +15,11 @@ use super::plotted::PlottedColumns;
 pub struct PanelSpec {
     /// The stage whose table is drawn.
     pub input: String,
-    /// A fixed title (may quote manifests); otherwise `panels = value` or `panel_label`.
+    /// A fixed title (may quote manifests); otherwise `panel_title`, `panel_label` or
+    /// `panels = value`.
     pub title: Option<String>,
+    /// `panel_title = "ε = {value}"`: each panel's title, `{value}` its `panels` value.
+    pub panel_title: Option<String>,
     /// String column whose value titles each panel (instead of `column = value`).
     pub panel_label: Option<String>,
     /// Row filter: draw only rows where these columns equal these values.
@@ -48,6 +51,8 @@ pub enum Plot {
         x_label: String,
         /// Axis labels.
         y_label: String,
+        /// `series_style`: a curve's colour, dash, marker and legend text, by its name.
+        styles: Vec<CurveStyle>,
     },
     /// z over an (x, y) grid.
     Heatmap {
@@ -72,8 +77,31 @@ pub enum Plot {
         /// How values become colours.
         colours: Colours,
         /// The value range the colours span.
-        z_range: Option<(f64, f64)>,
+        z_range: ZRange,
     },
+}
+
+/// The look a `series_style` entry gives the curve it names.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveStyle {
+    /// The curve's name: its y column, or its `series` label.
+    pub name: String,
+    /// Colour, dash, marker.
+    pub style: SeriesStyle,
+    /// The legend's text (markup), instead of the name.
+    pub label: Option<String>,
+}
+
+/// The values a heat map's colours span.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ZRange {
+    /// The data's own range (symmetric about zero for diverging colours).
+    Full,
+    /// Symmetric, to the 99th percentile of |z|: a few large values (the impact itself) do
+    /// not wash out the rest. The default for diverging colours; the colour bar says so.
+    Robust,
+    /// `z_range = [lo, hi]`.
+    Fixed(f64, f64),
 }
 
 pub(super) fn flag(fields: &mut Fields<'_>, key: &str) -> Result<bool> {
@@ -99,14 +127,25 @@ pub(super) fn parse_panel(
     let view = View {
         x: range_key(f, "x_range")?,
         y: range_key(f, "y_range")?,
+        x_scale: scale_key(f, "x_scale")?,
+        y_scale: scale_key(f, "y_scale")?,
     };
+    for (key, scale, range) in [("x_range", view.x_scale, view.x), ("y_range", view.y_scale, view.y)] {
+        if scale == Scale::Log && range.is_some_and(|(lo, _)| lo <= 0.0) {
+            return Err(f.error(key, "a log axis starts above zero"));
+        }
+    }
+    let panel_title: Option<String>;
     let marks = parse_marks(f)?;
     let lines = f.optional::<toml::Table>("lines")?;
     let heat = f.optional::<toml::Table>("heatmap")?;
     let plot = match (lines, heat) {
         (Some(t), None) => {
             let mut f = f.nested("lines", t);
+            panel_title = f.optional::<String>("panel_title")?;
+            let styles = parse_series_styles(&mut f)?;
             let plot = Plot::Lines {
+                styles,
                 x: f.required("x")?,
                 y: f.required("y")?,
                 panels: f.optional("panels")?,
@@ -134,6 +173,7 @@ pub(super) fn parse_panel(
         }
         (None, Some(t)) => {
             let mut f = f.nested("heatmap", t);
+            panel_title = f.optional::<String>("panel_title")?;
             let mark_max = flag(&mut f, "mark_max")?;
             let overlays = parse_overlays(&mut f)?;
             let categories = f.optional::<Vec<String>>("categories")?;
@@ -152,10 +192,11 @@ pub(super) fn parse_panel(
                     ))
                 }
             };
+            let z_range = parse_z_range(&mut f, &colours)?;
             let plot = Plot::Heatmap {
                 overlays,
                 colours,
-                z_range: range_key(&mut f, "z_range")?,
+                z_range,
                 x: f.required("x")?,
                 y: f.required("y")?,
                 z: f.required("z")?,
@@ -181,15 +222,86 @@ pub(super) fn parse_panel(
             return Err(f.error("lines", reason));
         }
     };
+    if let Some(t) = &panel_title {
+        markup(t).map_err(|reason| f.error("panel_title", reason))?;
+    }
     Ok(PanelSpec {
         input,
         title,
+        panel_title,
         panel_label,
         filter,
         marks,
         view,
         plot,
     })
+}
+
+/// `x_scale = "linear" | "log"`.
+fn scale_key(f: &mut Fields<'_>, key: &str) -> Result<Scale> {
+    match f.optional::<String>(key)?.as_deref() {
+        None | Some("linear") => Ok(Scale::Linear),
+        Some("log") => Ok(Scale::Log),
+        Some(other) => Err(f.error(key, format!("expected \"linear\" or \"log\", got \"{other}\""))),
+    }
+}
+
+/// `z_range = [lo, hi] | "robust" | "full"`; by default robust for diverging colours.
+fn parse_z_range(f: &mut Fields<'_>, colours: &Colours) -> Result<ZRange> {
+    match f.take("z_range") {
+        None if *colours == Colours::Diverging => Ok(ZRange::Robust),
+        None => Ok(ZRange::Full),
+        Some(toml::Value::String(s)) if s == "robust" => Ok(ZRange::Robust),
+        Some(toml::Value::String(s)) if s == "full" => Ok(ZRange::Full),
+        Some(value) => match <Vec<f64> as woodpile_pipeline::fields::FromToml>::from_toml(value).as_deref() {
+            Some(&[lo, hi]) if lo < hi => Ok(ZRange::Fixed(lo, hi)),
+            _ => Err(f.error("z_range", "expected [lo, hi] with lo < hi, \"robust\" or \"full\"")),
+        },
+    }
+}
+
+/// `series_style = { E_tr = { colour = "#009e73", dash = "dashed", marker = "circle", label =
+/// "E_{tr}" }, ... }` of a `[lines]`.
+fn parse_series_styles(f: &mut Fields<'_>) -> Result<Vec<CurveStyle>> {
+    let table = f.optional::<toml::Table>("series_style")?.unwrap_or_default();
+    let outer = f.nested("series_style", table.clone());
+    let mut styles = Vec::new();
+    for (name, value) in table {
+        let toml::Value::Table(t) = value else {
+            return Err(outer.error(&name, "expected { colour, dash, marker, label }"));
+        };
+        let mut s = outer.nested(&name, t);
+        let named = |s: &Fields<'_>, key: &str, text: Option<String>, parse: fn(&str) -> Option<()>, expected: &str| {
+            match text {
+                Some(t) if parse(&t).is_none() => Err(s.error(key, format!("expected {expected}, got \"{t}\""))),
+                _ => Ok(()),
+            }
+        };
+        let colour_text = s.optional::<String>("colour")?;
+        let colour = match &colour_text {
+            None => None,
+            Some(t) => Some(hex_colour(t).ok_or_else(|| s.error("colour", format!("expected \"#rrggbb\", got \"{t}\"")))?),
+        };
+        let dash_text = s.optional::<String>("dash")?;
+        named(&s, "dash", dash_text.clone(), |t| Dash::named(t).map(drop), "\"solid\", \"dashed\", \"dotted\" or \"dashdot\"")?;
+        let marker_text = s.optional::<String>("marker")?;
+        named(&s, "marker", marker_text.clone(), |t| Marker::named(t).map(drop), "\"none\", \"circle\", \"square\", \"triangle\", \"diamond\" or \"cross\"")?;
+        let label = s.optional::<String>("label")?;
+        if let Some(l) = &label {
+            markup(l).map_err(|reason| s.error("label", reason))?;
+        }
+        s.finish()?;
+        styles.push(CurveStyle {
+            name,
+            style: SeriesStyle {
+                colour,
+                dash: dash_text.as_deref().and_then(Dash::named),
+                marker: marker_text.as_deref().and_then(Marker::named),
+            },
+            label,
+        });
+    }
+    Ok(styles)
 }
 
 /// `mark = [{ x = value, label = "text" } | { y = value, label = "text" }, ...]`.

@@ -21,10 +21,17 @@ pub(super) fn check_quotes(text: &str, inputs: &[String]) -> std::result::Result
     Ok(())
 }
 
+/// The quotes of `text`: each `{...}` that is not a markup group (`E_{tr}`, `10^{-3}`).
 fn quotes(text: &str) -> impl Iterator<Item = &str> {
-    text.split('{')
-        .skip(1)
-        .filter_map(|part| part.split_once('}').map(|(q, _)| q))
+    text.match_indices('{')
+        .filter(|&(i, _)| !is_markup_group(text, i))
+        .filter_map(|(i, _)| text[i + 1..].split_once('}').map(|(q, _)| q))
+        .filter(|q| !q.contains('{'))
+}
+
+/// Whether the `{` at byte `open` of `text` opens a sub- or superscript group.
+fn is_markup_group(text: &str, open: usize) -> bool {
+    text[..open].ends_with(['_', '^'])
 }
 
 /// Longest text a title or label may expand to: far more than any figure shows.
@@ -45,6 +52,11 @@ pub(super) fn quoted(
     while let Some(open) = rest.find('{') {
         out.push_str(&rest[..open]);
         let after = &rest[open + 1..];
+        if is_markup_group(rest, open) {
+            out.push('{');
+            rest = after;
+            continue;
+        }
         // A quote runs to the next `}` with no `{` before it; anything else is literal.
         let Some(close) = after
             .find(['{', '}'])
@@ -94,4 +106,18 @@ fn quote_value<'a>(
         Value::String(s) => s.clone(),
         other => other.to_string(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn markup_groups_are_not_quotes() {
+        let inputs = ["f4".to_string()];
+        assert!(check_quotes("best E_{tr} at {f4.params.at}, 10^{-3}", &inputs).is_ok());
+        assert!(check_quotes("{tr}", &inputs).is_err());
+        let expanded = quoted("E_{tr} and 10^{-3}", &HashMap::new()).unwrap();
+        assert_eq!(expanded, "E_{tr} and 10^{-3}");
+    }
 }

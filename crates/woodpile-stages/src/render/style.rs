@@ -1,0 +1,145 @@
+//! A render stage's `[style]` (printed size, type, legends, panel conventions) and its
+//! `labels` (how names are written in a figure), parsed once. Project-wide values go in the
+//! stage folder's `defaults.toml` under `[render.style]` and `[render.labels]`; a stage's own
+//! keys override them.
+
+use std::collections::BTreeMap;
+
+use woodpile_pipeline::error::Result;
+use woodpile_pipeline::fields::Fields;
+use woodpile_plot::{markup, Legend, Style};
+
+use super::spec::flag;
+
+/// Printed width of a figure of one panel, and of more: a journal's single column and page.
+const SINGLE_COLUMN_MM: f64 = 86.0;
+const FULL_PAGE_MM: f64 = 178.0;
+/// Room for the figure's title, in millimetres, above the panels' rows.
+const TITLE_MM: f64 = 9.0;
+/// Most pixels a figure may have (a 500 mm square at 360 DPI): bounds the raster's memory.
+const MAX_PIXELS: f64 = 5e7;
+
+/// The `[style]` keys, before the number of panels is known.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StyleSpec {
+    /// `width_mm`: fixed, or 86 for one panel and 178 for more.
+    pub width_mm: Option<f64>,
+    /// `height_mm`: fixed, or from `aspect`.
+    pub height_mm: Option<f64>,
+    /// `aspect`: a panel's height over its width (default 0.72 for lines, 0.8 for maps).
+    pub aspect: Option<f64>,
+    /// `dpi` of the PNG (default 300).
+    pub dpi: f64,
+    /// `font_pt`: tick labels, axis labels and legends (default 8); titles a little larger.
+    pub font_pt: f64,
+    /// `legend`: where legends go (default "best").
+    pub legend: Legend,
+    /// `panel_letters`: (a), (b), (c) in each panel's corner.
+    pub panel_letters: bool,
+    /// `minor_grid`: a light grid between the ticks (default off).
+    pub minor_grid: bool,
+    /// `share_x`, `share_y`: one range across panels.
+    pub share_x: bool,
+    /// See `share_x`.
+    pub share_y: bool,
+}
+
+impl StyleSpec {
+    /// The optional `[style]` table of `fields`.
+    pub(super) fn parse(fields: &mut Fields<'_>) -> Result<StyleSpec> {
+        let table = fields.optional::<toml::Table>("style")?.unwrap_or_default();
+        let mut f = fields.nested("style", table);
+        let bounded = |f: &mut Fields<'_>, key: &str, lo: f64, hi: f64| -> Result<Option<f64>> {
+            match f.optional::<f64>(key)? {
+                Some(v) if !(lo..=hi).contains(&v) => {
+                    Err(f.error(key, format!("expected a number from {lo} to {hi}, got {v}")))
+                }
+                v => Ok(v),
+            }
+        };
+        let width_mm = bounded(&mut f, "width_mm", 20.0, 500.0)?;
+        let height_mm = bounded(&mut f, "height_mm", 20.0, 500.0)?;
+        let aspect = bounded(&mut f, "aspect", 0.2, 3.0)?;
+        if height_mm.is_some() && aspect.is_some() {
+            return Err(f.error("aspect", "give `height_mm` or `aspect`, not both"));
+        }
+        let dpi = bounded(&mut f, "dpi", 50.0, 1200.0)?.unwrap_or(300.0);
+        let font_pt = bounded(&mut f, "font_pt", 4.0, 24.0)?.unwrap_or(8.0);
+        let legend = match f.optional::<String>("legend")? {
+            None => Legend::Best,
+            Some(name) => Legend::named(&name).ok_or_else(|| {
+                f.error("legend", format!("expected {}, got \"{name}\"", Legend::NAMES))
+            })?,
+        };
+        let spec = StyleSpec {
+            width_mm,
+            height_mm,
+            aspect,
+            dpi,
+            font_pt,
+            legend,
+            panel_letters: flag(&mut f, "panel_letters")?,
+            minor_grid: flag(&mut f, "minor_grid")?,
+            share_x: flag(&mut f, "share_x")?,
+            share_y: flag(&mut f, "share_y")?,
+        };
+        let (w, h) = (spec.width_mm.unwrap_or(FULL_PAGE_MM), spec.height_mm.unwrap_or(500.0));
+        if (w * dpi / 25.4) * (h.min(3.0 * w) * dpi / 25.4) > MAX_PIXELS {
+            return Err(f.error("dpi", format!("{dpi} DPI makes the figure more than {MAX_PIXELS:e} pixels")));
+        }
+        f.finish()?;
+        Ok(spec)
+    }
+
+    /// The style of a figure of `panels` panels, `columns` per row, of maps or of lines.
+    pub(super) fn resolve(&self, panels: usize, columns: usize, maps: bool) -> Style {
+        let columns = columns.clamp(1, panels.max(1));
+        let rows = panels.div_ceil(columns).max(1);
+        let width_mm = self.width_mm.unwrap_or(if panels <= 1 { SINGLE_COLUMN_MM } else { FULL_PAGE_MM });
+        let aspect = self.aspect.unwrap_or(if maps { 0.8 } else { 0.72 });
+        let height_mm = self
+            .height_mm
+            .unwrap_or(TITLE_MM + rows as f64 * aspect * width_mm / columns as f64)
+            .min(3.0 * width_mm);
+        Style {
+            width_mm,
+            height_mm,
+            dpi: self.dpi,
+            font_pt: self.font_pt,
+            legend: self.legend,
+            panel_letters: self.panel_letters,
+            minor_grid: self.minor_grid,
+            share_x: self.share_x,
+            share_y: self.share_y,
+        }
+    }
+}
+
+/// `labels = { E_tr = "E_{tr}", eps = "\\varepsilon" }`: how a name (a curve's column, a
+/// colour bar's label) is written in the figure, in the markup of [`woodpile_plot::markup`].
+/// The stage's table keeps the names; only the drawing shows the labels.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Labels(BTreeMap<String, String>);
+
+impl Labels {
+    pub(super) fn parse(fields: &mut Fields<'_>) -> Result<Labels> {
+        let table = fields.optional::<toml::Table>("labels")?.unwrap_or_default();
+        let mut f = fields.nested("labels", table);
+        let mut labels = BTreeMap::new();
+        for key in f.keys() {
+            let text: String = f.required(&key)?;
+            let drawn = markup(&text).map_err(|reason| f.error(&key, reason))?;
+            labels.insert(key, drawn);
+        }
+        f.finish()?;
+        Ok(Labels(labels))
+    }
+
+    /// `text` as drawn: its label if it has one, else its own markup rendered.
+    pub(super) fn show(&self, text: &str) -> std::result::Result<String, String> {
+        match self.0.get(text) {
+            Some(label) => Ok(label.clone()),
+            None => markup(text),
+        }
+    }
+}
