@@ -53,7 +53,9 @@ impl Pipeline {
             .iter()
             .map(|f| Stage::load(f, &root, kinds, &defaults))
             .collect::<Result<Vec<_>>>()?;
-        stages.extend(crate::variant::variants(&stages, sets, &root, kinds, &defaults)?);
+        stages.extend(crate::variant::variants(
+            &stages, sets, &root, kinds, &defaults,
+        )?);
         let mut seen: HashMap<&str, &Path> = HashMap::new();
         for stage in &stages {
             if let Some(other) = seen.insert(&stage.name, &stage.file) {

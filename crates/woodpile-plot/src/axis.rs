@@ -73,7 +73,7 @@ fn superscript_integer(k: i64) -> String {
 /// Steps of 1, 2, 2.5 or 5 times a power of ten, about `target` of them; minor ticks at a
 /// fifth (or a quarter, between steps of 2) of a step.
 fn linear_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, Vec<f64>) {
-    if !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
+    if hi <= lo || !lo.is_finite() || !hi.is_finite() {
         return (vec![lo], Vec::new());
     }
     let rough = (hi - lo) / target.max(1) as f64;
@@ -98,7 +98,7 @@ fn linear_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, Vec<f64>) {
 /// Decades, with 2 and 5 between them when the axis spans fewer than two; minor ticks at 2..9
 /// times each decade. An axis inside one decade falls back to linear steps of the values.
 fn log_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, Vec<f64>) {
-    if !(hi > lo) || !lo.is_finite() || !hi.is_finite() {
+    if hi <= lo || !lo.is_finite() || !hi.is_finite() {
         return (vec![lo], Vec::new());
     }
     let inside = |u: f64| u >= lo - 1e-9 && u <= hi + 1e-9;
@@ -122,7 +122,11 @@ fn log_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, Vec<f64>) {
     }
     if major.len() < 2 {
         let (lin, _) = linear_ticks(10f64.powf(lo), 10f64.powf(hi), target);
-        major = lin.into_iter().filter(|&v| v > 0.0).map(f64::log10).collect();
+        major = lin
+            .into_iter()
+            .filter(|&v| v > 0.0)
+            .map(f64::log10)
+            .collect();
     }
     let minor = with(&[2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
         .into_iter()

@@ -28,7 +28,12 @@ pub(crate) struct Ticked {
 
 impl Ticked {
     pub(crate) fn new(lo: f64, hi: f64, (major, minor): (Vec<f64>, Vec<f64>)) -> Ticked {
-        Ticked { lo, hi, major, minor }
+        Ticked {
+            lo,
+            hi,
+            major,
+            minor,
+        }
     }
 }
 
@@ -58,6 +63,11 @@ pub(crate) fn text<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
 
+/// A panel's x and y ranges in plot space.
+type Ranges = ((f64, f64), (f64, f64));
+/// A polyline in backend pixels.
+type Curve = Vec<(f64, f64)>;
+
 /// Ranges every panel of a kind shares (plot space), when the style asks for it.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Shared {
@@ -79,15 +89,20 @@ pub(crate) fn figure<DB: DrawingBackend>(
     let (top, body) = root.split_vertically(strip);
     for (k, line) in lines.iter().enumerate() {
         let y = style.pt(2.0) + k as f64 * style.font(1.2) * 1.3;
-        top.draw(&Text::new(line.clone(), (style.pt(4.0) as i32, y as i32), title_font.clone()))
-            .map_err(text)?;
+        top.draw(&Text::new(
+            line.clone(),
+            (style.pt(4.0) as i32, y as i32),
+            title_font.clone(),
+        ))
+        .map_err(text)?;
     }
     let heat_maps: Vec<_> = fig.panels.iter().filter_map(Panel::as_heat).collect();
     let shared_bar = fig.shared_colour_bar && !heat_maps.is_empty();
     let (body, bar) = if shared_bar {
         let bar_width = match heat_maps.first().map(|h| &h.colours) {
             Some(crate::Colours::Categories(names)) => {
-                legend::measure(root, &crate::heat::category_entries(names), style).0 + style.pt(6.0)
+                legend::measure(root, &crate::heat::category_entries(names), style).0
+                    + style.pt(6.0)
             }
             _ => style.mm(17.0),
         }
@@ -112,15 +127,33 @@ pub(crate) fn figure<DB: DrawingBackend>(
         .panels
         .iter()
         .zip(areas.iter())
-        .map(|(p, a)| wrap(a, p.title(), a.dim_in_pixel().0 as f64 - style.pt(24.0), &title_font))
+        .map(|(p, a)| {
+            wrap(
+                a,
+                p.title(),
+                a.dim_in_pixel().0 as f64 - style.pt(24.0),
+                &title_font,
+            )
+        })
         .collect();
-    let strip_lines = title_lines.iter().map(Vec::len).max().unwrap_or(1);
+    // One panel is the figure: no letter, and no strip for a title it does not have.
+    let letters = style.panel_letters && fig.panels.len() > 1;
+    let has_title = |lines: &Vec<String>| lines.iter().any(|l| !l.is_empty());
+    let strip_lines = title_lines
+        .iter()
+        .filter(|l| has_title(l))
+        .map(Vec::len)
+        .max()
+        .unwrap_or(usize::from(letters));
     let mut covered = Vec::with_capacity(fig.panels.len());
     for (k, (panel, area)) in fig.panels.iter().zip(areas.iter()).enumerate() {
-        let letter = style
-            .panel_letters
-            .then(|| format!("({})", char::from(b'a' + (k % 26) as u8)));
-        let plot_area = panel_title(area, (&title_lines[k], strip_lines), letter.as_deref(), style)?;
+        let letter = letters.then(|| format!("({})", char::from(b'a' + (k % 26) as u8)));
+        let plot_area = panel_title(
+            area,
+            (&title_lines[k], strip_lines),
+            letter.as_deref(),
+            style,
+        )?;
         covered.push(match panel {
             Panel::Lines(p) => lines_panel(&plot_area, p, style, shared_lines)?,
             Panel::Heat(h) => crate::heat::panel(&plot_area, h, style, shared_heat, !shared_bar)?,
@@ -144,7 +177,10 @@ pub(crate) fn wrap<DB: DrawingBackend>(
     width: f64,
     font: &TextStyle<'_>,
 ) -> Vec<String> {
-    let fits = |s: &str| area.estimate_text_size(s, font).map_or(true, |(w, _)| w as f64 <= width);
+    let fits = |s: &str| {
+        area.estimate_text_size(s, font)
+            .map_or(true, |(w, _)| w as f64 <= width)
+    };
     let mut lines: Vec<String> = Vec::new();
     for word in text.split(' ') {
         match lines.last_mut() {
@@ -167,11 +203,16 @@ fn panel_title<DB: DrawingBackend>(
     style: &Style,
 ) -> Result<DrawingArea<DB, Shift>, String> {
     let line = style.font(1.1) * 1.25;
+    if strip_lines == 0 {
+        return Ok(area.clone());
+    }
     let height = (strip_lines as f64 * line + style.font(1.1) * 0.4).round() as u32;
     let (top, rest) = area.split_vertically(height);
     let font = (FONT, style.font(1.1)).into_font().color(&BLACK);
     let width = top.dim_in_pixel().0 as i32;
-    let bold = (FONT, style.font(1.1), FontStyle::Bold).into_font().color(&BLACK);
+    let bold = (FONT, style.font(1.1), FontStyle::Bold)
+        .into_font()
+        .color(&BLACK);
     // A centred title moves right of the panel's letter rather than run into it.
     let letter_end = letter.map_or(0, |l| {
         top.estimate_text_size(l, &bold).map_or(0, |s| s.0) as i32 + style.pt(6.0) as i32
@@ -184,23 +225,41 @@ fn panel_title<DB: DrawingBackend>(
             .map_err(text)?;
     }
     if let Some(letter) = letter {
-        top.draw(&Text::new(letter.to_string(), (style.pt(3.0) as i32, style.pt(2.0) as i32), bold))
-            .map_err(text)?;
+        top.draw(&Text::new(
+            letter.to_string(),
+            (style.pt(3.0) as i32, style.pt(2.0) as i32),
+            bold,
+        ))
+        .map_err(text)?;
     }
     Ok(rest)
 }
 
 /// The union of every panel's ranges, on the axes the style shares.
-fn shared_ranges(fig: &Figure, ranges: impl Fn(&Panel) -> Option<((f64, f64), (f64, f64))>) -> Shared {
+fn shared_ranges(
+    fig: &Figure,
+    ranges: impl Fn(&Panel) -> Option<((f64, f64), (f64, f64))>,
+) -> Shared {
     let all: Vec<_> = fig.panels.iter().filter_map(ranges).collect();
-    let union = |pick: fn(&((f64, f64), (f64, f64))) -> (f64, f64)| {
-        all.iter().map(pick).filter(|(l, h)| l.is_finite() && h.is_finite()).fold(None, |acc: Option<(f64, f64)>, (l, h)| {
-            Some(acc.map_or((l, h), |(a, b)| (a.min(l), b.max(h))))
-        })
+    let union = |pick: fn(&Ranges) -> (f64, f64)| {
+        all.iter()
+            .map(pick)
+            .filter(|(l, h)| l.is_finite() && h.is_finite())
+            .fold(None, |acc: Option<(f64, f64)>, (l, h)| {
+                Some(acc.map_or((l, h), |(a, b)| (a.min(l), b.max(h))))
+            })
     };
     Shared {
-        x: if fig.style.share_x { union(|r| r.0) } else { None },
-        y: if fig.style.share_y { union(|r| r.1) } else { None },
+        x: if fig.style.share_x {
+            union(|r| r.0)
+        } else {
+            None
+        },
+        y: if fig.style.share_y {
+            union(|r| r.1)
+        } else {
+            None
+        },
     }
 }
 
@@ -208,8 +267,16 @@ fn shared_ranges(fig: &Figure, ranges: impl Fn(&Panel) -> Option<((f64, f64), (f
 fn line_ranges(p: &LinePanel) -> ((f64, f64), (f64, f64)) {
     let (sx, sy) = (p.view.x_scale, p.view.y_scale);
     let all = || p.series.iter().flat_map(|s| s.points.iter());
-    let x = p.view.x.map(|(a, b)| (sx.to_plot(a), sx.to_plot(b))).unwrap_or_else(|| range(all().map(|q| sx.to_plot(q.0)), 0.0));
-    let y = p.view.y.map(|(a, b)| (sy.to_plot(a), sy.to_plot(b))).unwrap_or_else(|| range(all().map(|q| sy.to_plot(q.1)), 0.05));
+    let x = p
+        .view
+        .x
+        .map(|(a, b)| (sx.to_plot(a), sx.to_plot(b)))
+        .unwrap_or_else(|| range(all().map(|q| sx.to_plot(q.0)), 0.0));
+    let y = p
+        .view
+        .y
+        .map(|(a, b)| (sy.to_plot(a), sy.to_plot(b)))
+        .unwrap_or_else(|| range(all().map(|q| sy.to_plot(q.1)), 0.05));
     (x, y)
 }
 
@@ -217,7 +284,9 @@ fn line_ranges(p: &LinePanel) -> ((f64, f64), (f64, f64)) {
 pub(crate) fn range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(v), h.max(v))
+        });
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
@@ -293,9 +362,16 @@ pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
 }
 
 /// The plotting rectangle of `chart` in backend pixels.
-pub(crate) fn plot_rect<DB: DrawingBackend, CT: CoordTranslate>(chart: &ChartContext<'_, DB, CT>) -> Rect {
+pub(crate) fn plot_rect<DB: DrawingBackend, CT: CoordTranslate>(
+    chart: &ChartContext<'_, DB, CT>,
+) -> Rect {
     let (xr, yr) = chart.plotting_area().get_pixel_range();
-    Rect { x0: xr.start as f64, y0: yr.start as f64, x1: xr.end as f64, y1: yr.end as f64 }
+    Rect {
+        x0: xr.start as f64,
+        y0: yr.start as f64,
+        x1: xr.end as f64,
+        y1: yr.end as f64,
+    }
 }
 
 /// `(x, y)` in plot space as backend pixels.
@@ -315,7 +391,7 @@ pub(crate) fn marks<DB: DrawingBackend>(
     marks: &[Mark],
     (sx, sy): (Scale, Scale),
     style: &Style,
-) -> Result<(Vec<Entry>, Vec<Vec<(f64, f64)>>), String> {
+) -> Result<(Vec<Entry>, Vec<Curve>), String> {
     let rect = plot_rect(chart);
     let mut entries: Vec<Entry> = Vec::new();
     let mut drawn = Vec::new();
@@ -345,7 +421,13 @@ pub(crate) fn marks<DB: DrawingBackend>(
                 vec![(rect.x0, py), (rect.x1, py)]
             }
         };
-        legend::polyline(area, &line, &rect, (MARK_COLOURS[k % 2], Dash::Dashed, 0.9), style)?;
+        legend::polyline(
+            area,
+            &line,
+            &rect,
+            (MARK_COLOURS[k % 2], Dash::Dashed, 0.9),
+            style,
+        )?;
         drawn.push(line);
     }
     Ok((entries, drawn))
@@ -384,13 +466,18 @@ fn lines_panel<DB: DrawingBackend>(
     if let Some(y) = shared.y.filter(|_| p.view.y.is_none()) {
         (y0, y1) = y;
     }
-    if !(x1 > x0) {
+    if x1 <= x0 || x0.is_nan() || x1.is_nan() {
         (x0, x1) = (x0 - 0.5, x0 + 0.5);
     }
     let curves: Vec<Vec<(f64, f64)>> = p
         .series
         .iter()
-        .map(|s| s.points.iter().map(|&(x, y)| (sx.to_plot(x), sy.to_plot(y))).collect())
+        .map(|s| {
+            s.points
+                .iter()
+                .map(|&(x, y)| (sx.to_plot(x), sy.to_plot(y)))
+                .collect()
+        })
         .collect();
     let mut entries: Vec<Entry> = p
         .series
@@ -398,20 +485,44 @@ fn lines_panel<DB: DrawingBackend>(
         .enumerate()
         .map(|(k, s)| {
             let (colour, dash, marker) = s.style.resolve(k);
-            Entry { label: s.label.clone(), glyph: Glyph::Line { colour, dash, marker, width_pt: 1.2 } }
+            Entry {
+                label: s.label.clone(),
+                glyph: Glyph::Line {
+                    colour,
+                    dash,
+                    marker,
+                    width_pt: 1.2,
+                },
+            }
         })
         .collect();
     // One curve is named by the y label; a legend would only hide data.
     let wants_legend = (p.series.len() > 1 || !p.marks.is_empty()) && style.legend != Legend::None;
-    let mark_labels = p.marks.iter().filter(|m| !entries.iter().any(|e| e.label == m.label)).count();
+    let mark_labels = p
+        .marks
+        .iter()
+        .filter(|m| !entries.iter().any(|e| e.label == m.label))
+        .count();
     let size = legend::measure(area, &entries, style);
     let size = (size.0, size.1 + mark_labels as f64 * style.font(1.35));
     // Where the legend goes decides the chart's area, so place it on a trial chart first.
-    let mut placement = if wants_legend { style.legend } else { Legend::None };
+    let mut placement = if wants_legend {
+        style.legend
+    } else {
+        Legend::None
+    };
     if placement == Legend::Best {
         let trial = chart(area, (x0, x1, sx), (y0, y1, sy), style, None)?;
         let points = pixel_curves(&trial, &curves);
-        if inside_place(Legend::Best, &plot_rect(&trial), size, &legend::dense(&points, 2.0), style).is_none() {
+        if inside_place(
+            Legend::Best,
+            &plot_rect(&trial),
+            size,
+            &legend::dense(&points, 2.0),
+            style,
+        )
+        .is_none()
+        {
             placement = Legend::OutsideRight;
         }
     }
@@ -429,7 +540,13 @@ fn lines_panel<DB: DrawingBackend>(
         }
         _ => (area.clone(), None),
     };
-    let chart = chart(&main, (x0, x1, sx), (y0, y1, sy), style, Some((&p.x_label, &p.y_label, true)))?;
+    let chart = chart(
+        &main,
+        (x0, x1, sx),
+        (y0, y1, sy),
+        style,
+        Some((&p.x_label, &p.y_label, true)),
+    )?;
     let rect = plot_rect(&chart);
     let points = pixel_curves(&chart, &curves);
     for (k, (series, line)) in p.series.iter().zip(&points).enumerate() {
@@ -438,29 +555,44 @@ fn lines_panel<DB: DrawingBackend>(
         for segment in line.split(|q| !(q.0.is_finite() && q.1.is_finite())) {
             legend::polyline(area, segment, &rect, (colour, dash, 1.2), style)?;
         }
-        // Every point when there are few; otherwise about eight per curve, staggered so that
-        // curves sharing an x do not stack their markers.
-        let every = if line.len() <= 40 { 1 } else { line.len() / 8 };
-        let start = if every == 1 { 0 } else { (k * every) / p.series.len().max(1) / 2 };
-        for &q in line.iter().skip(start).step_by(every.max(1)) {
-            if q.0.is_finite() && q.1.is_finite() && rect.contains_point(q) {
+        // Every point when there are few; otherwise about eight per curve, evenly spaced
+        // across the plot's width (whatever the axis scale), staggered so that curves
+        // sharing an x do not stack their markers.
+        let gap = (rect.x1 - rect.x0) / 8.0;
+        let mut next = rect.x0 + gap * (k as f64 / p.series.len().max(1) as f64);
+        for &q in line {
+            if !(q.0.is_finite() && q.1.is_finite() && rect.contains_point(q)) {
+                continue;
+            }
+            if line.len() <= 40 || q.0 >= next {
                 legend::marker(area, q, marker, colour, style)?;
+                next = q.0 + gap;
             }
         }
     }
     let (mark_entries, mark_lines) = marks(area, &chart, &p.marks, (sx, sy), style)?;
-    entries.extend(mark_entries.into_iter().filter(|m| !p.series.iter().any(|s| s.label == m.label)));
+    entries.extend(
+        mark_entries
+            .into_iter()
+            .filter(|m| !p.series.iter().any(|s| s.label == m.label)),
+    );
     let all: Vec<Vec<(f64, f64)>> = points.into_iter().chain(mark_lines).collect();
     let dense = legend::dense(&all, 2.0);
     let at = match (placement, &side) {
         (Legend::None, _) => return Ok(0),
         (Legend::OutsideRight, Some(side)) => {
             let (bx, by) = side.get_base_pixel();
-            (bx as f64 + gap, by as f64 + rect.y0 - main.get_base_pixel().1 as f64)
+            (
+                bx as f64 + gap,
+                by as f64 + rect.y0 - main.get_base_pixel().1 as f64,
+            )
         }
         (Legend::Below, Some(side)) => {
             let (bx, by) = side.get_base_pixel();
-            (bx as f64 + 0.5 * (side.dim_in_pixel().0 as f64 - size.0), by as f64)
+            (
+                bx as f64 + 0.5 * (side.dim_in_pixel().0 as f64 - size.0),
+                by as f64,
+            )
         }
         _ => inside_place(placement, &rect, size, &dense, style)
             .unwrap_or_else(|| legend::inside(Corner::UpperRight, &rect, size, style)),
@@ -470,12 +602,21 @@ fn lines_panel<DB: DrawingBackend>(
 }
 
 /// Each curve (plot space) as backend pixels; non-finite points stay non-finite.
-pub(crate) fn pixel_curves<DB: DrawingBackend>(chart: &Chart<'_, DB>, curves: &[Vec<(f64, f64)>]) -> Vec<Vec<(f64, f64)>> {
+pub(crate) fn pixel_curves<DB: DrawingBackend>(
+    chart: &Chart<'_, DB>,
+    curves: &[Vec<(f64, f64)>],
+) -> Vec<Vec<(f64, f64)>> {
     curves
         .iter()
         .map(|c| {
             c.iter()
-                .map(|&q| if q.0.is_finite() && q.1.is_finite() { pixel(chart, q) } else { (f64::NAN, f64::NAN) })
+                .map(|&q| {
+                    if q.0.is_finite() && q.1.is_finite() {
+                        pixel(chart, q)
+                    } else {
+                        (f64::NAN, f64::NAN)
+                    }
+                })
                 .collect()
         })
         .collect()

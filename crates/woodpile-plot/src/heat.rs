@@ -51,8 +51,12 @@ pub(crate) fn ranges(h: &HeatPanel) -> ((f64, f64), (f64, f64)) {
     let (sx, sy) = (h.view.x_scale, h.view.y_scale);
     let ex = drawn_edges(&plot_space(&h.xs, sx));
     let ey = drawn_edges(&plot_space(&h.ys, sy));
-    let x = h.view.x.map_or((ex[0], ex[ex.len() - 1]), |(a, b)| (sx.to_plot(a), sx.to_plot(b)));
-    let y = h.view.y.map_or((ey[0], ey[ey.len() - 1]), |(a, b)| (sy.to_plot(a), sy.to_plot(b)));
+    let x = h.view.x.map_or((ex[0], ex[ex.len() - 1]), |(a, b)| {
+        (sx.to_plot(a), sx.to_plot(b))
+    });
+    let y = h.view.y.map_or((ey[0], ey[ey.len() - 1]), |(a, b)| {
+        (sy.to_plot(a), sy.to_plot(b))
+    });
     (x, y)
 }
 
@@ -77,7 +81,11 @@ impl ColourScale<'_> {
                 (_, true) => (lo - 0.5, lo + 0.5),
             }
         });
-        ColourScale { colours: &h.colours, lo, hi }
+        ColourScale {
+            colours: &h.colours,
+            lo,
+            hi,
+        }
     }
 
     fn colour(&self, v: Option<f64>) -> RGBColor {
@@ -103,7 +111,13 @@ impl ColourScale<'_> {
 /// The heat map's cells as an RGB raster of `(w, h)` pixels covering the visible ranges (plot
 /// space): one image instead of a rectangle per cell, so a fine space-time map stays small in
 /// SVG.
-fn raster(h: &HeatPanel, scale: &ColourScale<'_>, (w, hgt): (u32, u32), (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Vec<u8> {
+fn raster(
+    h: &HeatPanel,
+    scale: &ColourScale<'_>,
+    (w, hgt): (u32, u32),
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Vec<u8> {
     let ex = drawn_edges(&plot_space(&h.xs, h.view.x_scale));
     let ey = drawn_edges(&plot_space(&h.ys, h.view.y_scale));
     let cell = |edges: &[f64], v: f64| -> Option<usize> {
@@ -145,7 +159,9 @@ pub(crate) fn panel<DB: DrawingBackend>(
     let (sx, sy) = (h.view.x_scale, h.view.y_scale);
     let width = area.dim_in_pixel().0;
     let bar_width = match &h.colours {
-        Colours::Categories(names) => legend::measure(area, &category_entries(names), style).0 + style.pt(6.0),
+        Colours::Categories(names) => {
+            legend::measure(area, &category_entries(names), style).0 + style.pt(6.0)
+        }
         _ => style.mm(17.0),
     };
     let (main, bar) = if own_bar {
@@ -156,7 +172,10 @@ pub(crate) fn panel<DB: DrawingBackend>(
     };
     // Overlay and mark legends go under the map, which has no free corner.
     let entry_count = h.overlays.len() + distinct_labels(&h.marks);
-    let (main, below) = if entry_count > 0 && style.legend != Legend::None && !matches!(style.legend, Legend::Inside(_)) {
+    let (main, below) = if entry_count > 0
+        && style.legend != Legend::None
+        && !matches!(style.legend, Legend::Inside(_))
+    {
         let rows = entry_count as f64 * style.font(1.35) + style.pt(8.0);
         let (m, b) = main.split_vertically((main.dim_in_pixel().1 as f64 - rows).max(1.0) as u32);
         (m, Some(b))
@@ -171,11 +190,18 @@ pub(crate) fn panel<DB: DrawingBackend>(
         (y0, y1) = y;
     }
     let scale = ColourScale::of(h);
-    let chart = chart(&main, (x0, x1, sx), (y0, y1, sy), style, Some((&h.x_label, &h.y_label, false)))?;
+    let chart = chart(
+        &main,
+        (x0, x1, sx),
+        (y0, y1, sy),
+        style,
+        Some((&h.x_label, &h.y_label, false)),
+    )?;
     let size = chart.plotting_area().dim_in_pixel();
     if size.0 > 0 && size.1 > 0 {
         let pixels = raster(h, &scale, size, (x0, x1), (y0, y1));
-        let image = BitMapElement::with_owned_buffer((x0, y1), size, pixels).ok_or("heat-map raster of the wrong size")?;
+        let image = BitMapElement::with_owned_buffer((x0, y1), size, pixels)
+            .ok_or("heat-map raster of the wrong size")?;
         chart.plotting_area().draw(&image).map_err(text)?;
     }
     let rect = plot_rect(&chart);
@@ -184,12 +210,21 @@ pub(crate) fn panel<DB: DrawingBackend>(
         let r = style.pt(3.0);
         let (bx, by) = area.get_base_pixel();
         let (cx, cy) = (at.0 as i32 - bx, at.1 as i32 - by);
-        area.draw(&Circle::new((cx, cy), r as i32, ShapeStyle::from(&WHITE).stroke_width(style.stroke(0.8))))
-            .map_err(text)?;
+        area.draw(&Circle::new(
+            (cx, cy),
+            r as i32,
+            ShapeStyle::from(&WHITE).stroke_width(style.stroke(0.8)),
+        ))
+        .map_err(text)?;
         // The label goes above the circle, or below it near the top edge.
         let font = (FONT, style.font(1.0)).into_font().color(&WHITE);
-        let dy = if at.1 - rect.y0 < 3.0 * style.font(1.0) { r as i32 } else { -(r as i32) - style.font(1.0) as i32 };
-        area.draw(&Text::new(label.clone(), (cx + r as i32, cy + dy), font)).map_err(text)?;
+        let dy = if at.1 - rect.y0 < 3.0 * style.font(1.0) {
+            r as i32
+        } else {
+            -(r as i32) - style.font(1.0) as i32
+        };
+        area.draw(&Text::new(label.clone(), (cx + r as i32, cy + dy), font))
+            .map_err(text)?;
     }
     let overlay_colours = match h.colours {
         Colours::Sequential => OVERLAY_COLOURS,
@@ -198,7 +233,12 @@ pub(crate) fn panel<DB: DrawingBackend>(
     let curves: Vec<Vec<(f64, f64)>> = h
         .overlays
         .iter()
-        .map(|o| o.points.iter().map(|&(x, y)| (sx.to_plot(x).clamp(x0, x1), sy.to_plot(y).clamp(y0, y1))).collect())
+        .map(|o| {
+            o.points
+                .iter()
+                .map(|&(x, y)| (sx.to_plot(x).clamp(x0, x1), sy.to_plot(y).clamp(y0, y1)))
+                .collect()
+        })
         .collect();
     let lines = pixel_curves(&chart, &curves);
     let mut entries = Vec::new();
@@ -209,7 +249,12 @@ pub(crate) fn panel<DB: DrawingBackend>(
         }
         entries.push(Entry {
             label: overlay.label.clone(),
-            glyph: Glyph::Line { colour, dash: Dash::Solid, marker: Marker::None, width_pt: 1.5 },
+            glyph: Glyph::Line {
+                colour,
+                dash: Dash::Solid,
+                marker: Marker::None,
+                width_pt: 1.5,
+            },
         });
     }
     let (mark_entries, mark_lines) = marks(area, &chart, &h.marks, (sx, sy), style)?;
@@ -229,7 +274,10 @@ pub(crate) fn panel<DB: DrawingBackend>(
     let at = match &below {
         Some(b) => {
             let (bx, by) = b.get_base_pixel();
-            (bx as f64 + 0.5 * (b.dim_in_pixel().0 as f64 - size.0), by as f64 + style.pt(2.0))
+            (
+                bx as f64 + 0.5 * (b.dim_in_pixel().0 as f64 - size.0),
+                by as f64 + style.pt(2.0),
+            )
         }
         None => inside_place(style.legend, &rect, size, &dense, style)
             .unwrap_or_else(|| legend::inside(Corner::UpperLeft, &rect, size, style)),
@@ -240,7 +288,11 @@ pub(crate) fn panel<DB: DrawingBackend>(
 
 /// The map's colour scale as a strip with its own labelled axis, its label written level
 /// above it so that it reads at print size.
-pub(crate) fn colour_bar<DB: DrawingBackend>(bar: &DrawingArea<DB, Shift>, h: &HeatPanel, style: &Style) -> Result<(), String> {
+pub(crate) fn colour_bar<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    h: &HeatPanel,
+    style: &Style,
+) -> Result<(), String> {
     let scale = ColourScale::of(h);
     let (z0, z1) = (scale.lo, scale.hi);
     let font = (FONT, style.font(1.0)).into_font().color(&BLACK);
@@ -249,8 +301,15 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(bar: &DrawingArea<DB, Shift>, h: &H
     let line = style.font(1.0) * 1.25;
     let (top, rest) = bar.split_vertically((lines.len() as f64 * line + style.pt(4.0)) as u32);
     for (k, text) in lines.into_iter().enumerate() {
-        top.draw(&Text::new(text, (style.pt(2.0) as i32, (style.pt(2.0) + k as f64 * line) as i32), font.clone()))
-            .map_err(crate::draw::text)?;
+        top.draw(&Text::new(
+            text,
+            (
+                style.pt(2.0) as i32,
+                (style.pt(2.0) + k as f64 * line) as i32,
+            ),
+            font.clone(),
+        ))
+        .map_err(crate::draw::text)?;
     }
     let (major, _) = crate::Scale::Linear.ticks(z0, z1, 6);
     let mut bar_chart = ChartBuilder::on(&rest)
@@ -258,7 +317,10 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(bar: &DrawingArea<DB, Shift>, h: &H
         .margin_bottom(style.font(2.9) as u32)
         .margin_left(style.pt(2.0) as u32)
         .right_y_label_area_size(style.font(3.6) as u32)
-        .build_cartesian_2d(0.0..1.0, crate::draw::Ticked::new(z0, z1, (major, Vec::new())))
+        .build_cartesian_2d(
+            0.0..1.0,
+            crate::draw::Ticked::new(z0, z1, (major, Vec::new())),
+        )
         .map_err(text)?;
     bar_chart
         .configure_mesh()
@@ -273,7 +335,10 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(bar: &DrawingArea<DB, Shift>, h: &H
     let strip = (0..steps).map(|k| {
         let (a, b) = (k as f64 / steps as f64, (k + 1) as f64 / steps as f64);
         let (va, vb) = (z0 + a * (z1 - z0), z0 + b * (z1 - z0));
-        Rectangle::new([(0.0, va), (1.0, vb)], scale.colour(Some(z0 + 0.5 * (a + b) * (z1 - z0))).filled())
+        Rectangle::new(
+            [(0.0, va), (1.0, vb)],
+            scale.colour(Some(z0 + 0.5 * (a + b) * (z1 - z0))).filled(),
+        )
     });
     bar_chart.draw_series(strip).map_err(text)?;
     Ok(())
@@ -291,15 +356,27 @@ pub(crate) fn category_entries(names: &[String]) -> Vec<Entry> {
     names
         .iter()
         .enumerate()
-        .map(|(k, name)| Entry { label: name.clone(), glyph: Glyph::Swatch(CATEGORIES[k % CATEGORIES.len()]) })
+        .map(|(k, name)| Entry {
+            label: name.clone(),
+            glyph: Glyph::Swatch(CATEGORIES[k % CATEGORIES.len()]),
+        })
         .collect()
 }
 
 /// A legend of named categories in place of a colour bar: a swatch and a name each.
-pub(crate) fn category_legend<DB: DrawingBackend>(bar: &DrawingArea<DB, Shift>, names: &[String], style: &Style) -> Result<(), String> {
+pub(crate) fn category_legend<DB: DrawingBackend>(
+    bar: &DrawingArea<DB, Shift>,
+    names: &[String],
+    style: &Style,
+) -> Result<(), String> {
     let entries = category_entries(names);
     let (bx, by) = bar.get_base_pixel();
-    legend::draw(bar, &entries, (bx as f64 + style.pt(2.0), by as f64 + style.font(3.0)), style)
+    legend::draw(
+        bar,
+        &entries,
+        (bx as f64 + style.pt(2.0), by as f64 + style.font(3.0)),
+        style,
+    )
 }
 
 #[cfg(test)]
@@ -318,7 +395,10 @@ mod tests {
     fn on_a_log_axis_cells_meet_at_geometric_midpoints() {
         let xs = [0.1, 1.0, 10.0];
         let edges = drawn_edges(&plot_space(&xs, crate::Scale::Log));
-        let back: Vec<f64> = edges.iter().map(|&u| crate::Scale::Log.from_plot(u)).collect();
+        let back: Vec<f64> = edges
+            .iter()
+            .map(|&u| crate::Scale::Log.from_plot(u))
+            .collect();
         assert!((back[1] - (0.1f64 * 1.0).sqrt()).abs() < 1e-12);
         assert!((back[2] - 10f64.sqrt()).abs() < 1e-12);
         assert!((back[3] - 10.0).abs() < 1e-12);

@@ -78,12 +78,10 @@ fn clipped(a: (f64, f64), b: (f64, f64), clip: &Rect) -> Option<((f64, f64), (f6
             }
         }
     }
-    (t0 <= t1).then(|| {
-        (
-            (a.0 + t0 * dx, a.1 + t0 * dy),
-            (a.0 + t1 * dx, a.1 + t1 * dy),
-        )
-    })
+    (t0 <= t1).then_some((
+        (a.0 + t0 * dx, a.1 + t0 * dy),
+        (a.0 + t1 * dx, a.1 + t1 * dy),
+    ))
 }
 
 /// Draws the polyline `points` (backend pixels) inside `clip` with `dash`, continuing the dash
@@ -96,7 +94,11 @@ pub(crate) fn polyline<DB: DrawingBackend>(
     style: &Style,
 ) -> Result<(), String> {
     let stroke = ShapeStyle::from(&colour).stroke_width(style.stroke(width_pt));
-    let pattern: Vec<f64> = dash.pattern().iter().map(|&l| style.pt(l * width_pt.max(0.75))).collect();
+    let pattern: Vec<f64> = dash
+        .pattern()
+        .iter()
+        .map(|&l| style.pt(l * width_pt.max(0.75)))
+        .collect();
     let mut runs: Vec<Vec<(i32, i32)>> = vec![Vec::new()];
     let push = |runs: &mut Vec<Vec<(i32, i32)>>, p: (f64, f64)| {
         if let Some(run) = runs.last_mut() {
@@ -168,17 +170,29 @@ pub(crate) fn marker<DB: DrawingBackend>(
         }
         Marker::Triangle => {
             let h = r.round() as i32;
-            area.draw(&Polygon::new(vec![(x, y - h), (x + h, y + h * 3 / 4), (x - h, y + h * 3 / 4)], fill))
-                .map_err(err)
+            area.draw(&Polygon::new(
+                vec![(x, y - h), (x + h, y + h * 3 / 4), (x - h, y + h * 3 / 4)],
+                fill,
+            ))
+            .map_err(err)
         }
         Marker::Diamond => area
-            .draw(&Polygon::new(vec![(x, y - ri), (x + ri, y), (x, y + ri), (x - ri, y)], fill))
+            .draw(&Polygon::new(
+                vec![(x, y - ri), (x + ri, y), (x, y + ri), (x - ri, y)],
+                fill,
+            ))
             .map_err(err),
         Marker::Cross => {
-            area.draw(&PathElement::new(vec![(x - ri, y - ri), (x + ri, y + ri)], outline))
-                .map_err(err)?;
-            area.draw(&PathElement::new(vec![(x - ri, y + ri), (x + ri, y - ri)], outline))
-                .map_err(err)
+            area.draw(&PathElement::new(
+                vec![(x - ri, y - ri), (x + ri, y + ri)],
+                outline,
+            ))
+            .map_err(err)?;
+            area.draw(&PathElement::new(
+                vec![(x - ri, y + ri), (x + ri, y - ri)],
+                outline,
+            ))
+            .map_err(err)
         }
     }
 }
@@ -197,11 +211,17 @@ pub(crate) fn measure<DB: DrawingBackend>(
     let line = style.font(1.35);
     let widest = entries
         .iter()
-        .map(|e| area.estimate_text_size(&e.label, &font(style)).map_or(0, |s| s.0))
+        .map(|e| {
+            area.estimate_text_size(&e.label, &font(style))
+                .map_or(0, |s| s.0)
+        })
         .max()
         .unwrap_or(0) as f64;
     let pad = style.pt(3.0);
-    (widest + style.pt(16.0) + 2.0 * pad, entries.len() as f64 * line + 2.0 * pad)
+    (
+        widest + style.pt(16.0) + 2.0 * pad,
+        entries.len() as f64 * line + 2.0 * pad,
+    )
 }
 
 /// The top-left corner of a `size` box at `corner` inside `plot`, a little in from its edges.
@@ -226,7 +246,12 @@ pub(crate) fn inside(corner: Corner, plot: &Rect, (w, h): (f64, f64), style: &St
 }
 
 /// How many of `points` lie under a `size` box at `at`, with a margin of a point around it.
-pub(crate) fn covered(points: &[(f64, f64)], at: (f64, f64), (w, h): (f64, f64), style: &Style) -> usize {
+pub(crate) fn covered(
+    points: &[(f64, f64)],
+    at: (f64, f64),
+    (w, h): (f64, f64),
+    style: &Style,
+) -> usize {
     let m = style.pt(1.0);
     let rect = Rect {
         x0: at.0 - m,
@@ -248,7 +273,10 @@ pub(crate) fn dense(curves: &[Vec<(f64, f64)>], step: f64) -> Vec<(f64, f64)> {
             let n = (length / step).ceil().clamp(1.0, 10_000.0) as usize;
             out.extend((1..=n).map(|k| {
                 let f = k as f64 / n as f64;
-                (w[0].0 + f * (w[1].0 - w[0].0), w[0].1 + f * (w[1].1 - w[0].1))
+                (
+                    w[0].0 + f * (w[1].0 - w[0].0),
+                    w[0].1 + f * (w[1].1 - w[0].1),
+                )
             }));
         }
     }
@@ -286,18 +314,39 @@ pub(crate) fn draw<DB: DrawingBackend>(
                 marker: m,
                 width_pt,
             } => {
-                let clip = Rect { x0, y0: mid - 1.0, x1, y1: mid + 1.0 };
+                let clip = Rect {
+                    x0,
+                    y0: mid - 1.0,
+                    x1,
+                    y1: mid + 1.0,
+                };
                 if colour == WHITE {
                     // A white line (over a map) shows in the white box as a black-edged one.
-                    polyline(area, &[(x0, mid), (x1, mid)], &clip, (BLACK, Dash::Solid, width_pt + 1.0), style)?;
+                    polyline(
+                        area,
+                        &[(x0, mid), (x1, mid)],
+                        &clip,
+                        (BLACK, Dash::Solid, width_pt + 1.0),
+                        style,
+                    )?;
                 }
-                polyline(area, &[(x0, mid), (x1, mid)], &clip, (colour, dash, width_pt), style)?;
+                polyline(
+                    area,
+                    &[(x0, mid), (x1, mid)],
+                    &clip,
+                    (colour, dash, width_pt),
+                    style,
+                )?;
                 marker(area, (0.5 * (x0 + x1), mid), m, colour, style)?;
             }
             Glyph::Swatch(colour) => {
                 let s = style.pt(3.0);
-                let (a, b) = (local(area, (x0, mid - s)), local(area, (x0 + 2.0 * s, mid + s)));
-                area.draw(&Rectangle::new([a, b], colour.filled())).map_err(err)?;
+                let (a, b) = (
+                    local(area, (x0, mid - s)),
+                    local(area, (x0 + 2.0 * s, mid + s)),
+                );
+                area.draw(&Rectangle::new([a, b], colour.filled()))
+                    .map_err(err)?;
             }
         }
         let (tx, ty) = local(area, (x1 + style.pt(3.0), mid - 0.5 * style.font(1.0)));
@@ -313,8 +362,16 @@ mod tests {
 
     #[test]
     fn segments_are_clipped_to_the_axes() {
-        let clip = Rect { x0: 0.0, y0: 0.0, x1: 10.0, y1: 10.0 };
-        assert_eq!(clipped((-5.0, 5.0), (5.0, 5.0), &clip), Some(((0.0, 5.0), (5.0, 5.0))));
+        let clip = Rect {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 10.0,
+            y1: 10.0,
+        };
+        assert_eq!(
+            clipped((-5.0, 5.0), (5.0, 5.0), &clip),
+            Some(((0.0, 5.0), (5.0, 5.0)))
+        );
         assert_eq!(clipped((-5.0, -5.0), (-1.0, 20.0), &clip), None);
     }
 

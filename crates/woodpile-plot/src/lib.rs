@@ -274,7 +274,9 @@ impl Figure {
             self.style.width_mm, self.style.height_mm
         );
         if !text.contains(&pixels) {
-            return Err(fail("svg")("the SVG header has no pixel size to restate".into()));
+            return Err(fail("svg")(
+                "the SVG header has no pixel size to restate".into(),
+            ));
         }
         Ok(text.replacen(&pixels, &printed, 1))
     }
@@ -373,7 +375,10 @@ mod tests {
         assert_eq!(&bytes[1..4], b"PNG");
         let text = figure.svg().unwrap();
         assert!(text.contains("<svg") && text.contains("E_tr") && text.contains("test"));
-        assert!(text.contains(r#"width="120.0mm" height="80.0mm""#), "the SVG states its printed size");
+        assert!(
+            text.contains(r#"width="120.0mm" height="80.0mm""#),
+            "the SVG states its printed size"
+        );
         assert!(text.contains("bound"), "the overlay has a legend entry");
         assert!(
             text.contains("switch-on") && text.contains("defect"),

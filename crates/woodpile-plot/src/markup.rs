@@ -45,7 +45,11 @@ pub fn markup(text: &str) -> Result<String, String> {
                     None => return Err(format!("`{c}` ends \"{text}\" with nothing to set")),
                 };
                 for g in group.chars() {
-                    let shifted = if c == '_' { subscript(g) } else { superscript(g) };
+                    let shifted = if c == '_' {
+                        subscript(g)
+                    } else {
+                        superscript(g)
+                    };
                     out.push(shifted.ok_or_else(|| {
                         let place = if c == '_' { "subscript" } else { "superscript" };
                         format!("`{g}` has no {place} form (in \"{text}\")")
@@ -88,13 +92,42 @@ fn command(chars: &mut std::iter::Peekable<std::str::Chars<'_>>) -> Result<Strin
 
 fn greek(name: &str) -> Option<char> {
     const LETTERS: [(&str, char); 37] = [
-        ("alpha", 'α'), ("beta", 'β'), ("gamma", 'γ'), ("delta", 'δ'), ("epsilon", 'ϵ'),
-        ("varepsilon", 'ε'), ("zeta", 'ζ'), ("eta", 'η'), ("theta", 'θ'), ("iota", 'ι'),
-        ("kappa", 'κ'), ("lambda", 'λ'), ("mu", 'μ'), ("nu", 'ν'), ("xi", 'ξ'), ("pi", 'π'),
-        ("rho", 'ρ'), ("sigma", 'σ'), ("tau", 'τ'), ("upsilon", 'υ'), ("phi", 'ϕ'),
-        ("varphi", 'φ'), ("chi", 'χ'), ("psi", 'ψ'), ("omega", 'ω'), ("Gamma", 'Γ'),
-        ("Delta", 'Δ'), ("Theta", 'Θ'), ("Lambda", 'Λ'), ("Xi", 'Ξ'), ("Pi", 'Π'),
-        ("Sigma", 'Σ'), ("Phi", 'Φ'), ("Psi", 'Ψ'), ("Omega", 'Ω'), ("prime", '′'),
+        ("alpha", 'α'),
+        ("beta", 'β'),
+        ("gamma", 'γ'),
+        ("delta", 'δ'),
+        ("epsilon", 'ϵ'),
+        ("varepsilon", 'ε'),
+        ("zeta", 'ζ'),
+        ("eta", 'η'),
+        ("theta", 'θ'),
+        ("iota", 'ι'),
+        ("kappa", 'κ'),
+        ("lambda", 'λ'),
+        ("mu", 'μ'),
+        ("nu", 'ν'),
+        ("xi", 'ξ'),
+        ("pi", 'π'),
+        ("rho", 'ρ'),
+        ("sigma", 'σ'),
+        ("tau", 'τ'),
+        ("upsilon", 'υ'),
+        ("phi", 'ϕ'),
+        ("varphi", 'φ'),
+        ("chi", 'χ'),
+        ("psi", 'ψ'),
+        ("omega", 'ω'),
+        ("Gamma", 'Γ'),
+        ("Delta", 'Δ'),
+        ("Theta", 'Θ'),
+        ("Lambda", 'Λ'),
+        ("Xi", 'Ξ'),
+        ("Pi", 'Π'),
+        ("Sigma", 'Σ'),
+        ("Phi", 'Φ'),
+        ("Psi", 'Ψ'),
+        ("Omega", 'Ω'),
+        ("prime", '′'),
         ("infty", '∞'),
     ];
     LETTERS.iter().find(|(n, _)| *n == name).map(|&(_, c)| c)
@@ -113,7 +146,9 @@ fn superscript(c: char) -> Option<char> {
 }
 
 fn shift(c: char, from: &str, to: &str) -> Option<char> {
-    from.chars().position(|f| f == c).and_then(|k| to.chars().nth(k))
+    from.chars()
+        .position(|f| f == c)
+        .and_then(|k| to.chars().nth(k))
 }
 
 #[cfg(test)]
@@ -132,7 +167,12 @@ mod tests {
 
     #[test]
     fn plain_text_and_unicode_pass_unchanged() {
-        for text in ["energy fraction", "ε = m/M", "velocity u′ₙ", "t (dimensionless time)"] {
+        for text in [
+            "energy fraction",
+            "ε = m/M",
+            "velocity u′ₙ",
+            "t (dimensionless time)",
+        ] {
             assert_eq!(markup(text).unwrap(), text);
         }
         assert_eq!(markup("a\\_b").unwrap(), "a_b");
@@ -142,9 +182,13 @@ mod tests {
 
     #[test]
     fn what_cannot_be_set_is_an_error_naming_it() {
-        assert!(markup("E_{q}").unwrap_err().contains("`q` has no subscript form"));
+        assert!(markup("E_{q}")
+            .unwrap_err()
+            .contains("`q` has no subscript form"));
         assert!(markup("E_{tr").unwrap_err().contains("not closed"));
         assert!(markup("x_").unwrap_err().contains("nothing to set"));
-        assert!(markup("\\foo").unwrap_err().contains("unknown command `\\foo`"));
+        assert!(markup("\\foo")
+            .unwrap_err()
+            .contains("unknown command `\\foo`"));
     }
 }

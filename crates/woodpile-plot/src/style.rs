@@ -154,7 +154,10 @@ mod tests {
         assert_eq!(style.pixels(), (2102, 1417));
         assert!((style.pt(72.0) - 300.0).abs() < 1e-12);
         assert_eq!(Legend::named("below"), Some(Legend::Below));
-        assert_eq!(Legend::named("lower right"), Some(Legend::Inside(Corner::LowerRight)));
+        assert_eq!(
+            Legend::named("lower right"),
+            Some(Legend::Inside(Corner::LowerRight))
+        );
         assert_eq!(Legend::named("top"), None);
     }
 }

@@ -65,14 +65,28 @@ x_label = "\\varepsilon"
 y_label = "L"
 z_label = "E_{tr}"
 "#;
-    let p = Project::new(&[("sweep", LOG_SWEEP), ("at_end", REDUCE), ("lines", lines), ("map", map)]);
+    let p = Project::new(&[
+        ("sweep", LOG_SWEEP),
+        ("at_end", REDUCE),
+        ("lines", lines),
+        ("map", map),
+    ]);
     p.counted(&[]);
     let svg = std::fs::read_to_string(p.figures().join("lines.svg")).unwrap();
-    assert!(svg.contains(r#"width="178.0mm""#), "two panels print at page width");
+    assert!(
+        svg.contains(r#"width="178.0mm""#),
+        "two panels print at page width"
+    );
     assert!(svg.contains("Eₜᵣ") && svg.contains("ε = m/M") && svg.contains("T (transmitted)"));
-    assert!(svg.contains(">L = 0<") || svg.contains("L = 0"), "panel titles from panel_title");
+    assert!(
+        svg.contains(">L = 0<") || svg.contains("L = 0"),
+        "panel titles from panel_title"
+    );
     let single = std::fs::read_to_string(p.figures().join("map.svg")).unwrap();
-    assert!(single.contains(r#"width="86.0mm""#), "one panel prints at column width");
+    assert!(
+        single.contains(r#"width="86.0mm""#),
+        "one panel prints at column width"
+    );
     let drawn = summary(&p.output("lines"));
     assert_eq!(drawn["font_pt"], 7.0);
     assert_eq!(drawn["legend_covers_points"], serde_json::json!([0, 0]));
@@ -98,9 +112,15 @@ z_label = "E_{tr}"
     let e = load_error(&[
         ("sweep", LOG_SWEEP),
         ("at_end", REDUCE),
-        ("lines", &lines.replace("x_label = \"\\\\varepsilon = m/M\"", "x_label = \"E_{q}\"")),
+        (
+            "lines",
+            &lines.replace("x_label = \"\\\\varepsilon = m/M\"", "x_label = \"E_{q}\""),
+        ),
     ]);
-    assert!(e.contains("x_label") && e.contains("no subscript form"), "{e}");
+    assert!(
+        e.contains("x_label") && e.contains("no subscript form"),
+        "{e}"
+    );
 }
 
 /// Every committed figure prints at a journal's column or page width with text of at least
@@ -117,8 +137,12 @@ fn committed_figures_print_at_journal_size_with_no_legend_over_a_curve() {
         assert!(width == 86.0 || width == 178.0, "{name}: {width} mm wide");
         assert!(drawn["font_pt"].as_f64().unwrap() >= 7.0, "{name}");
         let covers = drawn["legend_covers_points"].as_array().unwrap();
-        assert!(covers.iter().all(|c| c == 0), "{name}: a legend covers {covers:?}");
-        let svg = std::fs::read_to_string(root.join("figures").join(format!("{name}.svg"))).unwrap();
+        assert!(
+            covers.iter().all(|c| c == 0),
+            "{name}: a legend covers {covers:?}"
+        );
+        let svg =
+            std::fs::read_to_string(root.join("figures").join(format!("{name}.svg"))).unwrap();
         assert!(svg.contains(&format!("width=\"{width:.1}mm\"")), "{name}");
         checked += 1;
     }

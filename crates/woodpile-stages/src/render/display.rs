@@ -15,8 +15,20 @@ const ROBUST_QUANTILE: f64 = 0.99;
 /// the default of diverging maps): symmetric, to the 99th percentile of |z| of its panel.
 pub(super) fn robust_ranges(panels: &mut [Panel], specs: &[&PanelSpec]) {
     for (panel, spec) in panels.iter_mut().zip(specs) {
-        if let (Panel::Heat(h), Plot::Heatmap { z_range: ZRange::Robust, .. }) = (panel, &spec.plot) {
-            let mut magnitudes: Vec<f64> = h.z.iter().flatten().filter(|v| v.is_finite()).map(|v| v.abs()).collect();
+        if let (
+            Panel::Heat(h),
+            Plot::Heatmap {
+                z_range: ZRange::Robust,
+                ..
+            },
+        ) = (panel, &spec.plot)
+        {
+            let mut magnitudes: Vec<f64> =
+                h.z.iter()
+                    .flatten()
+                    .filter(|v| v.is_finite())
+                    .map(|v| v.abs())
+                    .collect();
             if magnitudes.is_empty() {
                 continue;
             }
@@ -42,7 +54,11 @@ pub(super) fn show(panel: &mut Panel, spec: &PanelSpec, labels: &Labels) -> Resu
                 Plot::Heatmap { .. } => &[],
             };
             for s in &mut p.series {
-                s.label = match styles.iter().find(|c| c.name == s.label).and_then(|c| c.label.as_ref()) {
+                s.label = match styles
+                    .iter()
+                    .find(|c| c.name == s.label)
+                    .and_then(|c| c.label.as_ref())
+                {
                     Some(label) => woodpile_plot::markup(label)?,
                     None => labels.show(&s.label)?,
                 };
@@ -54,7 +70,13 @@ pub(super) fn show(panel: &mut Panel, spec: &PanelSpec, labels: &Labels) -> Resu
             h.x_label = labels.show(&h.x_label)?;
             h.y_label = labels.show(&h.y_label)?;
             h.z_label = labels.show(&h.z_label)?;
-            if matches!(spec.plot, Plot::Heatmap { z_range: ZRange::Robust, .. }) {
+            if matches!(
+                spec.plot,
+                Plot::Heatmap {
+                    z_range: ZRange::Robust,
+                    ..
+                }
+            ) {
                 h.z_label.push_str(" (scale: 99th percentile of |value|)");
             }
             for o in &mut h.overlays {

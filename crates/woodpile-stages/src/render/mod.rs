@@ -198,10 +198,22 @@ impl Render {
         };
         for panel in &panels {
             let (key, texts) = match &panel.plot {
-                Plot::Lines { x_label, y_label, .. } => ("lines", vec![("x_label", x_label), ("y_label", y_label)]),
-                Plot::Heatmap { x_label, y_label, z_label, .. } => {
-                    ("heatmap", vec![("x_label", x_label), ("y_label", y_label), ("z_label", z_label)])
-                }
+                Plot::Lines {
+                    x_label, y_label, ..
+                } => ("lines", vec![("x_label", x_label), ("y_label", y_label)]),
+                Plot::Heatmap {
+                    x_label,
+                    y_label,
+                    z_label,
+                    ..
+                } => (
+                    "heatmap",
+                    vec![
+                        ("x_label", x_label),
+                        ("y_label", y_label),
+                        ("z_label", z_label),
+                    ],
+                ),
             };
             for (name, text) in texts {
                 labels
@@ -264,7 +276,10 @@ impl Render {
         }
         let maps = matches!(panels.first(), Some(Panel::Heat(_)));
         let figure = Figure {
-            title: self.labels.show(&quote(&self.title)?).map_err(|r| PipelineError::stage(stage, r))?,
+            title: self
+                .labels
+                .show(&quote(&self.title)?)
+                .map_err(|r| PipelineError::stage(stage, r))?,
             columns: self.columns,
             style: self.style.resolve(panels.len(), self.columns, maps),
             shared_colour_bar: self.same_colour_scale,

@@ -2,7 +2,9 @@
 //! under which filter, with which marks and visible ranges.
 
 use polars::prelude::DataFrame;
-use woodpile_plot::{hex_colour, markup, Colours, Dash, Mark, MarkAt, Marker, Scale, SeriesStyle, View};
+use woodpile_plot::{
+    hex_colour, markup, Colours, Dash, Mark, MarkAt, Marker, Scale, SeriesStyle, View,
+};
 
 use woodpile_pipeline::error::Result;
 use woodpile_pipeline::fields::{Ends, Fields};
@@ -130,7 +132,10 @@ pub(super) fn parse_panel(
         x_scale: scale_key(f, "x_scale")?,
         y_scale: scale_key(f, "y_scale")?,
     };
-    for (key, scale, range) in [("x_range", view.x_scale, view.x), ("y_range", view.y_scale, view.y)] {
+    for (key, scale, range) in [
+        ("x_range", view.x_scale, view.x),
+        ("y_range", view.y_scale, view.y),
+    ] {
         if scale == Scale::Log && range.is_some_and(|(lo, _)| lo <= 0.0) {
             return Err(f.error(key, "a log axis starts above zero"));
         }
@@ -242,7 +247,10 @@ fn scale_key(f: &mut Fields<'_>, key: &str) -> Result<Scale> {
     match f.optional::<String>(key)?.as_deref() {
         None | Some("linear") => Ok(Scale::Linear),
         Some("log") => Ok(Scale::Log),
-        Some(other) => Err(f.error(key, format!("expected \"linear\" or \"log\", got \"{other}\""))),
+        Some(other) => Err(f.error(
+            key,
+            format!("expected \"linear\" or \"log\", got \"{other}\""),
+        )),
     }
 }
 
@@ -253,17 +261,24 @@ fn parse_z_range(f: &mut Fields<'_>, colours: &Colours) -> Result<ZRange> {
         None => Ok(ZRange::Full),
         Some(toml::Value::String(s)) if s == "robust" => Ok(ZRange::Robust),
         Some(toml::Value::String(s)) if s == "full" => Ok(ZRange::Full),
-        Some(value) => match <Vec<f64> as woodpile_pipeline::fields::FromToml>::from_toml(value).as_deref() {
-            Some(&[lo, hi]) if lo < hi => Ok(ZRange::Fixed(lo, hi)),
-            _ => Err(f.error("z_range", "expected [lo, hi] with lo < hi, \"robust\" or \"full\"")),
-        },
+        Some(value) => {
+            match <Vec<f64> as woodpile_pipeline::fields::FromToml>::from_toml(value).as_deref() {
+                Some(&[lo, hi]) if lo < hi => Ok(ZRange::Fixed(lo, hi)),
+                _ => Err(f.error(
+                    "z_range",
+                    "expected [lo, hi] with lo < hi, \"robust\" or \"full\"",
+                )),
+            }
+        }
     }
 }
 
 /// `series_style = { E_tr = { colour = "#009e73", dash = "dashed", marker = "circle", label =
 /// "E_{tr}" }, ... }` of a `[lines]`.
 fn parse_series_styles(f: &mut Fields<'_>) -> Result<Vec<CurveStyle>> {
-    let table = f.optional::<toml::Table>("series_style")?.unwrap_or_default();
+    let table = f
+        .optional::<toml::Table>("series_style")?
+        .unwrap_or_default();
     let outer = f.nested("series_style", table.clone());
     let mut styles = Vec::new();
     for (name, value) in table {
@@ -271,21 +286,42 @@ fn parse_series_styles(f: &mut Fields<'_>) -> Result<Vec<CurveStyle>> {
             return Err(outer.error(&name, "expected { colour, dash, marker, label }"));
         };
         let mut s = outer.nested(&name, t);
-        let named = |s: &Fields<'_>, key: &str, text: Option<String>, parse: fn(&str) -> Option<()>, expected: &str| {
+        let named = |s: &Fields<'_>,
+                     key: &str,
+                     text: Option<String>,
+                     parse: fn(&str) -> Option<()>,
+                     expected: &str| {
             match text {
-                Some(t) if parse(&t).is_none() => Err(s.error(key, format!("expected {expected}, got \"{t}\""))),
+                Some(t) if parse(&t).is_none() => {
+                    Err(s.error(key, format!("expected {expected}, got \"{t}\"")))
+                }
                 _ => Ok(()),
             }
         };
         let colour_text = s.optional::<String>("colour")?;
-        let colour = match &colour_text {
-            None => None,
-            Some(t) => Some(hex_colour(t).ok_or_else(|| s.error("colour", format!("expected \"#rrggbb\", got \"{t}\"")))?),
-        };
+        let colour =
+            match &colour_text {
+                None => None,
+                Some(t) => Some(hex_colour(t).ok_or_else(|| {
+                    s.error("colour", format!("expected \"#rrggbb\", got \"{t}\""))
+                })?),
+            };
         let dash_text = s.optional::<String>("dash")?;
-        named(&s, "dash", dash_text.clone(), |t| Dash::named(t).map(drop), "\"solid\", \"dashed\", \"dotted\" or \"dashdot\"")?;
+        named(
+            &s,
+            "dash",
+            dash_text.clone(),
+            |t| Dash::named(t).map(drop),
+            "\"solid\", \"dashed\", \"dotted\" or \"dashdot\"",
+        )?;
         let marker_text = s.optional::<String>("marker")?;
-        named(&s, "marker", marker_text.clone(), |t| Marker::named(t).map(drop), "\"none\", \"circle\", \"square\", \"triangle\", \"diamond\" or \"cross\"")?;
+        named(
+            &s,
+            "marker",
+            marker_text.clone(),
+            |t| Marker::named(t).map(drop),
+            "\"none\", \"circle\", \"square\", \"triangle\", \"diamond\" or \"cross\"",
+        )?;
         let label = s.optional::<String>("label")?;
         if let Some(l) = &label {
             markup(l).map_err(|reason| s.error("label", reason))?;

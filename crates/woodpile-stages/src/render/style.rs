@@ -68,7 +68,10 @@ impl StyleSpec {
         let legend = match f.optional::<String>("legend")? {
             None => Legend::Best,
             Some(name) => Legend::named(&name).ok_or_else(|| {
-                f.error("legend", format!("expected {}, got \"{name}\"", Legend::NAMES))
+                f.error(
+                    "legend",
+                    format!("expected {}, got \"{name}\"", Legend::NAMES),
+                )
             })?,
         };
         let spec = StyleSpec {
@@ -83,9 +86,15 @@ impl StyleSpec {
             share_x: flag(&mut f, "share_x")?,
             share_y: flag(&mut f, "share_y")?,
         };
-        let (w, h) = (spec.width_mm.unwrap_or(FULL_PAGE_MM), spec.height_mm.unwrap_or(500.0));
+        let (w, h) = (
+            spec.width_mm.unwrap_or(FULL_PAGE_MM),
+            spec.height_mm.unwrap_or(500.0),
+        );
         if (w * dpi / 25.4) * (h.min(3.0 * w) * dpi / 25.4) > MAX_PIXELS {
-            return Err(f.error("dpi", format!("{dpi} DPI makes the figure more than {MAX_PIXELS:e} pixels")));
+            return Err(f.error(
+                "dpi",
+                format!("{dpi} DPI makes the figure more than {MAX_PIXELS:e} pixels"),
+            ));
         }
         f.finish()?;
         Ok(spec)
@@ -95,7 +104,11 @@ impl StyleSpec {
     pub(super) fn resolve(&self, panels: usize, columns: usize, maps: bool) -> Style {
         let columns = columns.clamp(1, panels.max(1));
         let rows = panels.div_ceil(columns).max(1);
-        let width_mm = self.width_mm.unwrap_or(if panels <= 1 { SINGLE_COLUMN_MM } else { FULL_PAGE_MM });
+        let width_mm = self.width_mm.unwrap_or(if panels <= 1 {
+            SINGLE_COLUMN_MM
+        } else {
+            FULL_PAGE_MM
+        });
         let aspect = self.aspect.unwrap_or(if maps { 0.8 } else { 0.72 });
         let height_mm = self
             .height_mm
@@ -123,7 +136,9 @@ pub struct Labels(BTreeMap<String, String>);
 
 impl Labels {
     pub(super) fn parse(fields: &mut Fields<'_>) -> Result<Labels> {
-        let table = fields.optional::<toml::Table>("labels")?.unwrap_or_default();
+        let table = fields
+            .optional::<toml::Table>("labels")?
+            .unwrap_or_default();
         let mut f = fields.nested("labels", table);
         let mut labels = BTreeMap::new();
         for key in f.keys() {
