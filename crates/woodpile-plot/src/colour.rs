@@ -27,29 +27,30 @@ const DIVERGING: [(u8, u8, u8); 7] = [
     (103, 0, 31),
 ];
 
-/// Line colours: Okabe and Ito's palette, told apart by red-green colour-blind readers, in an
-/// order that starts with the pairs that differ most in grey (blue, vermillion, green, orange).
-/// Its yellow, too light on white, is left out.
+/// Okabe and Ito's colours, told apart by red-green colour-blind readers.
+const BLUE: RGBColor = RGBColor(0, 114, 178);
+const VERMILLION: RGBColor = RGBColor(213, 94, 0);
+const GREEN: RGBColor = RGBColor(0, 158, 115);
+const ORANGE: RGBColor = RGBColor(230, 159, 0);
+const PURPLE: RGBColor = RGBColor(204, 121, 167);
+const SKY: RGBColor = RGBColor(86, 180, 233);
+const YELLOW: RGBColor = RGBColor(240, 228, 66);
+
+/// Line colours, in an order that starts with the pairs that differ most in grey. Yellow, too
+/// light on white, is left out.
 pub const PALETTE: [RGBColor; 7] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(230, 159, 0),
-    RGBColor(204, 121, 167),
-    RGBColor(86, 180, 233),
+    BLUE,
+    VERMILLION,
+    GREEN,
+    ORANGE,
+    PURPLE,
+    SKY,
     RGBColor(0, 0, 0),
 ];
 
-/// Colours for categories, from the same palette: green, yellow, vermillion, then blue, purple
-/// and sky blue; three classes such as "meets", "misses", "unstable" read as go, caution, stop.
-pub const CATEGORIES: [RGBColor; 6] = [
-    RGBColor(0, 158, 115),
-    RGBColor(240, 228, 66),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 114, 178),
-    RGBColor(204, 121, 167),
-    RGBColor(86, 180, 233),
-];
+/// Colours for categories: three classes such as "meets", "misses", "unstable" read as go,
+/// caution, stop.
+pub const CATEGORIES: [RGBColor; 6] = [GREEN, YELLOW, VERMILLION, BLUE, PURPLE, SKY];
 
 /// How a curve is stroked.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +66,9 @@ pub enum Dash {
 }
 
 impl Dash {
+    /// The names [`Dash::named`] accepts, for messages.
+    pub const NAMES: &'static str = "\"solid\", \"dashed\", \"dotted\" or \"dashdot\"";
+
     /// The on-off lengths in points (empty: solid).
     pub(crate) fn pattern(self) -> &'static [f64] {
         match self {
@@ -105,6 +109,10 @@ pub enum Marker {
 }
 
 impl Marker {
+    /// The names [`Marker::named`] accepts, for messages.
+    pub const NAMES: &'static str =
+        "\"none\", \"circle\", \"square\", \"triangle\", \"diamond\" or \"cross\"";
+
     /// The marker called `name`: "none", "circle", "square", "triangle", "diamond" or "cross".
     pub fn named(name: &str) -> Option<Marker> {
         match name {

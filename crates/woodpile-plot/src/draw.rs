@@ -64,7 +64,7 @@ pub(crate) fn text<E: std::fmt::Debug>(e: E) -> String {
 }
 
 /// A panel's x and y ranges in plot space.
-type Ranges = ((f64, f64), (f64, f64));
+pub(crate) type Ranges = ((f64, f64), (f64, f64));
 /// A polyline in backend pixels.
 type Curve = Vec<(f64, f64)>;
 
@@ -73,6 +73,16 @@ type Curve = Vec<(f64, f64)>;
 pub(crate) struct Shared {
     pub x: Option<(f64, f64)>,
     pub y: Option<(f64, f64)>,
+}
+
+impl Shared {
+    /// A panel's own `ranges`, replaced by the shared ones on axes its view leaves free.
+    pub(crate) fn apply(self, view: &crate::View, (x, y): Ranges) -> Ranges {
+        (
+            self.x.filter(|_| view.x.is_none()).unwrap_or(x),
+            self.y.filter(|_| view.y.is_none()).unwrap_or(y),
+        )
+    }
 }
 
 /// Draws `fig` on `root`; returns, per panel, how many plotted points its legend covers.
@@ -236,10 +246,7 @@ fn panel_title<DB: DrawingBackend>(
 }
 
 /// The union of every panel's ranges, on the axes the style shares.
-fn shared_ranges(
-    fig: &Figure,
-    ranges: impl Fn(&Panel) -> Option<((f64, f64), (f64, f64))>,
-) -> Shared {
+fn shared_ranges(fig: &Figure, ranges: impl Fn(&Panel) -> Option<Ranges>) -> Shared {
     let all: Vec<_> = fig.panels.iter().filter_map(ranges).collect();
     let union = |pick: fn(&Ranges) -> (f64, f64)| {
         all.iter()
@@ -264,7 +271,7 @@ fn shared_ranges(
 }
 
 /// A line panel's own ranges in plot space: x at the data, y padded by 5%.
-fn line_ranges(p: &LinePanel) -> ((f64, f64), (f64, f64)) {
+fn line_ranges(p: &LinePanel) -> Ranges {
     let (sx, sy) = (p.view.x_scale, p.view.y_scale);
     let all = || p.series.iter().flat_map(|s| s.points.iter());
     let x = p
@@ -459,13 +466,7 @@ fn lines_panel<DB: DrawingBackend>(
     shared: Shared,
 ) -> Result<usize, String> {
     let (sx, sy) = (p.view.x_scale, p.view.y_scale);
-    let ((mut x0, mut x1), (mut y0, mut y1)) = line_ranges(p);
-    if let Some(x) = shared.x.filter(|_| p.view.x.is_none()) {
-        (x0, x1) = x;
-    }
-    if let Some(y) = shared.y.filter(|_| p.view.y.is_none()) {
-        (y0, y1) = y;
-    }
+    let ((mut x0, mut x1), (y0, y1)) = shared.apply(&p.view, line_ranges(p));
     if x1 <= x0 || x0.is_nan() || x1.is_nan() {
         (x0, x1) = (x0 - 0.5, x0 + 0.5);
     }

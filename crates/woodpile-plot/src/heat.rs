@@ -47,7 +47,7 @@ fn plot_space(centres: &[f64], scale: crate::Scale) -> Vec<f64> {
 }
 
 /// The map's ranges in plot space: its view, or its data.
-pub(crate) fn ranges(h: &HeatPanel) -> ((f64, f64), (f64, f64)) {
+pub(crate) fn ranges(h: &HeatPanel) -> crate::draw::Ranges {
     let (sx, sy) = (h.view.x_scale, h.view.y_scale);
     let ex = drawn_edges(&plot_space(&h.xs, sx));
     let ey = drawn_edges(&plot_space(&h.ys, sy));
@@ -182,13 +182,7 @@ pub(crate) fn panel<DB: DrawingBackend>(
     } else {
         (main, None)
     };
-    let ((mut x0, mut x1), (mut y0, mut y1)) = ranges(h);
-    if let Some(x) = shared.x.filter(|_| h.view.x.is_none()) {
-        (x0, x1) = x;
-    }
-    if let Some(y) = shared.y.filter(|_| h.view.y.is_none()) {
-        (y0, y1) = y;
-    }
+    let ((x0, x1), (y0, y1)) = shared.apply(&h.view, ranges(h));
     let scale = ColourScale::of(h);
     let chart = chart(
         &main,

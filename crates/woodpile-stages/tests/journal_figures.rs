@@ -7,25 +7,17 @@ mod common;
 
 use std::path::Path;
 
-use common::{load_error, Project, REDUCE};
+use common::{load_error, Project, REDUCE, SWEEP};
 use woodpile_pipeline::table;
 use woodpile_stages::KINDS;
 
-/// A sweep on a non-uniform grid, eps in {0.1, 0.2, 0.5, 1, 2, 5, 10}.
-const LOG_SWEEP: &str = r#"
-kind = "sweep"
-[axes]
-L = [0, 1]
-eps = [0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0]
-[scene]
-chain = { n = 12 }
-impulse = { site = -6 }
-run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
-[[scene.defect]]
-site = 0
-through = "$L"
-eps = "$eps"
-"#;
+/// The common sweep on a non-uniform grid, eps in {0.1, 0.2, 0.5, 1, 2, 5, 10}.
+fn log_sweep() -> String {
+    SWEEP.replace(
+        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
+        "eps = [0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0]",
+    )
+}
 
 /// The manifest summary of stage `name`'s table at `path`.
 fn summary(path: &Path) -> serde_json::Value {
@@ -65,8 +57,9 @@ x_label = "\\varepsilon"
 y_label = "L"
 z_label = "E_{tr}"
 "#;
+    let sweep = log_sweep();
     let p = Project::new(&[
-        ("sweep", LOG_SWEEP),
+        ("sweep", &sweep),
         ("at_end", REDUCE),
         ("lines", lines),
         ("map", map),
@@ -95,32 +88,25 @@ z_label = "E_{tr}"
     let series = table::str_column(&plotted, "series").unwrap();
     assert!(series.iter().any(|s| s.as_deref() == Some("E_tr")));
     // A wrong key is named, with what it accepts.
-    for (bad, key) in [
-        ("legend = \"best\"", "legend = \"top\""),
-        ("font_pt = 7", "font_pt = 1"),
-        ("x_scale = \"log\"", "x_scale = \"ln\""),
-        ("dash = \"dotted\"", "dash = \"wavy\""),
-    ] {
-        let e = load_error(&[
-            ("sweep", LOG_SWEEP),
-            ("at_end", REDUCE),
-            ("lines", &lines.replace(bad, key)),
-        ]);
-        let name = key.split(' ').next().unwrap();
-        assert!(e.contains("lines.toml") && e.contains(name), "{e}");
-    }
-    let e = load_error(&[
-        ("sweep", LOG_SWEEP),
-        ("at_end", REDUCE),
+    for (good, bad, says) in [
+        ("legend = \"best\"", "legend = \"top\"", "legend"),
+        ("font_pt = 7", "font_pt = 1", "font_pt"),
+        ("x_scale = \"log\"", "x_scale = \"ln\"", "x_scale"),
+        ("dash = \"dotted\"", "dash = \"wavy\"", "dash"),
         (
-            "lines",
-            &lines.replace("x_label = \"\\\\varepsilon = m/M\"", "x_label = \"E_{q}\""),
+            "x_label = \"\\\\varepsilon = m/M\"",
+            "x_label = \"E_{q}\"",
+            "no subscript form",
         ),
-    ]);
-    assert!(
-        e.contains("x_label") && e.contains("no subscript form"),
-        "{e}"
-    );
+    ] {
+        let stages = [
+            ("sweep", sweep.as_str()),
+            ("at_end", REDUCE),
+            ("lines", &lines.replace(good, bad)),
+        ];
+        let e = load_error(&stages);
+        assert!(e.contains("lines.toml") && e.contains(says), "{e}");
+    }
 }
 
 /// Every committed figure prints at a journal's column or page width with text of at least

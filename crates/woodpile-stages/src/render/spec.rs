@@ -286,42 +286,9 @@ fn parse_series_styles(f: &mut Fields<'_>) -> Result<Vec<CurveStyle>> {
             return Err(outer.error(&name, "expected { colour, dash, marker, label }"));
         };
         let mut s = outer.nested(&name, t);
-        let named = |s: &Fields<'_>,
-                     key: &str,
-                     text: Option<String>,
-                     parse: fn(&str) -> Option<()>,
-                     expected: &str| {
-            match text {
-                Some(t) if parse(&t).is_none() => {
-                    Err(s.error(key, format!("expected {expected}, got \"{t}\"")))
-                }
-                _ => Ok(()),
-            }
-        };
-        let colour_text = s.optional::<String>("colour")?;
-        let colour =
-            match &colour_text {
-                None => None,
-                Some(t) => Some(hex_colour(t).ok_or_else(|| {
-                    s.error("colour", format!("expected \"#rrggbb\", got \"{t}\""))
-                })?),
-            };
-        let dash_text = s.optional::<String>("dash")?;
-        named(
-            &s,
-            "dash",
-            dash_text.clone(),
-            |t| Dash::named(t).map(drop),
-            "\"solid\", \"dashed\", \"dotted\" or \"dashdot\"",
-        )?;
-        let marker_text = s.optional::<String>("marker")?;
-        named(
-            &s,
-            "marker",
-            marker_text.clone(),
-            |t| Marker::named(t).map(drop),
-            "\"none\", \"circle\", \"square\", \"triangle\", \"diamond\" or \"cross\"",
-        )?;
+        let colour = named(&mut s, "colour", hex_colour, "\"#rrggbb\"")?;
+        let dash = named(&mut s, "dash", Dash::named, Dash::NAMES)?;
+        let marker = named(&mut s, "marker", Marker::named, Marker::NAMES)?;
         let label = s.optional::<String>("label")?;
         if let Some(l) = &label {
             markup(l).map_err(|reason| s.error("label", reason))?;
@@ -331,13 +298,28 @@ fn parse_series_styles(f: &mut Fields<'_>) -> Result<Vec<CurveStyle>> {
             name,
             style: SeriesStyle {
                 colour,
-                dash: dash_text.as_deref().and_then(Dash::named),
-                marker: marker_text.as_deref().and_then(Marker::named),
+                dash,
+                marker,
             },
             label,
         });
     }
     Ok(styles)
+}
+
+/// The optional string `key` read by `parse`, or an error saying what it accepts.
+fn named<T>(
+    f: &mut Fields<'_>,
+    key: &str,
+    parse: fn(&str) -> Option<T>,
+    expected: &str,
+) -> Result<Option<T>> {
+    match f.optional::<String>(key)? {
+        None => Ok(None),
+        Some(text) => parse(&text)
+            .map(Some)
+            .ok_or_else(|| f.error(key, format!("expected {expected}, got \"{text}\""))),
+    }
 }
 
 /// `mark = [{ x = value, label = "text" } | { y = value, label = "text" }, ...]`.

@@ -19,29 +19,20 @@ const TITLE_MM: f64 = 9.0;
 /// Most pixels a figure may have (a 500 mm square at 360 DPI): bounds the raster's memory.
 const MAX_PIXELS: f64 = 5e7;
 
-/// The `[style]` keys, before the number of panels is known.
+/// The `[style]` keys, before the number of panels is known: the printed size, unless given,
+/// follows from the panels (86 mm for one, 178 mm for more; the height from `aspect`, a
+/// panel's height over its width, 0.72 for lines and 0.8 for maps).
 #[derive(Debug, Clone, PartialEq)]
 pub struct StyleSpec {
-    /// `width_mm`: fixed, or 86 for one panel and 178 for more.
+    /// `width_mm`, if given.
     pub width_mm: Option<f64>,
-    /// `height_mm`: fixed, or from `aspect`.
+    /// `height_mm`, if given.
     pub height_mm: Option<f64>,
-    /// `aspect`: a panel's height over its width (default 0.72 for lines, 0.8 for maps).
+    /// `aspect`, if given.
     pub aspect: Option<f64>,
-    /// `dpi` of the PNG (default 300).
-    pub dpi: f64,
-    /// `font_pt`: tick labels, axis labels and legends (default 8); titles a little larger.
-    pub font_pt: f64,
-    /// `legend`: where legends go (default "best").
-    pub legend: Legend,
-    /// `panel_letters`: (a), (b), (c) in each panel's corner.
-    pub panel_letters: bool,
-    /// `minor_grid`: a light grid between the ticks (default off).
-    pub minor_grid: bool,
-    /// `share_x`, `share_y`: one range across panels.
-    pub share_x: bool,
-    /// See `share_x`.
-    pub share_y: bool,
+    /// Everything else: `dpi` (300), `font_pt` (8), `legend` ("best"), `panel_letters`,
+    /// `minor_grid`, `share_x`, `share_y` (off); [`StyleSpec::resolve`] sets its size.
+    pub rest: Style,
 }
 
 impl StyleSpec {
@@ -78,13 +69,16 @@ impl StyleSpec {
             width_mm,
             height_mm,
             aspect,
-            dpi,
-            font_pt,
-            legend,
-            panel_letters: flag(&mut f, "panel_letters")?,
-            minor_grid: flag(&mut f, "minor_grid")?,
-            share_x: flag(&mut f, "share_x")?,
-            share_y: flag(&mut f, "share_y")?,
+            rest: Style {
+                dpi,
+                font_pt,
+                legend,
+                panel_letters: flag(&mut f, "panel_letters")?,
+                minor_grid: flag(&mut f, "minor_grid")?,
+                share_x: flag(&mut f, "share_x")?,
+                share_y: flag(&mut f, "share_y")?,
+                ..Style::default()
+            },
         };
         let (w, h) = (
             spec.width_mm.unwrap_or(FULL_PAGE_MM),
@@ -117,13 +111,7 @@ impl StyleSpec {
         Style {
             width_mm,
             height_mm,
-            dpi: self.dpi,
-            font_pt: self.font_pt,
-            legend: self.legend,
-            panel_letters: self.panel_letters,
-            minor_grid: self.minor_grid,
-            share_x: self.share_x,
-            share_y: self.share_y,
+            ..self.rest.clone()
         }
     }
 }
