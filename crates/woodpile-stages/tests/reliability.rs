@@ -8,29 +8,10 @@ mod common;
 use std::path::Path;
 use woodpile_stages::KINDS;
 
-use common::Project;
+use common::{single_defect_sweep, Project, REDUCE};
 use woodpile_pipeline::events::Silent;
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, Pipeline};
-
-const SWEEP: &str = r#"
-kind = "sweep"
-[axes]
-eps = [0.5, 1.0, 1.5]
-[scene]
-chain = { n = 12 }
-impulse = { site = -6 }
-run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
-[[scene.defect]]
-site = 0
-eps = "$eps"
-"#;
-
-const REDUCE: &str = r#"
-kind = "reduce"
-inputs = ["sweep"]
-at = 12.0
-"#;
 
 const FIGURE: &str = r#"
 kind = "render"
@@ -63,7 +44,7 @@ ours = { stage = "at_end", column = "E_tr", where = { eps = 1.0 } }
 #[test]
 fn a_figure_from_an_abandoned_edit_is_never_fresh() {
     let p = Project::new(&[
-        ("sweep", SWEEP),
+        ("sweep", &single_defect_sweep()),
         ("at_end", REDUCE),
         ("figure", &FIGURE.replace("TITLE", "first")),
     ]);
@@ -104,7 +85,11 @@ fn a_figure_from_an_abandoned_edit_is_never_fresh() {
 /// same name is still never replaced.
 #[test]
 fn a_report_is_never_stuck_on_its_own_markdown() {
-    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("rep", REPORT)]);
+    let p = Project::new(&[
+        ("sweep", &single_defect_sweep()),
+        ("at_end", REDUCE),
+        ("rep", REPORT),
+    ]);
     p.run(&[]).unwrap();
     let markdown = p.root().join("REPORT.md");
     assert!(std::fs::read_to_string(&markdown)
@@ -131,7 +116,7 @@ fn a_report_is_never_stuck_on_its_own_markdown() {
 #[test]
 fn two_reports_cannot_claim_one_file_by_spelling_it_twice() {
     let p = Project::new(&[
-        ("sweep", SWEEP),
+        ("sweep", &single_defect_sweep()),
         ("at_end", REDUCE),
         ("a", &REPORT.replace("REPORT.md", "d/x.md")),
         ("b", &REPORT.replace("REPORT.md", "d//x.md")),
@@ -147,7 +132,7 @@ fn two_reports_cannot_claim_one_file_by_spelling_it_twice() {
 fn a_report_never_writes_through_a_symlinked_folder() {
     let elsewhere = tempfile::tempdir().unwrap();
     let p = Project::new(&[
-        ("sweep", SWEEP),
+        ("sweep", &single_defect_sweep()),
         ("at_end", REDUCE),
         ("rep", &REPORT.replace("REPORT.md", "docs/r.md")),
     ]);
@@ -161,7 +146,7 @@ fn a_report_never_writes_through_a_symlinked_folder() {
 #[cfg(unix)]
 #[test]
 fn symlink_loops_are_not_followed() {
-    let p = Project::new(&[("sweep", SWEEP)]);
+    let p = Project::new(&[("sweep", &single_defect_sweep())]);
     std::os::unix::fs::symlink(".", p.pipeline().join("x")).unwrap();
     std::os::unix::fs::symlink(".", p.pipeline().join("y")).unwrap();
     let pipeline = Pipeline::load(&p.pipeline(), KINDS).unwrap();
@@ -181,7 +166,7 @@ fn symlink_loops_are_not_followed() {
 #[cfg(unix)]
 #[test]
 fn non_regular_files_in_results_are_damaged_never_read() {
-    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE)]);
+    let p = Project::new(&[("sweep", &single_defect_sweep()), ("at_end", REDUCE)]);
     p.run(&[]).unwrap();
     let table = p.output("at_end");
     let fifo_made = |path: &Path| {
@@ -210,7 +195,7 @@ fn non_regular_files_in_results_are_damaged_never_read() {
 #[test]
 fn shard_counts_are_bounded_and_missing_shards_counted() {
     use woodpile_pipeline::shard::{merge, run_shard, Shard};
-    let p = Project::new(&[("sweep", SWEEP)]);
+    let p = Project::new(&[("sweep", &single_defect_sweep())]);
     let pipeline = Pipeline::load(&p.pipeline(), KINDS).unwrap();
     let err = run_shard(
         &pipeline,
@@ -246,7 +231,7 @@ fn load_error(stages: &[(&str, &str)]) -> String {
 /// Requests whose planning alone would take gigabytes are refused at load, naming the key.
 #[test]
 fn huge_requests_are_refused_at_load() {
-    let blocks = SWEEP
+    let blocks = single_defect_sweep()
         .replace("chain = { n = 12 }", "chain = { n = 5000000 }")
         .replace("site = 0\neps", "site = 0\nthrough = 4000000\neps");
     let err = load_error(&[("sweep", &blocks)]);
@@ -305,13 +290,21 @@ y_label = "E_tr"
     assert!(err.contains("100 panels") && err.contains("64"), "{err}");
 
     let long = FIGURE.replace("TITLE", &"{at_end.kind}".repeat(20_000));
-    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("fig", &long)]);
+    let p = Project::new(&[
+        ("sweep", &single_defect_sweep()),
+        ("at_end", REDUCE),
+        ("fig", &long),
+    ]);
     let err = p.run(&[]).unwrap_err().to_string();
     assert!(err.contains("more than 100000 characters"), "{err}");
 
     // A quoted value is inserted as it is, never expanded again.
     let quoting = FIGURE.replace("TITLE", "{at_end.kind} at {at_end.params.at} {x");
-    let p = Project::new(&[("sweep", SWEEP), ("at_end", REDUCE), ("fig", &quoting)]);
+    let p = Project::new(&[
+        ("sweep", &single_defect_sweep()),
+        ("at_end", REDUCE),
+        ("fig", &quoting),
+    ]);
     p.run(&[]).unwrap();
     let manifest = table::read_manifest(&p.output("fig")).unwrap().unwrap();
     assert_eq!(

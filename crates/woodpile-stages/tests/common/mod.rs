@@ -134,6 +134,13 @@ through = "$L"
 eps = "$eps"
 "#;
 
+/// [`SWEEP`] without the L axis: one defect at site 0, eps in {0.5, 1, 1.5}.
+pub fn single_defect_sweep() -> String {
+    SWEEP
+        .replace("L = [0, 1]\n", "")
+        .replace("through = \"$L\"\n", "")
+}
+
 pub const REDUCE: &str = r#"
 kind = "reduce"
 inputs = ["sweep"]
