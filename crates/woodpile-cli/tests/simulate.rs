@@ -257,3 +257,47 @@ fn endless_runs_and_standing_impulses_exit_2_naming_the_key() {
         assert!(out.stdout.is_empty());
     }
 }
+
+/// The binary carries two copies of its hot loops, for AVX2 and for the x86-64 baseline, and
+/// picks one at run time (`WOODPILE_SIMD=baseline` forces the baseline): both give the same
+/// bits, on a scene with contact events, two resonators and `auto`'s verification runs.
+#[test]
+fn the_avx2_and_baseline_paths_give_the_same_bits() {
+    let path = scene_file(
+        r#"
+[chain]
+n = 60
+[impulse]
+site = -20
+velocity = 1.3
+[run]
+t_end = 60.0
+method = "auto"
+tolerance = 1e-7
+[[defect]]
+site = 0
+eps = 0.67
+[[defect]]
+site = 12
+eps = 3.0
+p = 3
+"#,
+    );
+    let run = |simd: &str| {
+        let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+            .arg("simulate")
+            .arg(&path)
+            .env("WOODPILE_SIMD", simd)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        json.as_object_mut().unwrap().remove("wall_s");
+        json
+    };
+    assert_eq!(run("baseline"), run("auto"));
+}

@@ -48,7 +48,7 @@ impl Model {
     /// `acc` outside the window are left untouched: the caller keeps them at zero, which is
     /// their exact value while those sites are at rest.
     pub fn accelerations_in(&self, t: f64, q: &[f64], acc: &mut [f64], window: Window) {
-        self.accelerations_impl(t, q, acc, window, None);
+        self.accelerations_dispatched(t, q, acc, window, None);
     }
 
     /// [`Model::accelerations_in`] that also writes every contact force of the window into
@@ -63,7 +63,18 @@ impl Model {
         window: Window,
         bond_force: &mut [f64],
     ) {
-        self.accelerations_impl(t, q, acc, window, Some(bond_force));
+        self.accelerations_dispatched(t, q, acc, window, Some(bond_force));
+    }
+
+    crate::simd::dispatched! {
+        /// The force loop, in its AVX2 copy where the CPU has one (`crate::simd`).
+        fn accelerations_dispatched[&self](
+            t: f64,
+            q: &[f64],
+            acc: &mut [f64],
+            window: Window,
+            bond_force: Option<&mut [f64]>,
+        ) => accelerations_impl, accelerations_avx2
     }
 
     #[inline(always)]

@@ -24,6 +24,7 @@ pub mod integrate;
 pub mod model;
 pub mod observe;
 pub mod run;
+pub mod simd;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod units;

@@ -155,10 +155,15 @@ impl<const S: usize> ContactEvents<S> {
         std::array::from_fn(|s| self.stage_force[s][bond])
     }
 
-    /// Lists in `self.changed` every bond of `window` whose contact opened or closed during the
-    /// step, as (bond, left site, right site) with `None` for a wall; `new_q` are the end
-    /// positions.
-    fn scan(&mut self, model: &Model, new_q: &[f64], window: Window) {
+    crate::simd::dispatched! {
+        /// Lists in `self.changed` every bond of `window` whose contact opened or closed during
+        /// the step, as (bond, left site, right site) with `None` for a wall; `new_q` are the
+        /// end positions.
+        fn scan[&mut self](model: &Model, new_q: &[f64], window: Window) => scan_body, scan_avx2
+    }
+
+    #[inline(always)]
+    fn scan_body(&mut self, model: &Model, new_q: &[f64], window: Window) {
         let n_sites = model.n_sites();
         let forces = &self.stage_force;
         // The scan over the window's bonds is the only per-bond cost; it touches the stage

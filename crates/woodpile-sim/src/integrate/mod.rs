@@ -463,8 +463,26 @@ fn check_finite(y: &[f64], t: f64) -> Result<(), SimError> {
 
 /// Fails if any entry of `y` in `ranges` is NaN or infinite. x - x is 0 for a finite x and NaN
 /// otherwise, and never overflows; eight independent partial sums let the loop vectorise.
-#[allow(clippy::eq_op)] // x - x is the point: it is NaN exactly when x is not finite
+#[allow(unsafe_code)]
 fn check_finite_in(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {
+    #[cfg(target_arch = "x86_64")]
+    if crate::simd::avx2() {
+        // SAFETY: `avx2()` is true only when the CPU has AVX2 and FMA.
+        return unsafe { check_finite_avx2(y, t, ranges) };
+    }
+    check_finite_body(y, t, ranges)
+}
+
+/// [`check_finite_in`] compiled with AVX2 (`crate::simd`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn check_finite_avx2(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {
+    check_finite_body(y, t, ranges)
+}
+
+#[inline(always)]
+#[allow(clippy::eq_op)] // x - x is the point: it is NaN exactly when x is not finite
+fn check_finite_body(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {
     let mut lanes = [0.0f64; 8];
     for range in ranges {
         let part = &y[range.clone()];

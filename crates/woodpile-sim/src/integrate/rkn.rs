@@ -191,10 +191,17 @@ impl<const S: usize> Rkn<S> {
         }
     }
 
-    /// One step of the tableau from `y` into `self.y_new` (uncorrected), recording the stage
-    /// forces when contacts are tracked. Each stage position and the new state are built by
-    /// whole-slice passes (one per nonzero coefficient), which vectorise.
-    fn raw_step(&mut self, model: &Model, t: f64, y: &[f64], h: f64, window: Window) {
+    crate::simd::dispatched! {
+        /// One step of the tableau from `y` into `self.y_new` (uncorrected), recording the
+        /// stage forces when contacts are tracked. Each stage position and the new state are
+        /// built by whole-slice passes (one per nonzero coefficient), which vectorise: in
+        /// their AVX2 copy where the CPU has one (`crate::simd`).
+        fn raw_step[&mut self](model: &Model, t: f64, y: &[f64], h: f64, window: Window)
+            => raw_step_body, raw_step_avx2
+    }
+
+    #[inline(always)]
+    fn raw_step_body(&mut self, model: &Model, t: f64, y: &[f64], h: f64, window: Window) {
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);
