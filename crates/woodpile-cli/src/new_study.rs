@@ -66,11 +66,25 @@ const FIGURE: &str = r#"kind = "render"
 description = "R, T and E_tr against eps"
 inputs = ["fractions"]
 title = "one defect at site 0, read out at t = {fractions.params.at}"
+# eps is log-spaced: a log axis spreads it evenly.
+x_scale = "log"
 [lines]
 x = "eps"
 y = ["R", "T", "E_tr"]
-x_label = "eps"
-y_label = "fraction"
+x_label = "\\varepsilon = m/M"
+y_label = "energy fraction"
+"#;
+
+const DEFAULTS: &str = r#"# Not a stage: keys every stage of a kind starts from; a stage's own keys override them.
+# Figures print at a journal's width (86 mm for one panel, 178 mm for more) with 8-pt text.
+[render.style]
+dpi = 300
+font_pt = 8
+legend = "best"
+
+# How names are written in the figures (the tables keep the names).
+[render.labels]
+E_tr = "E_{tr}"
 "#;
 
 const PROJECT: &str = r#"# This folder is a woodpile project: `woodpile run`, `status` and `diff` work here (and in any
@@ -88,8 +102,9 @@ woodpile status         # what is fresh or stale, and why
 woodpile run --set fractions.at=40.0   # a variant without editing a file
 ```
 
-`scenes/base.toml` is the scene; `pipeline/` holds the stages (sweep, reduce, render). Edit a
-stage and `woodpile run` recomputes only what changed.
+`scenes/base.toml` is the scene; `pipeline/` holds the stages (sweep, reduce, render) and
+`pipeline/defaults.toml` the figures' size, type and labels. Edit a stage and `woodpile run`
+recomputes only what changed.
 "#;
 
 pub(crate) fn run(args: &Args) -> Result<(), Failure> {
@@ -106,13 +121,14 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             root.display()
         )));
     }
-    let files: [(&str, &str); 6] = [
+    let files: [(&str, &str); 7] = [
         ("woodpile.toml", PROJECT),
         ("README.md", README),
         ("scenes/base.toml", SCENE),
         ("pipeline/sweep.toml", SWEEP),
         ("pipeline/fractions.toml", REDUCE),
         ("pipeline/figure.toml", FIGURE),
+        ("pipeline/defaults.toml", DEFAULTS),
     ];
     for (name, text) in files {
         write(&root.join(name), text)?;

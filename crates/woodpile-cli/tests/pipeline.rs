@@ -420,6 +420,10 @@ fn a_new_study_runs_as_written_without_directory_flags() {
         text(&ran.stderr)
     );
     assert!(study.join("figures/figure.png").exists());
+    // The study's figure is set for print by its defaults: one panel at column width, E_tr
+    // written as E with a subscript.
+    let svg = std::fs::read_to_string(study.join("figures/figure.svg")).unwrap();
+    assert!(svg.contains(r#"width="86.0mm""#) && svg.contains("Eₜᵣ"));
     let inside = woodpile(&study.join("pipeline"), &["status", "--check"]);
     assert_eq!(inside.status.code(), Some(0), "{}", text(&inside.stdout));
     let variant = woodpile(&study, &["run", "--set", "fractions.at=40.0"]);
