@@ -42,51 +42,39 @@ pub fn path() -> &'static str {
 /// Defines method `$name` as a dispatcher over two copies of the `#[inline(always)]` method
 /// `$body` (same receiver, same arguments): `$avx2`, compiled with AVX2 and FMA and called
 /// when [`avx2`] says so, and `$body` itself for the baseline. The receiver is written in
-/// brackets, `[&self]` or `[&mut self]` (`self` must be written by the macro itself to be
-/// usable in the bodies it writes).
+/// brackets, `[&self]` or `[&mut self]`.
 macro_rules! dispatched {
     (
         $(#[$meta:meta])*
-        $vis:vis fn $name:ident [&self] ($($arg:ident : $ty:ty),* $(,)?) $(-> $ret:ty)?
-        => $body:ident, $avx2:ident
+        $vis:vis fn $name:ident [&mut $s:ident] $($rest:tt)*
     ) => {
-        $(#[$meta])*
-        #[allow(unsafe_code)]
-        $vis fn $name(&self, $($arg: $ty),*) $(-> $ret)? {
-            #[cfg(target_arch = "x86_64")]
-            if crate::simd::avx2() {
-                // SAFETY: `avx2()` is true only when the CPU has AVX2 and FMA.
-                return unsafe { self.$avx2($($arg),*) };
-            }
-            self.$body($($arg),*)
-        }
-
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = "avx2,fma")]
-        fn $avx2(&self, $($arg: $ty),*) $(-> $ret)? {
-            self.$body($($arg),*)
-        }
+        crate::simd::dispatched!(@emit [$(#[$meta])*] $vis $name [&mut $s] $s $($rest)*);
     };
     (
         $(#[$meta:meta])*
-        $vis:vis fn $name:ident [&mut self] ($($arg:ident : $ty:ty),* $(,)?) $(-> $ret:ty)?
-        => $body:ident, $avx2:ident
+        $vis:vis fn $name:ident [& $s:ident] $($rest:tt)*
     ) => {
-        $(#[$meta])*
+        crate::simd::dispatched!(@emit [$(#[$meta])*] $vis $name [&$s] $s $($rest)*);
+    };
+    (
+        @emit [$($meta:tt)*] $vis:vis $name:ident [$($recv:tt)+] $s:ident
+        ($($arg:ident : $ty:ty),* $(,)?) $(-> $ret:ty)? => $body:ident, $avx2:ident
+    ) => {
+        $($meta)*
         #[allow(unsafe_code)]
-        $vis fn $name(&mut self, $($arg: $ty),*) $(-> $ret)? {
+        $vis fn $name($($recv)+, $($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             if crate::simd::avx2() {
                 // SAFETY: `avx2()` is true only when the CPU has AVX2 and FMA.
-                return unsafe { self.$avx2($($arg),*) };
+                return unsafe { $s.$avx2($($arg),*) };
             }
-            self.$body($($arg),*)
+            $s.$body($($arg),*)
         }
 
         #[cfg(target_arch = "x86_64")]
         #[target_feature(enable = "avx2,fma")]
-        fn $avx2(&mut self, $($arg: $ty),*) $(-> $ret)? {
-            self.$body($($arg),*)
+        fn $avx2($($recv)+, $($arg: $ty),*) $(-> $ret)? {
+            $s.$body($($arg),*)
         }
     };
 }
