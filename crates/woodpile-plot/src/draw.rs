@@ -390,33 +390,45 @@ pub(crate) fn pixel<DB: DrawingBackend>(chart: &Chart<'_, DB>, (x, y): (f64, f64
 /// Mark colours: dark grey and black read on white and on every map colour.
 const MARK_COLOURS: [RGBColor; 2] = [RGBColor(60, 60, 60), BLACK];
 
-/// Draws `marks` across the plot (in plot space, scaled), and returns their legend entries,
-/// one per distinct label.
+/// One legend entry per distinct mark label, in order of first appearance, each in its
+/// lines' colour.
+pub(crate) fn mark_entries(marks: &[Mark]) -> Vec<Entry> {
+    let mut entries: Vec<Entry> = Vec::new();
+    for mark in marks {
+        if !entries.iter().any(|e| e.label == mark.label) {
+            entries.push(Entry {
+                label: mark.label.clone(),
+                glyph: Glyph::Line {
+                    colour: MARK_COLOURS[entries.len() % MARK_COLOURS.len()],
+                    dash: Dash::Dashed,
+                    marker: Marker::None,
+                    width_pt: 0.9,
+                },
+            });
+        }
+    }
+    entries
+}
+
+/// Draws `marks` across the plot (in plot space, scaled) in the colours of
+/// [`mark_entries`]; returns their lines in backend pixels.
 pub(crate) fn marks<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     chart: &Chart<'_, DB>,
     marks: &[Mark],
     (sx, sy): (Scale, Scale),
     style: &Style,
-) -> Result<(Vec<Entry>, Vec<Curve>), String> {
+) -> Result<Vec<Curve>, String> {
     let rect = plot_rect(chart);
-    let mut entries: Vec<Entry> = Vec::new();
+    let entries = mark_entries(marks);
     let mut drawn = Vec::new();
     for mark in marks {
-        let k = match entries.iter().position(|e| e.label == mark.label) {
-            Some(k) => k,
-            None => {
-                entries.push(Entry {
-                    label: mark.label.clone(),
-                    glyph: Glyph::Line {
-                        colour: MARK_COLOURS[entries.len() % MARK_COLOURS.len()],
-                        dash: Dash::Dashed,
-                        marker: Marker::None,
-                        width_pt: 0.9,
-                    },
-                });
-                entries.len() - 1
-            }
+        let Some(Glyph::Line { colour, .. }) = entries
+            .iter()
+            .find(|e| e.label == mark.label)
+            .map(|e| e.glyph)
+        else {
+            continue;
         };
         let line = match mark.at {
             MarkAt::X(x) => {
@@ -428,16 +440,10 @@ pub(crate) fn marks<DB: DrawingBackend>(
                 vec![(rect.x0, py), (rect.x1, py)]
             }
         };
-        legend::polyline(
-            area,
-            &line,
-            &rect,
-            (MARK_COLOURS[k % 2], Dash::Dashed, 0.9),
-            style,
-        )?;
+        legend::polyline(area, &line, &rect, (colour, Dash::Dashed, 0.9), style)?;
         drawn.push(line);
     }
-    Ok((entries, drawn))
+    Ok(drawn)
 }
 
 /// Where the legend goes for `placement`: inside at a corner (or `None` when it must go
@@ -499,13 +505,13 @@ fn lines_panel<DB: DrawingBackend>(
         .collect();
     // One curve is named by the y label; a legend would only hide data.
     let wants_legend = (p.series.len() > 1 || !p.marks.is_empty()) && style.legend != Legend::None;
-    let mark_labels = p
-        .marks
-        .iter()
-        .filter(|m| !entries.iter().any(|e| e.label == m.label))
-        .count();
+    // A mark labelled like a curve shares its entry.
+    entries.extend(
+        mark_entries(&p.marks)
+            .into_iter()
+            .filter(|m| !p.series.iter().any(|s| s.label == m.label)),
+    );
     let size = legend::measure(area, &entries, style);
-    let size = (size.0, size.1 + mark_labels as f64 * style.font(1.35));
     // Where the legend goes decides the chart's area, so place it on a trial chart first.
     let mut placement = if wants_legend {
         style.legend
@@ -559,24 +565,19 @@ fn lines_panel<DB: DrawingBackend>(
         // Every point when there are few; otherwise about eight per curve, evenly spaced
         // across the plot's width (whatever the axis scale), staggered so that curves
         // sharing an x do not stack their markers.
-        let gap = (rect.x1 - rect.x0) / 8.0;
-        let mut next = rect.x0 + gap * (k as f64 / p.series.len().max(1) as f64);
+        let spacing = (rect.x1 - rect.x0) / 8.0;
+        let mut next = rect.x0 + spacing * (k as f64 / p.series.len().max(1) as f64);
         for &q in line {
             if !(q.0.is_finite() && q.1.is_finite() && rect.contains_point(q)) {
                 continue;
             }
             if line.len() <= 40 || q.0 >= next {
                 legend::marker(area, q, marker, colour, style)?;
-                next = q.0 + gap;
+                next = q.0 + spacing;
             }
         }
     }
-    let (mark_entries, mark_lines) = marks(area, &chart, &p.marks, (sx, sy), style)?;
-    entries.extend(
-        mark_entries
-            .into_iter()
-            .filter(|m| !p.series.iter().any(|s| s.label == m.label)),
-    );
+    let mark_lines = marks(area, &chart, &p.marks, (sx, sy), style)?;
     let all: Vec<Vec<(f64, f64)>> = points.into_iter().chain(mark_lines).collect();
     let dense = legend::dense(&all, 2.0);
     let at = match (placement, &side) {

@@ -6,7 +6,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::colour::{diverging, viridis, Dash, Marker, CATEGORIES};
-use crate::draw::{chart, inside_place, marks, pixel, pixel_curves, plot_rect, text, Shared, FONT};
+use crate::draw::{
+    chart, inside_place, mark_entries, marks, pixel, pixel_curves, plot_rect, text, Shared, FONT,
+};
 use crate::legend::{self, Entry, Glyph};
 use crate::style::{Corner, Legend, Style};
 use crate::{Colours, HeatPanel};
@@ -171,7 +173,7 @@ pub(crate) fn panel<DB: DrawingBackend>(
         (area.clone(), None)
     };
     // Overlay and mark legends go under the map, which has no free corner.
-    let entry_count = h.overlays.len() + distinct_labels(&h.marks);
+    let entry_count = h.overlays.len() + mark_entries(&h.marks).len();
     let (main, below) = if entry_count > 0
         && style.legend != Legend::None
         && !matches!(style.legend, Legend::Inside(_))
@@ -251,8 +253,8 @@ pub(crate) fn panel<DB: DrawingBackend>(
             },
         });
     }
-    let (mark_entries, mark_lines) = marks(area, &chart, &h.marks, (sx, sy), style)?;
-    entries.extend(mark_entries);
+    let mark_lines = marks(area, &chart, &h.marks, (sx, sy), style)?;
+    entries.extend(mark_entries(&h.marks));
     if let Some(bar) = bar {
         match &h.colours {
             Colours::Categories(names) => category_legend(&bar, names, style)?,
@@ -336,14 +338,6 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
     });
     bar_chart.draw_series(strip).map_err(text)?;
     Ok(())
-}
-
-/// How many distinct labels `marks` have: one legend entry each.
-fn distinct_labels(marks: &[crate::Mark]) -> usize {
-    let mut labels: Vec<&str> = marks.iter().map(|m| m.label.as_str()).collect();
-    labels.sort_unstable();
-    labels.dedup();
-    labels.len()
 }
 
 pub(crate) fn category_entries(names: &[String]) -> Vec<Entry> {

@@ -30,15 +30,6 @@ fn detected() -> bool {
     false
 }
 
-/// The instruction set the hot loops use in this process: `"avx2"` or `"baseline"`.
-pub fn path() -> &'static str {
-    if avx2() {
-        "avx2"
-    } else {
-        "baseline"
-    }
-}
-
 /// Defines method `$name` as a dispatcher over two copies of the `#[inline(always)]` method
 /// `$body` (same receiver, same arguments): `$avx2`, compiled with AVX2 and FMA and called
 /// when [`avx2`] says so, and `$body` itself for the baseline. The receiver is written in
@@ -80,11 +71,3 @@ macro_rules! dispatched {
 }
 
 pub(crate) use dispatched;
-
-#[cfg(test)]
-mod tests {
-    #[test]
-    fn the_path_is_named() {
-        assert!(["avx2", "baseline"].contains(&super::path()));
-    }
-}
