@@ -31,11 +31,7 @@ impl Stage {
         kinds: &'static Registry,
         defaults: &Defaults,
     ) -> Result<Stage> {
-        let text = woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
-            file: file.to_path_buf(),
-            reason: format!("cannot read: {e}"),
-            source: None,
-        })?;
+        let text = read_text(file)?;
         Stage::parse_in(&text, file, root, kinds, defaults)
     }
 
@@ -53,11 +49,7 @@ impl Stage {
         kinds: &'static Registry,
         defaults: &Defaults,
     ) -> Result<Stage> {
-        let mut table: toml::Table = toml::from_str(text).map_err(|e| PipelineError::Syntax {
-            file: file.to_path_buf(),
-            reason: e.to_string().trim_end().to_string(),
-            source: Some(Box::new(e)),
-        })?;
+        let mut table = parse_table(text, file)?;
         include_scene_file(&mut table, file, root)?;
         defaults.lay_under(&mut table);
         Stage::from_table(table, file, kinds)
@@ -113,16 +105,7 @@ impl Defaults {
         if !file.exists() {
             return Ok(Defaults::default());
         }
-        let text = woodpile_scene::read_input(&file).map_err(|e| PipelineError::Syntax {
-            file: file.clone(),
-            reason: format!("cannot read: {e}"),
-            source: None,
-        })?;
-        let table: toml::Table = toml::from_str(&text).map_err(|e| PipelineError::Syntax {
-            file: file.clone(),
-            reason: e.to_string().trim_end().to_string(),
-            source: Some(Box::new(e)),
-        })?;
+        let table = parse_table(&read_text(&file)?, &file)?;
         if let Some((key, _)) = table.iter().find(|(_, v)| !v.is_table()) {
             return Err(definition(
                 &file,
@@ -141,6 +124,24 @@ impl Defaults {
             merge(table, own);
         }
     }
+}
+
+/// The text of the TOML file at `file`, or a syntax error naming it.
+pub(crate) fn read_text(file: &Path) -> Result<String> {
+    woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
+        file: file.to_path_buf(),
+        reason: format!("cannot read: {e}"),
+        source: None,
+    })
+}
+
+/// `text` (of `file`) parsed as a TOML table, or a syntax error naming the file.
+pub(crate) fn parse_table(text: &str, file: &Path) -> Result<toml::Table> {
+    toml::from_str(text).map_err(|e| PipelineError::Syntax {
+        file: file.to_path_buf(),
+        reason: e.to_string().trim_end().to_string(),
+        source: Some(Box::new(e)),
+    })
 }
 
 fn stage_name(file: &Path) -> Result<String> {

@@ -95,18 +95,8 @@ pub fn variants(
                         .join(", "),
                 }
             })?;
-            let text =
-                woodpile_scene::read_input(&stage.file).map_err(|e| PipelineError::Syntax {
-                    file: stage.file.clone(),
-                    reason: format!("cannot read: {e}"),
-                    source: None,
-                })?;
-            let mut table: toml::Table =
-                toml::from_str(&text).map_err(|e| PipelineError::Syntax {
-                    file: stage.file.clone(),
-                    reason: e.to_string().trim_end().to_string(),
-                    source: Some(Box::new(e)),
-                })?;
+            let mut table =
+                crate::stage::parse_table(&crate::stage::read_text(&stage.file)?, &stage.file)?;
             for set in sets.iter().filter(|s| s.stage == name) {
                 assign(&mut table, &set.key, set.value.clone()).map_err(|reason| {
                     PipelineError::Definition {
