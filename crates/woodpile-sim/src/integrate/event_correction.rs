@@ -276,21 +276,43 @@ fn block_changes<const S: usize, const N: usize>(
     mask
 }
 
-/// The name of a stepper that keeps contact events in `contact` (`names[1]`) or does not
-/// (`names[0]`).
-pub(crate) fn named<const S: usize>(
-    contact: &Option<ContactEvents<S>>,
-    [plain, corrected]: [&'static str; 2],
-) -> &'static str {
-    match contact {
-        Some(_) => corrected,
-        None => plain,
-    }
+/// What the hand-written fixed-step steppers ([`super::Rk4Fused`], [`super::Rkn4`]) keep
+/// beside their stage derivatives: the position of the next force evaluation, the new state
+/// being assembled, the evaluations spent, and, for the `-contact` variant, each stage's bond
+/// forces. One constructor serves a method and its `-contact` variant.
+#[derive(Debug, Clone)]
+pub(crate) struct FixedStepScratch<const S: usize> {
+    pub q_stage: Vec<f64>,
+    pub y_new: Vec<f64>,
+    pub evals: u64,
+    pub contact: Option<ContactEvents<S>>,
+    /// The plain method's name and its `-contact` variant's.
+    names: [&'static str; 2],
 }
 
-/// Bonds whose contact changed state inside a step and were corrected (0 without events).
-pub(crate) fn events_of<const S: usize>(contact: &Option<ContactEvents<S>>) -> u64 {
-    contact.as_ref().map_or(0, ContactEvents::events)
+impl<const S: usize> FixedStepScratch<S> {
+    /// Scratch for states of `model`; contact events are kept when `quadrature` (the method's
+    /// quadrature of a bond force) is given.
+    pub fn new(model: &Model, names: [&'static str; 2], quadrature: Option<Quadrature<S>>) -> Self {
+        let n = model.n_dof();
+        Self {
+            q_stage: vec![0.0; n],
+            y_new: vec![0.0; 2 * n],
+            evals: 0,
+            contact: quadrature.map(|q| ContactEvents::new(model, q)),
+            names,
+        }
+    }
+
+    /// The method's name: the `-contact` one when contact events are kept.
+    pub fn name(&self) -> &'static str {
+        self.names[usize::from(self.contact.is_some())]
+    }
+
+    /// Bonds whose contact changed state inside a step and were corrected (0 without events).
+    pub fn contact_events(&self) -> u64 {
+        self.contact.as_ref().map_or(0, ContactEvents::events)
+    }
 }
 
 /// Stage `stage`'s accelerations `acc` at positions `q`, recording every bond force into

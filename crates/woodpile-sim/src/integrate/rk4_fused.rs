@@ -11,7 +11,7 @@
 //! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
 use super::contact_event::rk4_quadrature;
-use super::event_correction::{events_of, finish_step, named, stage_accelerations, ContactEvents};
+use super::event_correction::{finish_step, stage_accelerations, FixedStepScratch, Quadrature};
 use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
@@ -23,51 +23,44 @@ const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
 /// Fused RK4 stepper with its scratch (allocated once).
 #[derive(Debug, Clone)]
 pub struct Rk4Fused {
-    /// Stage positions.
-    q_stage: Vec<f64>,
+    /// Stage positions, the new state, evaluations, and `rk4-contact`'s stage bond forces.
+    scratch: FixedStepScratch<4>,
     /// Stage velocities (the position derivatives k_q).
     v_stage: Vec<f64>,
     /// Stage accelerations (the velocity derivatives k_v).
     a_stage: Vec<f64>,
-    /// The new state being accumulated.
-    y_new: Vec<f64>,
-    evals: u64,
-    /// For `rk4-contact`: the bond forces of each stage (see [`ContactEvents`]).
-    contact: Option<ContactEvents<4>>,
 }
 
 impl Rk4Fused {
     /// A stepper for states of `model`.
     pub fn new(model: &Model) -> Self {
-        let n = model.n_dof();
-        Self {
-            q_stage: vec![0.0; n],
-            v_stage: vec![0.0; n],
-            a_stage: vec![0.0; n],
-            y_new: vec![0.0; 2 * n],
-            evals: 0,
-            contact: None,
-        }
+        Self::with_quadrature(model, None)
     }
 
     /// `rk4-contact`: the same RK4, plus the exact integral of every contact force across the
     /// step in which that contact opens or closes ([`super::contact_event`]).
     pub fn with_contact_events(model: &Model) -> Self {
+        Self::with_quadrature(model, Some(rk4_quadrature))
+    }
+
+    fn with_quadrature(model: &Model, quadrature: Option<Quadrature<4>>) -> Self {
+        let n = model.n_dof();
         Self {
-            contact: Some(ContactEvents::new(model, rk4_quadrature)),
-            ..Self::new(model)
+            scratch: FixedStepScratch::new(model, ["rk4", "rk4-contact"], quadrature),
+            v_stage: vec![0.0; n],
+            a_stage: vec![0.0; n],
         }
     }
 
     /// Bonds whose contact changed state inside a step and were corrected (0 for plain RK4).
     pub fn contact_events(&self) -> u64 {
-        events_of(&self.contact)
+        self.scratch.contact_events()
     }
 }
 
 impl Stepper for Rk4Fused {
     fn name(&self) -> &'static str {
-        named(&self.contact, ["rk4", "rk4-contact"])
+        self.scratch.name()
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
@@ -75,13 +68,20 @@ impl Stepper for Rk4Fused {
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);
-        let (new_q, new_v) = self.y_new.split_at_mut(n);
+        let FixedStepScratch {
+            q_stage,
+            y_new,
+            evals,
+            contact,
+            ..
+        } = &mut self.scratch;
+        let (new_q, new_v) = y_new.split_at_mut(n);
         // Stage 1 is the state itself: its accelerations are taken at q directly, and the
         // first pass below writes y + (h b_1) k_1 and stage 2 from (q, v) instead of copying
         // (q, v) into four buffers first. Same operations on the same operands, same bits.
         stage_accelerations(
             model,
-            self.contact.as_mut(),
+            contact.as_mut(),
             (q, &mut self.a_stage),
             (t, 0),
             window,
@@ -93,7 +93,7 @@ impl Stepper for Rk4Fused {
                 let len = r.len();
                 let vs = &mut self.v_stage[r.clone()];
                 let as_ = &self.a_stage[r.clone()][..len];
-                let qs = &mut self.q_stage[r.clone()][..len];
+                let qs = &mut q_stage[r.clone()][..len];
                 let nq = &mut new_q[r.clone()][..len];
                 let nv = &mut new_v[r.clone()][..len];
                 let q0 = &q[r.clone()][..len];
@@ -127,21 +127,15 @@ impl Stepper for Rk4Fused {
             if stage < 3 {
                 stage_accelerations(
                     model,
-                    self.contact.as_mut(),
-                    (&self.q_stage, &mut self.a_stage),
+                    contact.as_mut(),
+                    (q_stage, &mut self.a_stage),
                     (t + C[stage + 1] * h, stage + 1),
                     window,
                 );
             }
         }
-        self.evals += 4;
-        finish_step(
-            self.contact.as_mut(),
-            model,
-            (y, &mut self.y_new),
-            h,
-            window,
-        );
+        *evals += 4;
+        finish_step(contact.as_mut(), model, (y, y_new), h, window);
         StepOutcome::Accepted { h_next: h }
     }
 
@@ -150,6 +144,6 @@ impl Stepper for Rk4Fused {
     }
 
     fn rhs_evals(&self) -> u64 {
-        self.evals
+        self.scratch.evals
     }
 }

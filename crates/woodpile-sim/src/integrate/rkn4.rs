@@ -22,7 +22,7 @@
 //! where the tableau stepper takes 6.7 ms (1.18x; best of 15, `cargo run --release -p
 //! woodpile-bench --example nystrom4`).
 
-use super::event_correction::{events_of, finish_step, named, stage_accelerations, ContactEvents};
+use super::event_correction::{finish_step, stage_accelerations, FixedStepScratch, Quadrature};
 use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
@@ -32,15 +32,11 @@ const C: [f64; 3] = [0.0, 0.5, 1.0];
 /// RKN4 with its scratch (allocated once).
 #[derive(Debug, Clone)]
 pub struct Rkn4 {
-    /// The position at which the next force is evaluated.
-    q_stage: Vec<f64>,
+    /// The next force's position, the new state, evaluations, and `rkn4-contact`'s stage bond
+    /// forces.
+    scratch: FixedStepScratch<3>,
     /// The three stage accelerations.
     a: [Vec<f64>; 3],
-    /// The new state being assembled, `[q, q']`.
-    y_new: Vec<f64>,
-    evals: u64,
-    /// For `rkn4-contact`: the bond forces of each stage.
-    contact: Option<ContactEvents<3>>,
 }
 
 /// RKN4's quadrature of a bond force from its stage values:
@@ -56,44 +52,48 @@ pub(crate) fn rkn4_quadrature(stage_forces: [f64; 3], h: f64) -> (f64, f64) {
 impl Rkn4 {
     /// A stepper for states of `model`.
     pub fn new(model: &Model) -> Self {
-        let n = model.n_dof();
-        Self {
-            q_stage: vec![0.0; n],
-            a: std::array::from_fn(|_| vec![0.0; n]),
-            y_new: vec![0.0; 2 * n],
-            evals: 0,
-            contact: None,
-        }
+        Self::with_quadrature(model, None)
     }
 
     /// `rkn4-contact`: the same method plus the exact integral of every contact force across
     /// the step in which that contact opens or closes.
     pub fn with_contact_events(model: &Model) -> Self {
+        Self::with_quadrature(model, Some(rkn4_quadrature))
+    }
+
+    fn with_quadrature(model: &Model, quadrature: Option<Quadrature<3>>) -> Self {
         Self {
-            contact: Some(ContactEvents::new(model, rkn4_quadrature)),
-            ..Self::new(model)
+            scratch: FixedStepScratch::new(model, ["rkn4", "rkn4-contact"], quadrature),
+            a: std::array::from_fn(|_| vec![0.0; model.n_dof()]),
         }
     }
 
     /// Bonds whose contact changed state inside a step and were corrected (0 for plain RKN4).
     pub fn contact_events(&self) -> u64 {
-        events_of(&self.contact)
+        self.scratch.contact_events()
     }
 }
 
 impl Stepper for Rkn4 {
     fn name(&self) -> &'static str {
-        named(&self.contact, ["rkn4", "rkn4-contact"])
+        self.scratch.name()
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
         let StepSpan { t, h, window } = span;
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
+        let FixedStepScratch {
+            q_stage,
+            y_new,
+            evals,
+            contact,
+            ..
+        } = &mut self.scratch;
         // Stage 1 is the state itself: its accelerations are taken at q, with no copy.
         stage_accelerations(
             model,
-            self.contact.as_mut(),
+            contact.as_mut(),
             (&y[..n], &mut self.a[0]),
             (t, 0),
             window,
@@ -106,7 +106,7 @@ impl Stepper for Rkn4 {
             let (q, v) = y.split_at(n);
             for r in ranges.clone() {
                 let len = r.len();
-                let qs = &mut self.q_stage[r.clone()][..len];
+                let qs = &mut q_stage[r.clone()][..len];
                 let (q0, v0) = (&q[r.clone()][..len], &v[r.clone()][..len]);
                 let a = &self.a[stage][r][..len];
                 for i in 0..len {
@@ -115,15 +115,15 @@ impl Stepper for Rkn4 {
             }
             stage_accelerations(
                 model,
-                self.contact.as_mut(),
-                (&self.q_stage, &mut self.a[stage + 1]),
+                contact.as_mut(),
+                (q_stage, &mut self.a[stage + 1]),
                 (t + C[stage + 1] * h, stage + 1),
                 window,
             );
         }
-        self.evals += 3;
+        *evals += 3;
         let (q, v) = y.split_at(n);
-        let (new_q, new_v) = self.y_new.split_at_mut(n);
+        let (new_q, new_v) = y_new.split_at_mut(n);
         let (bq1, bq2) = (h * h / 6.0, h * h / 3.0);
         let (bv1, bv2, bv3) = (h / 6.0, 2.0 * h / 3.0, h / 6.0);
         for r in ranges.clone() {
@@ -141,13 +141,7 @@ impl Stepper for Rkn4 {
                 nv[i] = v0[i] + (bv1 * a1[i] + bv2 * a2[i] + bv3 * a3[i]);
             }
         }
-        finish_step(
-            self.contact.as_mut(),
-            model,
-            (y, &mut self.y_new),
-            h,
-            window,
-        );
+        finish_step(contact.as_mut(), model, (y, y_new), h, window);
         StepOutcome::Accepted { h_next: h }
     }
 
@@ -156,6 +150,6 @@ impl Stepper for Rkn4 {
     }
 
     fn rhs_evals(&self) -> u64 {
-        self.evals
+        self.scratch.evals
     }
 }
