@@ -62,11 +62,12 @@ read-check: ## Open every result table with pyarrow, pandas and polars
 
 BASELINE := $(or $(CARGO_TARGET_DIR),target)/baseline
 
-bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, then divan benchmarks
+bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, batched against scalar scenes, then divan benchmarks
 	mkdir -p $(BASELINE)
 	gcc -O3 -march=x86-64-v3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
 	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py
+	$(CARGO) run --release -q -p woodpile-bench --example batch_lanes -- 16 0.215
 	$(CARGO) bench -p woodpile-bench
 
 audit: ## auto against an independent reference on 200 random scenes at 1e-5..1e-8 (about 7 min)
