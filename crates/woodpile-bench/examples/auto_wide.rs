@@ -14,61 +14,25 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_bench::on_two_cores;
-use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::{Method, MethodChoice};
-use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::run::{simulate, Scenario};
-use woodpile_sim::testing::{fixed_dt, reference_dt, reference_fractions, tolerance, Lcg};
+use woodpile_sim::testing::{
+    fixed_dt, random_scene, reference_dt, reference_fractions, tolerance, Lcg, SceneRanges,
+};
 
-fn random_scene(rng: &mut Lcg, tol: f64) -> Scenario {
-    let half = 40 + (rng.uniform() * 80.0) as usize;
-    let n_sites = 2 * half + 1;
-    let boundary = if rng.uniform() < 0.5 {
-        Boundary::Fixed
-    } else {
-        Boundary::Free
-    };
-    let mut resonators: Vec<Resonator> = (0..1 + (rng.uniform() * 3.0) as usize)
-        .map(|_| {
-            let site = half + (rng.uniform() * 30.0) as usize;
-            let p = [1, 1, 1, 3, 5, 7][(rng.uniform() * 6.0) as usize % 6];
-            let kappa = rng.log_uniform(0.3, 5.0);
-            let coupling = if rng.uniform() < 0.2 {
-                Coupling::Ramp {
-                    k1: 0.0,
-                    k2: kappa,
-                    t0: rng.uniform() * 60.0,
-                    tau: rng.log_uniform(0.1, 5.0),
-                }
-            } else {
-                Coupling::Constant(kappa)
-            };
-            Resonator {
-                site,
-                eps: rng.log_uniform(0.03, 100.0),
-                coupling,
-                p,
-            }
-        })
-        .collect();
-    resonators.sort_by_key(|r| r.site);
-    resonators.dedup_by_key(|r| r.site);
-    let lo = resonators[0].site as i64 - 1;
-    let hi = resonators[resonators.len() - 1].site as i64 + 1;
-    let impulse_site = half - 10 - (rng.uniform() * 25.0) as usize;
-    let impulse_velocity = rng.log_uniform(0.2, 3.0);
-    let t_end = 60.0 + rng.uniform() * 140.0;
-    Scenario {
-        model: Model::new(n_sites, boundary, resonators).unwrap(),
-        impulse_site,
-        impulse_velocity,
-        t_end,
-        region: Region::new(lo, hi, n_sites).unwrap(),
-        method: MethodChoice::Auto,
-        accuracy: tolerance(tol),
-        sample_every: 1.0,
-    }
-}
+/// This survey's ranges (the module doc).
+const WIDE: SceneRanges = SceneRanges {
+    half: (40, 80.0),
+    defects: 3.0,
+    site: (0, 30.0),
+    p: &[1, 1, 1, 3, 5, 7],
+    kappa: (0.3, 5.0),
+    eps: (0.03, 100.0),
+    impulse_back: 25.0,
+    velocity: (0.2, 3.0),
+    log_velocity: true,
+    t_end: (60.0, 140.0),
+};
 
 /// One line for `scene`, whether it missed, and its force evaluations.
 fn check(k: usize, scene: &Scenario, tol: f64) -> (String, bool, u64) {
@@ -128,8 +92,9 @@ fn main() {
     let n: usize = std::env::args().nth(1).map_or(60, |s| s.parse().unwrap());
     let tol: f64 = std::env::args().nth(2).map_or(1e-6, |s| s.parse().unwrap());
     let mut rng = Lcg(777);
-    let indexed: Vec<(usize, Scenario)> =
-        (0..n).map(|k| (k, random_scene(&mut rng, tol))).collect();
+    let indexed: Vec<(usize, Scenario)> = (0..n)
+        .map(|k| (k, random_scene(&mut rng, &WIDE, tol)))
+        .collect();
     if let Ok(k) = std::env::var("WIDE_SCENE") {
         examine(&indexed[k.parse::<usize>().unwrap()].1);
         return;

@@ -195,24 +195,67 @@ pub fn reference_fractions(scenario: &Scenario, dt: f64) -> Result<Fractions, Si
 /// finer than `auto`'s finest steps at 1e-8 on the audit's chains.
 pub const AUDIT_REFERENCE_DT: f64 = 2.5e-4;
 
-/// One scene of `auto`'s audit (`woodpile-bench`'s `auto_audit`), drawn wider than any stage
-/// file: n from 50 to 150, fixed or free ends, an impulse of velocity 0.5 to 2 left of centre,
-/// 1 to 5 defects near the centre (eps 0.05 to 100, kappa 0.1 to 10, p in {1, 3, 5, 7}, a fifth
-/// switched on by a tanh ramp), t_end from 100 to 200; `auto` at tolerance 1e-8.
-pub fn audit_scene(rng: &mut Lcg) -> Scenario {
-    let half = 50 + (rng.uniform() * 101.0) as usize;
+/// The ranges a random survey scene is drawn from: a chain of `2 half + 1` sites, fixed or
+/// free ends, defects near the centre, an impulse left of them. Each survey (the audit here,
+/// `auto_wide` in `woodpile-bench`) is one value of it, so that both draw in the same order.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneRanges {
+    /// `half` is `half.0 + floor(u · half.1)`.
+    pub half: (usize, f64),
+    /// At most this many defects (one at least; those on the same site merge).
+    pub defects: f64,
+    /// A defect's site is `half + site.0 + floor(u · site.1)`.
+    pub site: (i64, f64),
+    /// Coupling exponents, equally likely.
+    pub p: &'static [u32],
+    /// Log-uniform range of kappa.
+    pub kappa: (f64, f64),
+    /// Log-uniform range of eps.
+    pub eps: (f64, f64),
+    /// The impulse's site is `half - 10 - floor(u · impulse_back)`.
+    pub impulse_back: f64,
+    /// The range of the impulse's velocity.
+    pub velocity: (f64, f64),
+    /// Whether that velocity is log-uniform (uniform otherwise).
+    pub log_velocity: bool,
+    /// `t_end` is `t_end.0 + u · t_end.1`.
+    pub t_end: (f64, f64),
+}
+
+/// The audit's ranges: n from 50 to 150, 1 to 5 defects near the centre (eps 0.05 to 100,
+/// kappa 0.1 to 10, p in {1, 3, 5, 7}), an impulse of velocity 0.5 to 2 left of centre, t_end
+/// from 100 to 200.
+pub const AUDIT_RANGES: SceneRanges = SceneRanges {
+    half: (50, 101.0),
+    defects: 5.0,
+    site: (-5, 26.0),
+    p: &[1, 3, 5, 7],
+    kappa: (0.1, 10.0),
+    eps: (0.05, 100.0),
+    impulse_back: 30.0,
+    velocity: (0.5, 2.0),
+    log_velocity: false,
+    t_end: (100.0, 100.0),
+};
+
+/// A random scene drawn from `ranges`, `auto` at tolerance `tol`. A fifth of the defects are
+/// switched on by a tanh ramp.
+pub fn random_scene(rng: &mut Lcg, ranges: &SceneRanges, tol: f64) -> Scenario {
+    let half = ranges.half.0 + (rng.uniform() * ranges.half.1) as usize;
     let n_sites = 2 * half + 1;
     let boundary = if rng.uniform() < 0.5 {
         Boundary::Fixed
     } else {
         Boundary::Free
     };
-    let count = 1 + (rng.uniform() * 5.0) as usize;
+    let count = 1 + (rng.uniform() * ranges.defects) as usize;
     let mut resonators: Vec<Resonator> = (0..count)
         .map(|_| {
-            let site = half - 5 + (rng.uniform() * 26.0) as usize;
-            let p = [1, 3, 5, 7][(rng.uniform() * 4.0) as usize % 4];
-            let kappa = rng.log_uniform(0.1, 10.0);
+            let site =
+                (half as i64 + ranges.site.0) as usize + (rng.uniform() * ranges.site.1) as usize;
+            let choices = ranges.p.len();
+            let p = ranges.p[(rng.uniform() * choices as f64) as usize % choices];
+            let kappa = rng.log_uniform(ranges.kappa.0, ranges.kappa.1);
             let coupling = if rng.uniform() < 0.2 {
                 Coupling::Ramp {
                     k1: 0.0,
@@ -225,7 +268,7 @@ pub fn audit_scene(rng: &mut Lcg) -> Scenario {
             };
             Resonator {
                 site,
-                eps: rng.log_uniform(0.05, 100.0),
+                eps: rng.log_uniform(ranges.eps.0, ranges.eps.1),
                 coupling,
                 p,
             }
@@ -235,17 +278,29 @@ pub fn audit_scene(rng: &mut Lcg) -> Scenario {
     resonators.dedup_by_key(|r| r.site);
     let lo = resonators[0].site as i64 - 1;
     let hi = resonators[resonators.len() - 1].site as i64 + 1;
-    let impulse_site = half - 10 - (rng.uniform() * 30.0) as usize;
+    let impulse_site = half - 10 - (rng.uniform() * ranges.impulse_back) as usize;
+    let (v_lo, v_hi) = ranges.velocity;
+    let impulse_velocity = if ranges.log_velocity {
+        rng.log_uniform(v_lo, v_hi)
+    } else {
+        rng.uniform() * (v_hi - v_lo) + v_lo
+    };
     Scenario {
-        model: Model::new(n_sites, boundary, resonators).expect("a valid audit model"),
+        model: Model::new(n_sites, boundary, resonators).expect("a valid survey model"),
         impulse_site,
-        impulse_velocity: rng.uniform() * 1.5 + 0.5,
-        t_end: 100.0 + rng.uniform() * 100.0,
-        region: Region::new(lo, hi, n_sites).expect("a valid audit region"),
+        impulse_velocity,
+        t_end: ranges.t_end.0 + rng.uniform() * ranges.t_end.1,
+        region: Region::new(lo, hi, n_sites).expect("a valid survey region"),
         method: MethodChoice::Auto,
-        accuracy: tolerance(1e-8),
+        accuracy: tolerance(tol),
         sample_every: 1.0,
     }
+}
+
+/// One scene of `auto`'s audit (`woodpile-bench`'s `auto_audit`), drawn wider than any stage
+/// file from [`AUDIT_RANGES`]; `auto` at tolerance 1e-8.
+pub fn audit_scene(rng: &mut Lcg) -> Scenario {
+    random_scene(rng, &AUDIT_RANGES, 1e-8)
 }
 
 /// Scene `k` of the audit drawn with `seed` (the scenes before it are drawn and dropped).

@@ -308,11 +308,6 @@ impl<const S: usize> FixedStepScratch<S> {
     pub fn name(&self) -> &'static str {
         self.names[usize::from(self.contact.is_some())]
     }
-
-    /// Bonds whose contact changed state inside a step and were corrected (0 without events).
-    pub fn contact_events(&self) -> u64 {
-        self.contact.as_ref().map_or(0, ContactEvents::events)
-    }
 }
 
 /// Stage `stage`'s accelerations `acc` at positions `q`, recording every bond force into

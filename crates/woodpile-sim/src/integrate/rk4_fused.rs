@@ -51,11 +51,6 @@ impl Rk4Fused {
             a_stage: vec![0.0; n],
         }
     }
-
-    /// Bonds whose contact changed state inside a step and were corrected (0 for plain RK4).
-    pub fn contact_events(&self) -> u64 {
-        self.scratch.contact_events()
-    }
 }
 
 impl Stepper for Rk4Fused {

@@ -67,11 +67,6 @@ impl Rkn4 {
             a: std::array::from_fn(|_| vec![0.0; model.n_dof()]),
         }
     }
-
-    /// Bonds whose contact changed state inside a step and were corrected (0 for plain RKN4).
-    pub fn contact_events(&self) -> u64 {
-        self.scratch.contact_events()
-    }
 }
 
 impl Stepper for Rkn4 {
