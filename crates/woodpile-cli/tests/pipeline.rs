@@ -5,18 +5,14 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-const SWEEP: &str = r#"
-kind = "sweep"
-[axes]
-eps = [0.5, 1.0]
-[scene]
-chain = { n = 10 }
-impulse = { site = -5 }
-run = { t_end = 10.0, method = "rk4", dt = 0.02, sample_every = 5.0 }
-[[scene.defect]]
-site = 0
-eps = "$eps"
-"#;
+#[path = "../../woodpile-stages/tests/common/stage_files.rs"]
+mod stage_files;
+use stage_files::{sweep_file, FIGURE};
+
+/// A sweep over eps in {0.5, 1} on a chain of 21 sites, to t = 10.
+fn sweep() -> String {
+    sweep_file("eps = [0.5, 1.0]", 10, (10.0, 0.02, 5.0), &[(0, "$eps")])
+}
 
 fn woodpile(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_woodpile"))
@@ -33,7 +29,7 @@ fn text(bytes: &[u8]) -> String {
 fn project() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("pipeline")).unwrap();
-    std::fs::write(dir.path().join("pipeline/sweep.toml"), SWEEP).unwrap();
+    std::fs::write(dir.path().join("pipeline/sweep.toml"), sweep()).unwrap();
     dir
 }
 
@@ -61,7 +57,7 @@ fn run_status_and_diff_exit_codes() {
     // An edit makes the stage stale, and status says which parameter changed.
     std::fs::write(
         d.join("pipeline/sweep.toml"),
-        SWEEP.replace("dt = 0.02", "dt = 0.04"),
+        sweep().replace("dt = 0.02", "dt = 0.04"),
     )
     .unwrap();
     let status = woodpile(d, &["status"]);
@@ -99,7 +95,7 @@ fn bad_stage_files_and_unknown_stages_exit_2_naming_file_and_key() {
     assert!(text(&unknown.stderr).contains("no stage named `nope`"));
     std::fs::write(
         d.join("pipeline/sweep.toml"),
-        SWEEP.replace("[axes]", "[axes]\nfoo = \"x\""),
+        sweep().replace("[axes]", "[axes]\nfoo = \"x\""),
     )
     .unwrap();
     let bad = woodpile(d, &["status"]);
@@ -337,17 +333,6 @@ const REDUCE: &str = r#"
 kind = "reduce"
 inputs = ["sweep"]
 at = 10.0
-"#;
-
-const FIGURE: &str = r#"
-kind = "render"
-inputs = ["at_end"]
-title = "TITLE"
-[lines]
-x = "eps"
-y = ["R", "E_tr"]
-x_label = "eps"
-y_label = "fraction"
 "#;
 
 /// `kill -9` at spread-out moments of a render run for an edited title, then the edit

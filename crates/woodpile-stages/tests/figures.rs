@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{load_error, Counter, Project, REDUCE, SWEEP};
+use common::{load_error, single_defect_sweep_to, sweep_file, Counter, Project, REDUCE, SWEEP};
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, PipelineError};
@@ -144,10 +144,7 @@ paper = [0.5491, 0.0830, 0.0760]
 
 #[test]
 fn the_product_approximation_evaluates_the_fitted_forms() {
-    let single = SWEEP.replace("L = [0, 1]", "L = [0]").replace(
-        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
-        "eps = { from = 0.5, to = 4.0, step = 0.5 }",
-    );
+    let single = single_defect_sweep_to(4.0);
     let fits = r#"
 kind = "fit"
 inputs = ["single_at_end"]
@@ -163,22 +160,12 @@ y = "R"
 form = "tanh"
 start = [0.5, 0.5, 0.0]
 "#;
-    let pair = r#"
-kind = "sweep"
-[axes]
-eps1 = [1.0, 2.0]
-eps2 = [1.0, 2.0]
-[scene]
-chain = { n = 12 }
-impulse = { site = -6 }
-run = { t_end = 12.0, method = "rk4", dt = 0.02, sample_every = 2.0 }
-[[scene.defect]]
-site = 0
-eps = "$eps1"
-[[scene.defect]]
-site = 3
-eps = "$eps2"
-"#;
+    let pair = &sweep_file(
+        "eps1 = [1.0, 2.0]\neps2 = [1.0, 2.0]",
+        12,
+        (12.0, 0.02, 2.0),
+        &[(0, "$eps1"), (3, "$eps2")],
+    );
     let approx = r#"
 kind = "approximate"
 inputs = ["fits", "pair_at_end"]

@@ -7,7 +7,8 @@ use std::path::Path;
 use std::sync::atomic::Ordering;
 
 use common::{
-    load_error, Project, BEST, REDUCE, REPORT, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
+    design, load_error, single_defect_sweep_to, Project, BEST, REDUCE, REPORT, SWEEP,
+    WORK_PRECISION, WORK_PRECISION_CHART,
 };
 use woodpile_pipeline::layout::points_dir;
 use woodpile_pipeline::status::State;
@@ -15,10 +16,7 @@ use woodpile_pipeline::table;
 
 #[test]
 fn optimize_refines_a_grid_maximum_between_grid_points() {
-    let coarse = SWEEP.replace("L = [0, 1]", "L = [0]").replace(
-        "eps = { from = 0.5, to = 1.5, step = 0.5 }",
-        "eps = { from = 0.5, to = 3.0, step = 0.5 }",
-    );
+    let coarse = single_defect_sweep_to(3.0);
     let optimum = r#"
 kind = "optimize"
 inputs = ["at_end"]
@@ -173,25 +171,10 @@ fn work_precision_measures_error_against_the_reference() {
     assert_eq!(p.state("chart"), State::Fresh);
 }
 
-const DESIGN: &str = r#"
-kind = "design"
-seed = 7
-budget = 40
-refine = 10
-objective = "E_tr"
-verify_tolerance = 1e-8
-robustness = { samples = 6, spreads = [0.01, 0.05] }
-[scene]
-chain = { n = 12 }
-impulse = { site = -6 }
-run = { t_end = 12.0, method = "auto", tolerance = 1e-6 }
-fractions = { region = [-1, 4] }
-[space]
-resonators = [1, 2]
-sites = [0, 3]
-eps = { min = 0.1, max = 10.0, log = true }
-kappa = { min = 0.5, max = 2.0 }
-"#;
+/// The design these tests search: 40 trials, refined 10 times, the best verified at 1e-8.
+fn design_file() -> String {
+    design(40, 10, 1e-6, 1e-8, "samples = 6, spreads = [0.01, 0.05]")
+}
 
 fn count_files(dir: &Path) -> usize {
     std::fs::read_dir(dir)
@@ -218,7 +201,7 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
     let outputs: Vec<Vec<u8>> = [1, 2]
         .into_iter()
         .map(|threads| {
-            let p = Project::new(&[("trap", DESIGN)]);
+            let p = Project::new(&[("trap", &design_file())]);
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
@@ -244,7 +227,7 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
         "the search depends on the seed alone"
     );
 
-    let p = Project::new(&[("trap", DESIGN)]);
+    let p = Project::new(&[("trap", &design_file())]);
     p.counted(&[]);
     let table = table::read(&p.output("trap")).unwrap();
     let search = table::str_column(&table, "search").unwrap();

@@ -8,21 +8,10 @@ mod common;
 use std::path::Path;
 use woodpile_stages::KINDS;
 
-use common::{single_defect_sweep, Project, REDUCE};
+use common::{design, single_defect_sweep, sweep_file, Project, FIGURE, REDUCE};
 use woodpile_pipeline::events::Silent;
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, Pipeline};
-
-const FIGURE: &str = r#"
-kind = "render"
-inputs = ["at_end"]
-title = "TITLE"
-[lines]
-x = "eps"
-y = ["R", "E_tr"]
-x_label = "eps"
-y_label = "fraction"
-"#;
 
 const REPORT: &str = r#"
 kind = "report"
@@ -258,18 +247,12 @@ sites = [-5000000, 5000000]
 /// A figure may have at most 64 panels; a title is filled in once, in one pass, and bounded.
 #[test]
 fn panels_and_titles_are_bounded() {
-    let many = r#"
-kind = "sweep"
-[axes]
-eps = { from = 0.1, to = 10.0, step = 0.1 }
-[scene]
-chain = { n = 6 }
-impulse = { site = -3 }
-run = { t_end = 2.0, method = "rk4", dt = 0.05, sample_every = 1.0 }
-[[scene.defect]]
-site = 0
-eps = "$eps"
-"#;
+    let many = &sweep_file(
+        "eps = { from = 0.1, to = 10.0, step = 0.1 }",
+        6,
+        (2.0, 0.05, 1.0),
+        &[(0, "$eps")],
+    );
     let panels = r#"
 kind = "render"
 inputs = ["at_end"]
@@ -314,31 +297,14 @@ y_label = "E_tr"
     );
 }
 
-const DESIGN: &str = r#"
-kind = "design"
-seed = 7
-budget = 20
-refine = 4
-objective = "E_tr"
-verify_tolerance = 1e-7
-robustness = { samples = 2, spreads = [0.01] }
-[scene]
-chain = { n = 12 }
-impulse = { site = -6 }
-run = { t_end = 12.0, method = "auto", tolerance = 1e-5 }
-fractions = { region = [-1, 4] }
-[space]
-resonators = [1, 2]
-sites = [0, 3]
-eps = { min = 0.1, max = 10.0, log = true }
-kappa = { min = 0.5, max = 2.0 }
-"#;
-
 /// The best design's scene file is covered by the design stage's seal: an edit makes the
 /// stage stale, and a run writes the design it found again.
 #[test]
 fn an_edited_best_design_file_is_noticed() {
-    let p = Project::new(&[("trap", DESIGN)]);
+    let p = Project::new(&[(
+        "trap",
+        &design(20, 4, 1e-5, 1e-7, "samples = 2, spreads = [0.01]"),
+    )]);
     p.run(&[]).unwrap();
     let best = p.results().join("trap.best.toml");
     let found = std::fs::read_to_string(&best).unwrap();
