@@ -119,4 +119,5 @@ pub fn load_error(stages: &[(&str, &str)]) -> String {
 }
 
 mod stage_files;
+#[allow(unused_imports)] // each test file uses its own share of the fixtures
 pub use stage_files::*;
