@@ -313,36 +313,25 @@ z_label = "E_tr"
         .unwrap()
         .starts_with("read out at t = 10,"));
 
-    let e = load_error(&[
-        ("sweep", SWEEP),
-        ("at_end", REDUCE),
+    // Each edit of the composite, and what its load error must name.
+    let refused: [(&str, &str, &[&str]); 3] = [
         (
-            "both",
-            &composite.replace("{at_end.params.at}", "{other.params.at}"),
+            "{at_end.params.at}",
+            "{other.params.at}",
+            &["both.toml", "`title`", "other"],
         ),
-    ]);
-    assert!(
-        e.contains("both.toml") && e.contains("`title`") && e.contains("other"),
-        "{e}"
-    );
-    let e = load_error(&[
-        ("sweep", SWEEP),
-        ("at_end", REDUCE),
+        ("input = \"sweep\"", "input = \"nope\"", &["panel[1].input", "nope"]),
         (
-            "both",
-            &composite.replace("input = \"sweep\"", "input = \"nope\""),
+            "[[panel]]\ninput = \"sweep\"",
+            "[wrong]\ninput = \"sweep\"",
+            &["both.toml"],
         ),
-    ]);
-    assert!(e.contains("panel[1].input") && e.contains("nope"), "{e}");
-    let e = load_error(&[
-        ("sweep", SWEEP),
-        ("at_end", REDUCE),
-        (
-            "both",
-            &composite.replace("[[panel]]\ninput = \"sweep\"", "[wrong]\ninput = \"sweep\""),
-        ),
-    ]);
-    assert!(e.contains("both.toml"), "{e}");
+    ];
+    for (from, to, named) in refused {
+        let edited = composite.replace(from, to);
+        let e = load_error(&[("sweep", SWEEP), ("at_end", REDUCE), ("both", &edited)]);
+        assert!(named.iter().all(|n| e.contains(n)), "{from} -> {to}: {e}");
+    }
 }
 
 /// A fit that cannot converge is a row with its reason; the stages after it still run, the

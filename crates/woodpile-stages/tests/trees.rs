@@ -62,46 +62,35 @@ fn sharded_runs_merge_into_the_single_machine_result() {
     let sharded = Project::new(&[("sweep", SWEEP)]);
     let pipeline = sharded.load();
     let events = Counter::default();
-    for i in [0, 2] {
+    let shard = |i: usize, n: usize| {
         run_shard(
             &pipeline,
             "sweep",
-            Shard::new(i, 4).unwrap(),
+            Shard::new(i, n).unwrap(),
             &sharded.results(),
             &events,
         )
         .unwrap();
-    }
+    };
+    let merge_error = || {
+        merge(&pipeline, "sweep", &sharded.results(), &Counter::default())
+            .unwrap_err()
+            .to_string()
+    };
+    shard(0, 4);
+    shard(2, 4);
     // Incomplete: the error names the missing shards, and nothing is written.
-    let err = merge(&pipeline, "sweep", &sharded.results(), &Counter::default())
-        .unwrap_err()
-        .to_string();
+    let err = merge_error();
     assert!(err.contains("2 of 4 shard(s) missing (1, 3;"), "{err}");
     assert!(!sharded.output("sweep").exists());
     // A part made with another N is a mismatch, not a silent mix.
-    run_shard(
-        &pipeline,
-        "sweep",
-        Shard::new(0, 3).unwrap(),
-        &sharded.results(),
-        &events,
-    )
-    .unwrap();
-    let err = merge(&pipeline, "sweep", &sharded.results(), &Counter::default())
-        .unwrap_err()
-        .to_string();
+    shard(0, 3);
+    let err = merge_error();
     assert!(err.contains("different shard counts"), "{err}");
     std::fs::remove_dir_all(sharded.results().join("parts")).unwrap();
 
     for i in 0..4 {
-        run_shard(
-            &pipeline,
-            "sweep",
-            Shard::new(i, 4).unwrap(),
-            &sharded.results(),
-            &events,
-        )
-        .unwrap();
+        shard(i, 4);
     }
     // A shard re-run finds its part done and simulates nothing.
     let again = Counter::default();
