@@ -3,7 +3,7 @@
 //! non-finite value, unreadable file).
 #![allow(clippy::unwrap_used)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -21,12 +21,29 @@ fn scene_file(text: &str) -> PathBuf {
 
 fn simulate(text: &str) -> (Output, PathBuf) {
     let path = scene_file(text);
-    let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+    (simulate_file(&path), path)
+}
+
+fn simulate_file(path: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_woodpile"))
         .arg("simulate")
-        .arg(&path)
+        .arg(path)
         .output()
-        .unwrap();
-    (out, path)
+        .unwrap()
+}
+
+/// Asserts that `woodpile simulate path` is refused as bad input: exit 2, nothing on stdout,
+/// no panic, and a message naming each of `needles` (the file itself always).
+fn assert_refused(path: &Path, needles: &[&str]) {
+    let out = simulate_file(path);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let file = path.display().to_string();
+    assert_eq!(out.status.code(), Some(2), "{file}: {stderr}");
+    assert!(out.stdout.is_empty(), "{file}: printed a result");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in std::iter::once(file.as_str()).chain(needles.iter().copied()) {
+        assert!(stderr.contains(needle), "{stderr:?} lacks {needle:?}");
+    }
 }
 
 fn json_number(stdout: &str, key: &str) -> f64 {
@@ -159,33 +176,13 @@ fn bad_scenes_exit_nonzero_with_a_clear_message() {
         ("[[defect]\nsite = 0\n", "line 1", "TOML parse error"),
     ];
     for (text, key, reason) in cases {
-        let (out, path) = simulate(text);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{text:?}: {stderr}");
-        assert!(out.stdout.is_empty(), "{text:?}: printed a result");
-        let file = path.display().to_string();
-        for needle in [file.as_str(), key, reason] {
-            assert!(
-                stderr.contains(needle),
-                "{text:?}: {stderr:?} lacks {needle:?}"
-            );
-        }
-        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert_refused(&scene_file(text), &[key, reason]);
     }
 }
 
 #[test]
 fn unreadable_file_exits_nonzero() {
-    let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
-        .args(["simulate", "/nonexistent/scene.toml"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        stderr.contains("/nonexistent/scene.toml") && stderr.contains("cannot read"),
-        "{stderr}"
-    );
+    assert_refused(Path::new("/nonexistent/scene.toml"), &["cannot read"]);
 }
 
 /// A run that blows up is reported as a failure (exit 3), never as numbers.
@@ -211,28 +208,13 @@ fn blow_up_exits_3_without_numbers() {
 /// Inputs that are not files, or far too large, are refused before they are read.
 #[test]
 fn devices_and_oversized_files_are_refused_unread() {
-    let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
-        .args(["simulate", "/dev/zero"])
-        .output()
-        .unwrap();
-    assert_eq!(out.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        stderr.contains("/dev/zero") && stderr.contains("not a regular file"),
-        "{stderr}"
-    );
+    assert_refused(Path::new("/dev/zero"), &["not a regular file"]);
 
     let mut big = String::from("[chain]\nn = 100\n");
     while big.len() <= 2 << 20 {
         big.push_str("[[defect]]\nsite = 0\neps = 1.0\n");
     }
-    let (out, path) = simulate(&big);
-    assert_eq!(out.status.code(), Some(2));
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        stderr.contains(&*path.to_string_lossy()) && stderr.contains("bytes"),
-        "{stderr}"
-    );
+    assert_refused(&scene_file(&big), &["bytes"]);
 }
 
 /// Runs that could never finish are refused at once with the key and the estimate, and a
@@ -247,14 +229,7 @@ fn endless_runs_and_standing_impulses_exit_2_naming_the_key() {
         ("[[defect]]\nsite = 0\neps = 1e-300\n", "defect[0]"),
         ("[impulse]\nvelocity = 0.0\n", "impulse.velocity"),
     ] {
-        let (out, _) = simulate(scene);
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{scene}: {stderr}");
-        assert!(
-            stderr.contains(&format!("key `{key}`")),
-            "{scene}: {stderr}"
-        );
-        assert!(out.stdout.is_empty());
+        assert_refused(&scene_file(scene), &[&format!("key `{key}`")]);
     }
 }
 
