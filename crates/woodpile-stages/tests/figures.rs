@@ -320,7 +320,11 @@ z_label = "E_tr"
             "{other.params.at}",
             &["both.toml", "`title`", "other"],
         ),
-        ("input = \"sweep\"", "input = \"nope\"", &["panel[1].input", "nope"]),
+        (
+            "input = \"sweep\"",
+            "input = \"nope\"",
+            &["panel[1].input", "nope"],
+        ),
         (
             "[[panel]]\ninput = \"sweep\"",
             "[wrong]\ninput = \"sweep\"",
