@@ -80,39 +80,28 @@ pub enum Cell {
     I64List(Vec<i64>),
 }
 
-impl From<f64> for Cell {
-    fn from(x: f64) -> Self {
-        Cell::F64(Some(x))
-    }
+/// `Cell` from a value and from an optional one (`None` is the null cell), for each scalar
+/// kind.
+macro_rules! cell_from {
+    ($($t:ty => $variant:ident),*) => {$(
+        impl From<$t> for Cell {
+            fn from(x: $t) -> Self {
+                Cell::$variant(Some(x))
+            }
+        }
+        impl From<Option<$t>> for Cell {
+            fn from(x: Option<$t>) -> Self {
+                Cell::$variant(x)
+            }
+        }
+    )*};
 }
-impl From<Option<f64>> for Cell {
-    fn from(x: Option<f64>) -> Self {
-        Cell::F64(x)
-    }
-}
-impl From<i64> for Cell {
-    fn from(x: i64) -> Self {
-        Cell::I64(Some(x))
-    }
-}
-impl From<Option<i64>> for Cell {
-    fn from(x: Option<i64>) -> Self {
-        Cell::I64(x)
-    }
-}
-impl From<String> for Cell {
-    fn from(x: String) -> Self {
-        Cell::Str(Some(x))
-    }
-}
+
+cell_from!(f64 => F64, i64 => I64, String => Str);
+
 impl From<&str> for Cell {
     fn from(x: &str) -> Self {
         Cell::Str(Some(x.to_string()))
-    }
-}
-impl From<Option<String>> for Cell {
-    fn from(x: Option<String>) -> Self {
-        Cell::Str(x)
     }
 }
 

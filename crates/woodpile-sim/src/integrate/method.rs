@@ -3,7 +3,7 @@
 
 use super::{
     drive, ContactMode, Dop853, DriveConfig, Observer, Rk4Fused, Rkn, Rkn4, Stats, StepControl,
-    SymplecticStepper, DPRKN6, VERLET, YOSHIDA4, YOSHIDA6,
+    Stepper, SymplecticStepper, DPRKN6, VERLET, YOSHIDA4, YOSHIDA6,
 };
 use crate::error::SimError;
 use crate::model::Model;
@@ -404,57 +404,17 @@ impl Plan {
             energy_drift_limit: Some(self.drift_limit),
             active_window,
         };
+        // One dynamic call a step picks the stepper; its loops inside are static.
+        let mut run = |stepper: &mut dyn Stepper| drive(model, stepper, y, &cfg, observer);
         match self.method {
-            Method::Rk4 => drive(model, &mut Rk4Fused::new(model), y, &cfg, observer),
-            Method::Rk4Contact => drive(
-                model,
-                &mut Rk4Fused::with_contact_events(model),
-                y,
-                &cfg,
-                observer,
-            ),
-            Method::Rkn4Contact => drive(
-                model,
-                &mut Rkn4::with_contact_events(model),
-                y,
-                &cfg,
-                observer,
-            ),
-            Method::Rkn6Contact => drive(
-                model,
-                &mut Rkn::new(model, DPRKN6, ContactMode::Corrected),
-                y,
-                &cfg,
-                observer,
-            ),
-            Method::Verlet => drive(
-                model,
-                &mut SymplecticStepper::new(model, VERLET),
-                y,
-                &cfg,
-                observer,
-            ),
-            Method::Yoshida4 => drive(
-                model,
-                &mut SymplecticStepper::new(model, YOSHIDA4),
-                y,
-                &cfg,
-                observer,
-            ),
-            Method::Yoshida6 => drive(
-                model,
-                &mut SymplecticStepper::new(model, YOSHIDA6),
-                y,
-                &cfg,
-                observer,
-            ),
-            Method::Dop853 => drive(
-                model,
-                &mut Dop853::new(model, self.rtol, self.atol),
-                y,
-                &cfg,
-                observer,
-            ),
+            Method::Rk4 => run(&mut Rk4Fused::new(model)),
+            Method::Rk4Contact => run(&mut Rk4Fused::with_contact_events(model)),
+            Method::Rkn4Contact => run(&mut Rkn4::with_contact_events(model)),
+            Method::Rkn6Contact => run(&mut Rkn::new(model, DPRKN6, ContactMode::Corrected)),
+            Method::Verlet => run(&mut SymplecticStepper::new(model, VERLET)),
+            Method::Yoshida4 => run(&mut SymplecticStepper::new(model, YOSHIDA4)),
+            Method::Yoshida6 => run(&mut SymplecticStepper::new(model, YOSHIDA6)),
+            Method::Dop853 => run(&mut Dop853::new(model, self.rtol, self.atol)),
         }
     }
 }
