@@ -4,7 +4,10 @@
 
 mod common;
 
-use common::{load_error, single_defect_sweep_to, sweep_file, Counter, Project, REDUCE, SWEEP};
+use common::{
+    load_error, load_error_after_reduce, single_defect_sweep_to, sweep_file, Counter, Project,
+    REDUCE, SWEEP,
+};
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, PipelineError};
@@ -84,11 +87,7 @@ mark_max = true
         *p.counted(&[]).started.lock().unwrap(),
         vec!["map".to_string()]
     );
-    let e = load_error(&[
-        ("sweep", SWEEP),
-        ("at_end", REDUCE),
-        ("f", &figure.replace("[lines]", "[bars]")),
-    ]);
+    let e = load_error_after_reduce("f", &figure.replace("[lines]", "[bars]"));
     assert!(e.contains("f.toml") && e.contains("bars"), "{e}");
 }
 
@@ -134,11 +133,7 @@ paper = [0.5491, 0.0830, 0.0760]
         "LM beats any other coefficients"
     );
     assert!(col("se_A") > 0.0);
-    let e = load_error(&[
-        ("sweep", SWEEP),
-        ("at_end", REDUCE),
-        ("fit", &fit.replace("\"tanh\"", "\"cubic\"")),
-    ]);
+    let e = load_error_after_reduce("fit", &fit.replace("\"tanh\"", "\"cubic\""));
     assert!(e.contains("model[0].form") && e.contains("cubic"), "{e}");
 }
 
@@ -333,7 +328,7 @@ z_label = "E_tr"
     ];
     for (from, to, named) in refused {
         let edited = composite.replace(from, to);
-        let e = load_error(&[("sweep", SWEEP), ("at_end", REDUCE), ("both", &edited)]);
+        let e = load_error_after_reduce("both", &edited);
         assert!(named.iter().all(|n| e.contains(n)), "{from} -> {to}: {e}");
     }
 }

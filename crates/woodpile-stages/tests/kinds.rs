@@ -7,8 +7,8 @@ use std::path::Path;
 use std::sync::atomic::Ordering;
 
 use common::{
-    design, load_error, single_defect_sweep_to, Project, BEST, REDUCE, REPORT, SWEEP,
-    WORK_PRECISION, WORK_PRECISION_CHART,
+    design, load_error, load_error_after_reduce, single_defect_sweep_to, Project, BEST, REDUCE,
+    REPORT, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
 };
 use woodpile_pipeline::layout::points_dir;
 use woodpile_pipeline::status::State;
@@ -108,16 +108,10 @@ fn a_report_reads_and_scans_the_quoted_numbers() {
 
 #[test]
 fn a_report_source_must_be_an_input() {
-    let e = load_error(&[
-        ("sweep", SWEEP),
-        ("at_end", REDUCE),
-        (
-            "report",
-            &REPORT
-                .replace("PAPER", "0.1")
-                .replace("inputs = [\"sweep\", \"at_end\"]", "inputs = [\"sweep\"]"),
-        ),
-    ]);
+    let report = REPORT
+        .replace("PAPER", "0.1")
+        .replace("inputs = [\"sweep\", \"at_end\"]", "inputs = [\"sweep\"]");
+    let e = load_error_after_reduce("report", &report);
     assert!(
         e.contains("report.toml") && e.contains("quote[0].ours.stage") && e.contains("at_end"),
         "{e}"

@@ -110,6 +110,12 @@ impl Events for Counter {
     }
 }
 
+/// Why a project of [`SWEEP`], its reduction at the end (`at_end`) and the stage `name` of
+/// `text` does not load.
+pub fn load_error_after_reduce(name: &str, text: &str) -> String {
+    load_error(&[("sweep", SWEEP), ("at_end", REDUCE), (name, text)])
+}
+
 /// Why a project of these stage files does not load.
 pub fn load_error(stages: &[(&str, &str)]) -> String {
     let project = Project::new(stages);
