@@ -20,11 +20,10 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used, unsafe_code)]
 
 use std::time::Instant;
+use woodpile_bench::drive_fixed;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::{energy_density, Fractions};
-use woodpile_sim::integrate::{
-    drive, ContactMode, DriveConfig, Rkn, RknTableau, StepControl, DPRKN6,
-};
+use woodpile_sim::integrate::{ContactMode, Rkn, RknTableau, DPRKN6};
 use woodpile_sim::model::{Boundary, Coupling};
 use woodpile_sim::run::Scenario;
 use woodpile_stages::sampling::sampled_sweep_scenes;
@@ -284,28 +283,10 @@ fn fractions(scene: &Scenario, y: &[f64]) -> Fractions {
 
 /// One scalar run of `scene` by DPRKN6 in `mode` at `dt`, one sample interval; its state.
 fn scalar(scene: &Scenario, mode: ContactMode, dt: f64) -> Vec<f64> {
-    let model = &scene.model;
-    let mut y = model.rest_state();
-    model
-        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
-        .unwrap();
-    let cfg = DriveConfig {
-        t_end: scene.t_end,
-        sample_every: scene.t_end,
-        control: StepControl::Fixed { dt },
-        max_steps: 100_000_000,
-        energy_drift_limit: None,
-        active_window: true,
-    };
-    drive(
-        model,
-        &mut Rkn::new(model, DPRKN6, mode),
-        &mut y,
-        &cfg,
-        &mut (),
-    )
-    .unwrap();
-    y
+    let mut stepper = Rkn::new(&scene.model, DPRKN6, mode);
+    drive_fixed(scene, &mut stepper, (dt, scene.t_end), None)
+        .unwrap()
+        .0
 }
 
 /// Best of `passes` wall times of `work`, in ms.

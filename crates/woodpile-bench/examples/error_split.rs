@@ -16,12 +16,11 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use std::time::Instant;
-use woodpile_bench::{on_two_cores, standard_scene};
+use woodpile_bench::{drive_fixed, on_two_cores, standard_scene};
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{
-    drive, ContactMode, DriveConfig, Method, MethodChoice, Rk4Fused, Rkn, RknTableau, StepControl,
-    Stepper, DPRKN6, NYSTROM4,
+    ContactMode, Method, MethodChoice, Rk4Fused, Rkn, RknTableau, Stepper, DPRKN6, NYSTROM4,
 };
 use woodpile_sim::run::{simulate, Scenario};
 use woodpile_sim::testing::{fitted_order, fixed_dt, tolerance};
@@ -80,23 +79,17 @@ struct Run {
 }
 
 fn run(variant: Variant, scenario: &Scenario, dt: f64) -> Option<Run> {
-    let model = &scenario.model;
-    let mut y = model.rest_state();
-    model
-        .apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)
-        .unwrap();
-    let cfg = DriveConfig {
-        t_end: scenario.t_end,
-        sample_every: scenario.sample_every,
-        control: StepControl::Fixed { dt },
-        max_steps: 100_000_000,
-        energy_drift_limit: Some(1e-2),
-        active_window: true,
-    };
     let mut stepper = variant.stepper(scenario);
     let t0 = Instant::now();
-    let stats = drive(model, stepper.as_mut(), &mut y, &cfg, &mut ()).ok()?;
+    let (y, stats) = drive_fixed(
+        scenario,
+        stepper.as_mut(),
+        (dt, scenario.sample_every),
+        Some(1e-2),
+    )
+    .ok()?;
     let ms = t0.elapsed().as_secs_f64() * 1e3;
+    let model = &scenario.model;
     let mut density = vec![0.0; model.n_sites()];
     energy_density(model, scenario.t_end, &y, &mut density);
     Some(Run {

@@ -8,28 +8,13 @@
 
 use std::time::Instant;
 
-use woodpile_bench::fixed;
-use woodpile_sim::integrate::{
-    drive, ContactMode, DriveConfig, Method, Rkn, Rkn4, StepControl, Stepper, NYSTROM4,
-};
+use woodpile_bench::{drive_fixed, fixed};
+use woodpile_sim::integrate::{ContactMode, Method, Rkn, Rkn4, Stepper, NYSTROM4};
 
 fn run(stepper: &mut dyn Stepper) -> (f64, Vec<f64>) {
     let scene = fixed(Method::Rkn4Contact, 0.02);
-    let model = &scene.model;
-    let mut y = vec![0.0; model.state_len()];
-    model
-        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
-        .unwrap();
-    let cfg = DriveConfig {
-        t_end: scene.t_end,
-        sample_every: 1.0,
-        control: StepControl::Fixed { dt: 0.02 },
-        max_steps: 10_000_000,
-        energy_drift_limit: None,
-        active_window: true,
-    };
     let start = Instant::now();
-    drive(model, stepper, &mut y, &cfg, &mut ()).unwrap();
+    let (y, _) = drive_fixed(&scene, stepper, (0.02, 1.0), None).unwrap();
     (start.elapsed().as_secs_f64() * 1e3, y)
 }
 

@@ -5,7 +5,9 @@
 
 pub mod paper;
 
-use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
+use woodpile_sim::integrate::{
+    drive, Accuracy, DriveConfig, Method, MethodChoice, Stats, StepControl, Stepper,
+};
 use woodpile_sim::run::{simulate, Outcome, Scenario};
 use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
 use woodpile_sim::SimError;
@@ -23,6 +25,31 @@ pub fn fixed(method: Method, dt: f64) -> Scenario {
 /// Simulates `scenario` without observers.
 pub fn run(scenario: &Scenario) -> Result<Outcome, SimError> {
     simulate(scenario, &mut ())
+}
+
+/// `scene` from its impulse to its end by `stepper` at the fixed step `dt`, on the active
+/// window, observed every `sample_every` and stopped when the energy drifts by more than
+/// `drift_limit`: the final state `[q, q']` and the run's stats. For the examples that compare
+/// steppers `Plan` does not offer (plain contact treatments, batched lanes).
+pub fn drive_fixed(
+    scene: &Scenario,
+    stepper: &mut dyn Stepper,
+    (dt, sample_every): (f64, f64),
+    drift_limit: Option<f64>,
+) -> Result<(Vec<f64>, Stats), SimError> {
+    let model = &scene.model;
+    let mut y = model.rest_state();
+    model.apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)?;
+    let cfg = DriveConfig {
+        t_end: scene.t_end,
+        sample_every,
+        control: StepControl::Fixed { dt },
+        max_steps: 100_000_000,
+        energy_drift_limit: drift_limit,
+        active_window: true,
+    };
+    let stats = drive(model, stepper, &mut y, &cfg, &mut ())?;
+    Ok((y, stats))
 }
 
 /// `work` applied to every item on two threads (this machine's two cores), results in the
