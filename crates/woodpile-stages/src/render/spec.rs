@@ -149,15 +149,16 @@ pub(super) fn parse_panel(
             let mut f = f.nested("lines", t);
             panel_title = f.optional::<String>("panel_title")?;
             let styles = parse_series_styles(&mut f)?;
+            let (x, panels, x_label, y_label) = shared_axes(&mut f)?;
             let plot = Plot::Lines {
                 styles,
-                x: f.required("x")?,
+                x,
                 y: f.required("y")?,
-                panels: f.optional("panels")?,
+                panels,
                 series: f.optional("series")?,
                 series_label: f.optional("series_label")?,
-                x_label: f.required("x_label")?,
-                y_label: f.required("y_label")?,
+                x_label,
+                y_label,
             };
             if let Plot::Lines {
                 y,
@@ -198,16 +199,17 @@ pub(super) fn parse_panel(
                 }
             };
             let z_range = parse_z_range(&mut f, &colours)?;
+            let (x, panels, x_label, y_label) = shared_axes(&mut f)?;
             let plot = Plot::Heatmap {
                 overlays,
                 colours,
                 z_range,
-                x: f.required("x")?,
+                x,
                 y: f.required("y")?,
                 z: f.required("z")?,
-                panels: f.optional("panels")?,
-                x_label: f.required("x_label")?,
-                y_label: f.required("y_label")?,
+                panels,
+                x_label,
+                y_label,
                 z_label: f.required("z_label")?,
                 mark_max,
             };
@@ -243,6 +245,17 @@ pub(super) fn parse_panel(
 }
 
 /// `x_scale = "linear" | "log"`.
+/// The keys a line plot and a heat map share: the x column, the column that splits panels,
+/// and the axis labels.
+fn shared_axes(f: &mut Fields<'_>) -> Result<(String, Option<String>, String, String)> {
+    Ok((
+        f.required("x")?,
+        f.optional("panels")?,
+        f.required("x_label")?,
+        f.required("y_label")?,
+    ))
+}
+
 fn scale_key(f: &mut Fields<'_>, key: &str) -> Result<Scale> {
     match f.optional::<String>(key)?.as_deref() {
         None | Some("linear") => Ok(Scale::Linear),
