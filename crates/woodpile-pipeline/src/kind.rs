@@ -54,6 +54,18 @@ pub trait Kind: std::fmt::Debug + Send + Sync + Any {
     }
 }
 
+/// Where a grid's points are computed: for which stage (named in events and warnings), with
+/// which point cache, and whom to tell of progress.
+#[derive(Clone, Copy)]
+pub struct PointsAt<'a> {
+    /// The stage's name.
+    pub stage: &'a str,
+    /// The point cache the points are loaded from and saved to.
+    pub store: &'a PointStore,
+    /// Progress and warnings.
+    pub events: &'a dyn Events,
+}
+
 /// A kind whose table is a block of rows per point of a grid, each point computed on its own
 /// and cached in the [`PointStore`].
 pub trait PointGrid {
@@ -63,15 +75,9 @@ pub trait PointGrid {
     /// How many of them `store` already holds.
     fn cached(&self, store: &PointStore) -> Result<usize>;
 
-    /// Computes what `store` lacks among the points `indices` (increasing) and returns their
+    /// Computes what the store lacks among the points `indices` (increasing) and returns their
     /// rows (with a `point` column) and statistics: the whole table, or one shard's part.
-    fn run_points(
-        &self,
-        stage: &str,
-        store: &PointStore,
-        events: &dyn Events,
-        indices: &[usize],
-    ) -> Result<(DataFrame, PointStats)>;
+    fn run_points(&self, at: PointsAt<'_>, indices: &[usize]) -> Result<(DataFrame, PointStats)>;
 
     /// The manifest summary of the whole grid, given the statistics of all its points.
     fn summary(&self, stats: &PointStats) -> Result<serde_json::Value>;

@@ -15,7 +15,7 @@ use serde_json::json;
 
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
-use crate::kind::PointGrid;
+use crate::kind::{PointGrid, PointsAt};
 use crate::layout::{output_path, parts_dir, points_dir};
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
@@ -169,7 +169,12 @@ pub fn run_shard(
     store.sweep_stale_temps();
     crate::atomic::sweep_stale_temps(&parts_dir(results, name));
     events.stage_started(name, &format!("shard {shard}"));
-    let (frame, stats) = sweep.run_points(name, &store, events, &indices)?;
+    let at = PointsAt {
+        stage: name,
+        store: &store,
+        events,
+    };
+    let (frame, stats) = sweep.run_points(at, &indices)?;
     let manifest = manifest_for(
         pipeline,
         stage,

@@ -38,7 +38,7 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{parse_axes, point, point_count, Axis, AxisValue};
-use woodpile_pipeline::kind::{Context, Kind, PointGrid};
+use woodpile_pipeline::kind::{Context, Kind, PointGrid, PointsAt};
 use woodpile_pipeline::points::{
     point_key, PointData, PointResult, PointStats, PointStore, Series,
 };
@@ -182,7 +182,12 @@ impl Sweep {
         events: &dyn Events,
     ) -> Result<Output> {
         let all: Vec<usize> = (0..self.count()).collect();
-        let (frame, stats) = self.run_points(stage, store, events, &all)?;
+        let at = PointsAt {
+            stage,
+            store,
+            events,
+        };
+        let (frame, stats) = self.run_points(at, &all)?;
         Ok(Output {
             failures: Vec::new(),
             frame,
@@ -286,13 +291,12 @@ impl PointGrid for Sweep {
 
     /// Simulates what `store` lacks among the points `indices` (increasing) and assembles
     /// their rows: the whole output, or one shard's part of it.
-    fn run_points(
-        &self,
-        stage: &str,
-        store: &PointStore,
-        events: &dyn Events,
-        indices: &[usize],
-    ) -> Result<(DataFrame, PointStats)> {
+    fn run_points(&self, at: PointsAt<'_>, indices: &[usize]) -> Result<(DataFrame, PointStats)> {
+        let PointsAt {
+            stage,
+            store,
+            events,
+        } = at;
         let points = self.points_at(indices)?;
         let mut results: Vec<Option<PointResult>> =
             points.par_iter().map(|(k, _)| store.load(k)).collect();

@@ -22,8 +22,9 @@ use woodpile_stages::KINDS;
 fn definition_errors_name_the_file_and_key() {
     let sweep = |from: &str, to: &str| SWEEP.replace(from, to);
     let with_table = format!("{SWEEP}\n[scene.chain2]\nn = 3");
-    // Each project that must not load, and what its error must name.
-    let projects: Vec<(Vec<(&str, String)>, &[&str])> = vec![
+    // Each project that must not load (its stage files), and what its error must name.
+    type Refused<'a> = (Vec<(&'a str, String)>, &'a [&'a str]);
+    let projects: Vec<Refused> = vec![
         (
             vec![(
                 "sweep",
