@@ -99,6 +99,12 @@ pub enum Sharing {
 /// The outcome of [`Kind::check_inputs`]: `Err((key, reason))`.
 pub type KindCheck = std::result::Result<(), (String, String)>;
 
+/// The [`KindCheck`] failure of a stage whose `inputs` are not what its kind reads: `why`
+/// says what it reads.
+pub fn wrong_inputs(why: impl Into<String>) -> KindCheck {
+    Err(("inputs".into(), why.into()))
+}
+
 /// Parses a kind's keys; `inputs` are the stage's inputs.
 pub type Parse = fn(&mut Fields<'_>, &[String]) -> Result<Arc<dyn Kind>>;
 
@@ -133,10 +139,7 @@ impl Inputs<'_> {
 pub fn no_inputs(stage: &Stage) -> KindCheck {
     match stage.inputs.is_empty() {
         true => Ok(()),
-        false => Err((
-            "inputs".into(),
-            format!("a {} stage reads no other stage", stage.kind),
-        )),
+        false => wrong_inputs(format!("a {} stage reads no other stage", stage.kind)),
     }
 }
 
@@ -222,4 +225,15 @@ pub struct Output {
     /// quote that could not be read): recorded in the table, and the run ends non-zero
     /// naming them.
     pub failures: Vec<String>,
+}
+
+impl Output {
+    /// A table and its manifest summary, with nothing failed inside the stage.
+    pub fn table(frame: polars::prelude::DataFrame, summary: serde_json::Value) -> Output {
+        Output {
+            frame,
+            summary,
+            failures: Vec::new(),
+        }
+    }
 }

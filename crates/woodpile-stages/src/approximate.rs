@@ -25,7 +25,7 @@ use woodpile_analysis::lm::Form;
 use woodpile_analysis::product::{errors, product, Fitted};
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, str_column, Columns};
 use woodpile_pipeline::Output;
@@ -131,11 +131,7 @@ impl Approximate {
             .f64("approx_paper", paper)
             .f64("error", error)
             .i64("on_diagonal", diagonal);
-        Ok(Output {
-            failures: Vec::new(),
-            frame: columns.into_frame()?,
-            summary,
-        })
+        Ok(Output::table(columns.into_frame()?, summary))
     }
 }
 
@@ -178,10 +174,7 @@ impl Kind for Approximate {
             {
                 Ok(())
             }
-            _ => Err((
-                "inputs".into(),
-                "expected [a fit stage, a reduce stage]".into(),
-            )),
+            _ => wrong_inputs("expected [a fit stage, a reduce stage]"),
         }
     }
 

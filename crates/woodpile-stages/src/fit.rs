@@ -26,7 +26,7 @@ use serde_json::json;
 use woodpile_analysis::lm::{fit, Fit, Form};
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::{Ends, Fields};
-use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, matching_rows, rows_frame, Cell, Match, Row};
 use woodpile_pipeline::Output;
@@ -221,10 +221,7 @@ impl Row for ModelRow<'_> {
 impl Kind for FitStage {
     fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
         let [input] = stage.inputs.as_slice() else {
-            return Err((
-                "inputs".into(),
-                "a fit stage reads exactly one table".into(),
-            ));
+            return wrong_inputs("a fit stage reads exactly one table");
         };
         match inputs.get::<crate::render::Render>(input) {
             Some(_) => Err((

@@ -320,10 +320,9 @@ impl Optimize {
             .map(|r| value_of(&r.outcome))
             .unwrap_or(f64::NAN);
         let frame = self.frame(&rows, sweep, &searched)?;
-        Ok(Output {
-            failures: Vec::new(),
+        Ok(Output::table(
             frame,
-            summary: json!({
+            json!({
                 "grid": grid_first,
                 "refined": best_value,
                 "gain": best_value - grid_first,
@@ -338,7 +337,7 @@ impl Optimize {
                 "best_error_estimate": best.outcome.error_estimate,
                 "best_file": path.file_name().map(|n| n.to_string_lossy().into_owned()),
             }),
-        })
+        ))
     }
 
     fn frame(

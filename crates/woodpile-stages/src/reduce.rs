@@ -19,7 +19,7 @@ use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::Axis;
-use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row};
 use woodpile_pipeline::Output;
@@ -101,11 +101,10 @@ impl Reduce {
         };
         let reduced: Vec<Reduced> = rows.iter().map(|pick| Reduced { axes, pick }).collect();
         let failed: usize = rows.iter().map(|p| p.failed).sum();
-        Ok(Output {
-            failures: Vec::new(),
-            frame: rows_frame(&reduced)?,
-            summary: json!({"rows": rows.len(), "failed_points": failed, "at": self.at}),
-        })
+        Ok(Output::table(
+            rows_frame(&reduced)?,
+            json!({"rows": rows.len(), "failed_points": failed, "at": self.at}),
+        ))
     }
 }
 
@@ -306,10 +305,7 @@ fn maximize(picks: &[Pick], axes: &[Axis], m: &Maximize) -> Vec<Pick> {
 impl Kind for Reduce {
     fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
         let [input] = stage.inputs.as_slice() else {
-            return Err((
-                "inputs".into(),
-                "a reduce stage reads exactly one sweep".into(),
-            ));
+            return wrong_inputs("a reduce stage reads exactly one sweep");
         };
         match inputs.get::<Sweep>(input) {
             Some(sweep) => self

@@ -36,7 +36,7 @@ use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{Axis, AxisValue};
-use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{no_inputs, wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::Columns;
 use woodpile_pipeline::Output;
@@ -212,16 +212,15 @@ impl SpaceTime {
             .f64("t", t)
             .i64("site", site)
             .f64("velocity", velocity);
-        Ok(Output {
-            failures: Vec::new(),
-            frame: columns.into_frame()?,
-            summary: json!({
+        Ok(Output::table(
+            columns.into_frame()?,
+            json!({
                 "points": points,
                 "sites": self.sites,
                 "tolerance": tolerance,
                 "max_error_estimate": max_error_estimate,
             }),
-        })
+        ))
     }
 }
 
@@ -250,11 +249,8 @@ impl Kind for SpaceTime {
             [input] if input == design && inputs.get::<crate::design::Design>(input).is_some() => {
                 Ok(())
             }
-            _ => Err((
-                "inputs".into(),
-                format!(
-                    "a spacetime stage of `design = \"{design}\"` reads exactly that design stage"
-                ),
+            _ => wrong_inputs(format!(
+                "a spacetime stage of `design = \"{design}\"` reads exactly that design stage"
             )),
         }
     }

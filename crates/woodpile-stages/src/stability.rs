@@ -291,11 +291,7 @@ impl Stability {
         .i64("status", runs.iter().map(|r| Some(r.status)).collect())
         .f64("error", runs.iter().map(|r| r.error).collect())
         .str("failure", runs.iter().map(|r| r.failure.clone()).collect());
-        Ok(Output {
-            failures: Vec::new(),
-            frame: c.into_frame()?,
-            summary,
-        })
+        Ok(Output::table(c.into_frame()?, summary))
     }
 }
 

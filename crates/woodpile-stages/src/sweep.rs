@@ -188,11 +188,7 @@ impl Sweep {
             events,
         };
         let (frame, stats) = self.run_points(at, &all)?;
-        Ok(Output {
-            failures: Vec::new(),
-            frame,
-            summary: self.summary(&stats)?,
-        })
+        Ok(Output::table(frame, self.summary(&stats)?))
     }
 
     /// The output rows of the points `indices`: one per sample of each point, or one with the

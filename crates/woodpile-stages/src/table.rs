@@ -23,7 +23,7 @@ use serde_json::json;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{matching_rows, missing_column, Match};
 use woodpile_pipeline::{layout, Output};
@@ -78,15 +78,12 @@ impl Table {
         let frame = self.select(input).map_err(fail)?;
         let text = csv(&frame).map_err(fail)?;
         woodpile_pipeline::atomic::write(&csv_path(results, stage), text.as_bytes())?;
-        Ok(Output {
-            summary: json!({
-                "rows": frame.height(),
-                "columns": frame.get_column_names().iter().map(|c| c.to_string()).collect::<Vec<_>>(),
-                "csv": format!("{stage}.csv"),
-            }),
-            frame,
-            failures: Vec::new(),
-        })
+        let summary = json!({
+            "rows": frame.height(),
+            "columns": frame.get_column_names().iter().map(|c| c.to_string()).collect::<Vec<_>>(),
+            "csv": format!("{stage}.csv"),
+        });
+        Ok(Output::table(frame, summary))
     }
 }
 
@@ -147,10 +144,7 @@ impl Kind for Table {
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
         match stage.inputs.len() {
             1 => Ok(()),
-            _ => Err((
-                "inputs".into(),
-                "a table stage reads exactly one stage".into(),
-            )),
+            _ => wrong_inputs("a table stage reads exactly one stage"),
         }
     }
 

@@ -199,17 +199,16 @@ impl WorkPrecision {
                 }
             }
         }
-        Ok(Output {
-            failures: Vec::new(),
-            frame: rows_frame(&rows)?,
-            summary: json!({
+        Ok(Output::table(
+            rows_frame(&rows)?,
+            json!({
                 "reference": {"method": "dop853", "tolerance": self.reference_tolerance},
                 "references": references,
                 "repeats": self.repeats,
                 "machine": machine(),
                 "runs": self.scenes.len() * self.settings.len() * self.repeats,
             }),
-        })
+        ))
     }
 }
 

@@ -342,9 +342,9 @@ impl Design {
         let refined = self.best_of(&rows, Search::Refinement);
         let refined_random = self.best_of(&rows, Search::RefinementOfRandom);
         let frame = self.frame(&rows)?;
-        Ok(Output {
+        Ok(Output::table(
             frame,
-            summary: json!({
+            json!({
                 "objective": self.objective_name(),
                 "goal": if self.maximise { "max" } else { "min" },
                 "evaluations": rows.len(),
@@ -362,8 +362,7 @@ impl Design {
                 "verify_tolerance": self.verify_tolerance,
                 "best_file": best_file.file_name().map(|n| n.to_string_lossy().into_owned()),
             }),
-            failures: Vec::new(),
-        })
+        ))
     }
 
     /// Nelder–Mead from `start` (score `score`) on the eps and kappa genes of its resonators,

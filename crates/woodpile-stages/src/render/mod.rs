@@ -112,7 +112,7 @@ use woodpile_plot::{Figure, Panel};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::Output;
@@ -290,10 +290,9 @@ impl Render {
         let drawn = figure.draw().map_err(drawing)?;
         woodpile_pipeline::atomic::write(&png, &drawn.png)?;
         woodpile_pipeline::atomic::write(&svg, drawn.svg.as_bytes())?;
-        Ok(Output {
-            failures: Vec::new(),
+        Ok(Output::table(
             frame,
-            summary: json!({
+            json!({
                 "figures": [format!("{stage}.png"), format!("{stage}.svg")],
                 "panels": figure.panels.len(),
                 "title": figure.title,
@@ -302,7 +301,7 @@ impl Render {
                 "font_pt": figure.style.font_pt,
                 "legend_covers_points": drawn.legend_covers,
             }),
-        })
+        ))
     }
 }
 
@@ -327,10 +326,7 @@ fn share_colour_scale(panels: &mut [Panel]) {
 impl Kind for Render {
     fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
         if stage.inputs.is_empty() {
-            return Err((
-                "inputs".into(),
-                "a render stage reads one or more tables".into(),
-            ));
+            return wrong_inputs("a render stage reads one or more tables");
         }
         match stage
             .inputs

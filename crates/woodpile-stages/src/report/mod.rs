@@ -40,7 +40,7 @@ use serde_json::json;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::layout::output_path;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{self, rows_frame, Cell, Row};
@@ -381,10 +381,7 @@ impl Row for QuoteRow<'_> {
 impl Kind for Report {
     fn check_inputs(&self, stage: &Stage, _: &Inputs<'_>) -> KindCheck {
         if stage.inputs.is_empty() {
-            return Err((
-                "inputs".into(),
-                "a report reads the stages its quotes name".into(),
-            ));
+            return wrong_inputs("a report reads the stages its quotes name");
         }
         for (key, source) in self.sources() {
             if !stage.inputs.contains(&source.stage) {
