@@ -176,14 +176,45 @@ pub trait FromToml: Sized {
     fn from_toml(value: toml::Value) -> Option<Self>;
 }
 
-impl FromToml for String {
-    const EXPECTED: &'static str = "a string";
-    fn from_toml(value: toml::Value) -> Option<Self> {
-        match value {
-            toml::Value::String(s) => Some(s),
-            _ => None,
+/// `FromToml` for the types that are one TOML variant as it is.
+macro_rules! from_toml_variant {
+    ($($t:ty => $variant:ident, $expected:literal;)*) => {$(
+        impl FromToml for $t {
+            const EXPECTED: &'static str = $expected;
+            fn from_toml(value: toml::Value) -> Option<Self> {
+                match value {
+                    toml::Value::$variant(x) => Some(x),
+                    _ => None,
+                }
+            }
         }
-    }
+    )*};
+}
+
+from_toml_variant! {
+    String => String, "a string";
+    i64 => Integer, "an integer";
+    toml::Table => Table, "a table";
+}
+
+/// `FromToml` for arrays whose every item reads as the element type.
+macro_rules! from_toml_array {
+    ($($t:ty, $expected:literal;)*) => {$(
+        impl FromToml for Vec<$t> {
+            const EXPECTED: &'static str = $expected;
+            fn from_toml(value: toml::Value) -> Option<Self> {
+                match value {
+                    toml::Value::Array(items) => items.into_iter().map(<$t>::from_toml).collect(),
+                    _ => None,
+                }
+            }
+        }
+    )*};
+}
+
+from_toml_array! {
+    String, "an array of strings";
+    f64, "an array of numbers";
 }
 
 impl FromToml for f64 {
@@ -192,46 +223,6 @@ impl FromToml for f64 {
         match value {
             toml::Value::Float(x) if x.is_finite() => Some(x),
             toml::Value::Integer(i) => Some(i as f64),
-            _ => None,
-        }
-    }
-}
-
-impl FromToml for i64 {
-    const EXPECTED: &'static str = "an integer";
-    fn from_toml(value: toml::Value) -> Option<Self> {
-        match value {
-            toml::Value::Integer(i) => Some(i),
-            _ => None,
-        }
-    }
-}
-
-impl FromToml for Vec<String> {
-    const EXPECTED: &'static str = "an array of strings";
-    fn from_toml(value: toml::Value) -> Option<Self> {
-        match value {
-            toml::Value::Array(items) => items.into_iter().map(String::from_toml).collect(),
-            _ => None,
-        }
-    }
-}
-
-impl FromToml for Vec<f64> {
-    const EXPECTED: &'static str = "an array of numbers";
-    fn from_toml(value: toml::Value) -> Option<Self> {
-        match value {
-            toml::Value::Array(items) => items.into_iter().map(f64::from_toml).collect(),
-            _ => None,
-        }
-    }
-}
-
-impl FromToml for toml::Table {
-    const EXPECTED: &'static str = "a table";
-    fn from_toml(value: toml::Value) -> Option<Self> {
-        match value {
-            toml::Value::Table(t) => Some(t),
             _ => None,
         }
     }

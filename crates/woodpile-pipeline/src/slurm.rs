@@ -104,41 +104,52 @@ impl SlurmJob<'_> {
 
     /// The array job: task I computes shard I/N.
     pub fn array_script(&self) -> String {
-        let mut s = self.header(
-            &format!("woodpile-{}", self.stage),
-            &format!("{}-%A_%a.out", self.stage),
-        );
-        s += &format!("#SBATCH --array=0-{}\n", self.tasks.saturating_sub(1));
-        s += &format!(
-            "# Shard I of {} of sweep `{}`; re-running a task skips its finished points.\n",
-            self.tasks, self.stage
-        );
-        s += &self.common();
-        s += &format!(
-            "exec {} run {} --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\" {}\n",
-            quote(self.binary),
-            self.stage,
-            self.tasks,
-            self.locations()
-        );
-        s
+        self.script(
+            ("", "%A_%a"),
+            &format!("#SBATCH --array=0-{}\n", self.tasks.saturating_sub(1)),
+            &format!(
+                "Shard I of {} of sweep `{}`; re-running a task skips its finished points.",
+                self.tasks, self.stage
+            ),
+            &format!(
+                "run {} --shard \"${{SLURM_ARRAY_TASK_ID}}/{}\"",
+                self.stage, self.tasks
+            ),
+        )
     }
 
     /// The merge job (submitted with `--dependency=afterok:<array job id>`).
     pub fn merge_script(&self) -> String {
+        self.script(
+            ("-merge", "merge-%j"),
+            "",
+            &format!(
+                "Joins the {} parts of `{}` into its result; refuses an incomplete set.",
+                self.tasks, self.stage
+            ),
+            &format!("merge {}", self.stage),
+        )
+    }
+
+    /// A job script: named `woodpile-STAGE{suffix}`, logging to `STAGE-{log}.out`, with the
+    /// extra `#SBATCH` lines `directives`, a `comment`, and `woodpile {command}` as its work.
+    fn script(
+        &self,
+        (suffix, log): (&str, &str),
+        directives: &str,
+        comment: &str,
+        command: &str,
+    ) -> String {
         let mut s = self.header(
-            &format!("woodpile-{}-merge", self.stage),
-            &format!("{}-merge-%j.out", self.stage),
+            &format!("woodpile-{}{suffix}", self.stage),
+            &format!("{}-{log}.out", self.stage),
         );
-        s += &format!(
-            "# Joins the {} parts of `{}` into its result; refuses an incomplete set.\n",
-            self.tasks, self.stage
-        );
+        s += directives;
+        s += &format!("# {comment}\n");
         s += &self.common();
         s += &format!(
-            "exec {} merge {} {}\n",
+            "exec {} {command} {}\n",
             quote(self.binary),
-            self.stage,
             self.locations()
         );
         s
