@@ -159,16 +159,11 @@ pub fn total_momentum(model: &Model, y: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Coupling, Resonator};
+    use crate::model::Resonator;
 
     #[test]
     fn density_sums_to_total_energy() {
-        let res = vec![Resonator {
-            site: 2,
-            eps: 3.0,
-            coupling: Coupling::Constant(0.8),
-            p: 3,
-        }];
+        let res = vec![Resonator::constant(2, 3.0, 0.8, 3)];
         let model = Model::new(5, Boundary::Fixed, res).unwrap();
         let y = vec![
             -0.1, 0.2, 0.1, 0.05, 0.3, -0.2, 0.5, -1.0, 0.3, 0.2, 0.1, 0.7,

@@ -174,24 +174,14 @@ impl Model {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Coupling, Resonator};
+    use crate::model::Resonator;
 
     /// The force is minus the gradient of the potential energy: check by central differences.
     #[test]
     fn force_is_minus_gradient_of_potential() {
         let res = vec![
-            Resonator {
-                site: 1,
-                eps: 0.7,
-                coupling: Coupling::Constant(1.3),
-                p: 1,
-            },
-            Resonator {
-                site: 2,
-                eps: 2.0,
-                coupling: Coupling::Constant(0.4),
-                p: 3,
-            },
+            Resonator::constant(1, 0.7, 1.3, 1),
+            Resonator::constant(2, 2.0, 0.4, 3),
         ];
         let masses = Some(vec![1.0, 2.0, 0.5, 1.5]);
         let model = Model::with_masses(4, Boundary::Fixed, res, masses).unwrap();

@@ -83,6 +83,17 @@ pub struct Resonator {
 }
 
 impl Resonator {
+    /// A resonator at `site` of mass ratio `eps`, coupled with the constant strength `kappa`
+    /// and exponent `p`.
+    pub fn constant(site: usize, eps: f64, kappa: f64, p: u32) -> Resonator {
+        Resonator {
+            site,
+            eps,
+            coupling: Coupling::Constant(kappa),
+            p,
+        }
+    }
+
     /// Linear angular frequency of the host (mass `host_mass`) and resonator pair vibrating
     /// against each other: omega^2 = kappa (1/m + 1/eps), at the largest kappa the coupling takes.
     /// For p > 1 this is the frequency at unit stretch, a scale rather than a constant.
@@ -325,12 +336,7 @@ mod tests {
     use super::*;
 
     fn res(site: usize, eps: f64, p: u32) -> Resonator {
-        Resonator {
-            site,
-            eps,
-            coupling: Coupling::Constant(1.0),
-            p,
-        }
+        Resonator::constant(site, eps, 1.0, p)
     }
 
     #[test]

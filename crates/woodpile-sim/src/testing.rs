@@ -28,12 +28,7 @@ pub fn paper_site(n: i64, half_width: usize) -> usize {
 /// starts with the resonator displaced by `x0` and everything at rest. Returns the model, the
 /// state, and the angular frequency of the relative coordinate u - v.
 pub fn linear_oscillator(eps: f64, kappa: f64, x0: f64) -> (Model, Vec<f64>, f64) {
-    let res = vec![Resonator {
-        site: 0,
-        eps,
-        coupling: Coupling::Constant(kappa),
-        p: 1,
-    }];
+    let res = vec![Resonator::constant(0, eps, kappa, 1)];
     let model = Model::new(1, Boundary::Free, res).expect("valid oscillator");
     let mut y = model.rest_state();
     y[1] = x0;

@@ -12,12 +12,7 @@ use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
 
 fn linear(site: usize, eps: f64, kappa: f64) -> Resonator {
-    Resonator {
-        site,
-        eps,
-        coupling: Coupling::Constant(kappa),
-        p: 1,
-    }
+    Resonator::constant(site, eps, kappa, 1)
 }
 
 /// Scenes covering what the window must respect: walls, free ends, two defects, a nonlinear

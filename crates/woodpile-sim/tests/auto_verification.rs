@@ -119,12 +119,7 @@ fn auto_does_not_accept_a_pair_on_an_error_plateau() {
             coupling: ramp(2.6810316232832903, 45.63277177607065, 1.0667503192452776),
             p: 3,
         },
-        Resonator {
-            site: 130,
-            eps: 93.09645542646219,
-            coupling: Coupling::Constant(0.8957921281524939),
-            p: 1,
-        },
+        Resonator::constant(130, 93.09645542646219, 0.8957921281524939, 1),
     ];
     let model = Model::new(207, Boundary::Fixed, resonators).unwrap();
     let scene = Scenario {

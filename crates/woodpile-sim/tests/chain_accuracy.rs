@@ -12,19 +12,14 @@ use woodpile_sim::integrate::{
     Rk4Fused, Rkn, Rkn4, StepControl, Stepper, SymplecticStepper, DPRKN6, VERLET, YOSHIDA4,
     YOSHIDA6,
 };
-use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+use woodpile_sim::model::{Boundary, Model, Resonator};
 use woodpile_sim::testing::fitted_order;
 use woodpile_sim::SimError;
 
 /// A short chain (sites -20..20), defect eps = 3 at 0, impulse at -8, t in [0, 40]: the wave
 /// crosses the defect and splits, with every kind of contact event, in a test-sized run.
 fn short_scene() -> (Model, Vec<f64>, Region) {
-    let res = vec![Resonator {
-        site: 20,
-        eps: 3.0,
-        coupling: Coupling::Constant(1.0),
-        p: 1,
-    }];
+    let res = vec![Resonator::constant(20, 3.0, 1.0, 1)];
     let model = Model::new(41, Boundary::Fixed, res).unwrap();
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, 12, 1.0).unwrap();
@@ -135,36 +130,34 @@ fn convergence_orders_on_the_hertz_chain() {
     }
 }
 
-/// The contact-event correction is worth its cost: at every step of the convergence test the
-/// state error of `rk4-contact` is at least 5 times smaller than plain RK4's.
+/// Each refinement is worth its cost, at every step of the convergence test:
+/// - the contact-event correction: `rk4-contact`'s state error is at least 5 times smaller
+///   than plain RK4's;
+/// - the sixth-order Nyström method with contact events (six force evaluations a step):
+///   its error is at least 10 times smaller than `rk4-contact`'s (four a step), so it reaches
+///   a given error at a step several times larger.
 #[test]
-fn contact_events_beat_plain_rk4_at_every_step() {
+fn each_refinement_beats_the_method_it_refines_at_every_step() {
     let error = state_error_against_tight_run();
-    for dt in [0.08, 0.04, 0.02] {
-        let (plain, corrected) = (error(Method::Rk4, dt), error(Method::Rk4Contact, dt));
-        assert!(
-            corrected * 5.0 < plain,
-            "dt = {dt}: rk4-contact {corrected:.2e}, rk4 {plain:.2e}"
-        );
-    }
-}
-
-/// The sixth-order Nyström method with contact events is worth its six force evaluations a step:
-/// at every step of the convergence test its state error is at least 10 times smaller than
-/// `rk4-contact`'s (four evaluations a step), so it reaches a given error at a step several
-/// times larger.
-#[test]
-fn rkn6_contact_beats_rk4_contact_at_every_step() {
-    let error = state_error_against_tight_run();
-    for dt in [0.08, 0.04, 0.02, 0.01] {
-        let (rk4, rkn6) = (
-            error(Method::Rk4Contact, dt),
-            error(Method::Rkn6Contact, dt),
-        );
-        assert!(
-            rkn6 * 10.0 < rk4,
-            "dt = {dt}: rkn6-contact {rkn6:.2e}, rk4-contact {rk4:.2e}"
-        );
+    let refinements: [(Method, Method, f64, &[f64]); 2] = [
+        (Method::Rk4Contact, Method::Rk4, 5.0, &[0.08, 0.04, 0.02]),
+        (
+            Method::Rkn6Contact,
+            Method::Rk4Contact,
+            10.0,
+            &[0.08, 0.04, 0.02, 0.01],
+        ),
+    ];
+    for (better, base, factor, steps) in refinements {
+        for &dt in steps {
+            let (ours, theirs) = (error(better, dt), error(base, dt));
+            assert!(
+                ours * factor < theirs,
+                "dt = {dt}: {} {ours:.2e}, {} {theirs:.2e}",
+                better.name(),
+                base.name()
+            );
+        }
     }
 }
 
@@ -245,12 +238,7 @@ fn energy_is_conserved_within_stated_bounds() {
 /// Failures are errors, never numbers: a step far beyond stability is reported with its time.
 #[test]
 fn blow_up_is_an_error() {
-    let res = vec![Resonator {
-        site: 20,
-        eps: 1e-3,
-        coupling: Coupling::Constant(1.0),
-        p: 1,
-    }];
+    let res = vec![Resonator::constant(20, 1e-3, 1.0, 1)];
     let model = Model::new(41, Boundary::Fixed, res).unwrap();
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, 12, 1.0).unwrap();
@@ -283,12 +271,7 @@ fn blow_up_is_an_error() {
 #[test]
 fn tolerance_driven_steps_respect_the_stability_bound() {
     for eps in [1e-4, 1e-2, 1.0] {
-        let res = vec![Resonator {
-            site: 0,
-            eps,
-            coupling: Coupling::Constant(1.0),
-            p: 1,
-        }];
+        let res = vec![Resonator::constant(0, eps, 1.0, 1)];
         let model = Model::new(3, Boundary::Fixed, res).unwrap();
         for method in [
             Method::Rk4,
@@ -315,12 +298,7 @@ fn tolerance_driven_steps_respect_the_stability_bound() {
 /// Free ends conserve momentum along the whole chain run.
 #[test]
 fn free_chain_conserves_momentum() {
-    let res = vec![Resonator {
-        site: 20,
-        eps: 3.0,
-        coupling: Coupling::Constant(1.0),
-        p: 3,
-    }];
+    let res = vec![Resonator::constant(20, 3.0, 1.0, 3)];
     let model = Model::new(41, Boundary::Free, res).unwrap();
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, 12, 1.0).unwrap();
