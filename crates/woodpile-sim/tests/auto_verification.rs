@@ -3,16 +3,32 @@
 //! plateau where two runs agree while both miss.
 #![allow(clippy::unwrap_used)]
 
-use woodpile_sim::integrate::{Method, MethodChoice, Plan};
+use woodpile_sim::energy::Region;
+use woodpile_sim::integrate::{Method, MethodChoice, Plan, AUTO_METHOD};
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
+use woodpile_sim::run::{auto_first_step, simulate, Scenario};
+use woodpile_sim::testing::{
+    audit_scene_at, fixed_dt, paper_scene, reference_fractions, tolerance, PaperDefect,
+    AUDIT_REFERENCE_DT,
+};
+use woodpile_sim::SimError;
+
+/// Asserts that `auto` on `scene` converges within `tol` of the `rk4-contact` reference at
+/// the step `reference_dt`.
+fn assert_auto_within(scene: &Scenario, reference_dt: f64, tol: f64) {
+    let out = simulate(scene, &mut ()).expect("auto converges");
+    let reference = reference_fractions(scene, reference_dt).unwrap();
+    let error = out.fractions.largest_difference(&reference);
+    assert!(
+        error <= tol,
+        "auto is off by {error:.1e} at tolerance {tol:e}"
+    );
+}
 
 /// A stiff nonlinear resonator (p = 13, eps = 0.01): `auto`'s answer agrees with an
 /// independent tighter Yoshida-6 run.
 #[test]
 fn auto_on_a_stiff_nonlinear_resonator_agrees_with_yoshida6() {
-    use woodpile_sim::integrate::MethodChoice;
-    use woodpile_sim::run::simulate;
-    use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
     let defect = PaperDefect {
         p: 13,
         ..PaperDefect::linear(0, 0.01, 1.0)
@@ -40,11 +56,6 @@ fn auto_on_a_stiff_nonlinear_resonator_agrees_with_yoshida6() {
 /// scene, and still meet the tolerance.
 #[test]
 fn auto_halves_past_a_first_step_that_blows_up() {
-    use woodpile_sim::integrate::{MethodChoice, AUTO_METHOD};
-    use woodpile_sim::run::{auto_first_step, simulate, Scenario};
-    use woodpile_sim::testing::{
-        fixed_dt, paper_scene, reference_fractions, tolerance, PaperDefect,
-    };
     let defects = [PaperDefect::linear(0, 10.0, 1.0)];
     let strong = |method, accuracy| Scenario {
         impulse_velocity: 3.0,
@@ -73,21 +84,12 @@ fn auto_halves_past_a_first_step_that_blows_up() {
 /// moments by the same 3e-5 and agreed with each other: the run passed, 3 times off.
 #[test]
 fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
-    use woodpile_sim::integrate::MethodChoice;
-    use woodpile_sim::run::simulate;
-    use woodpile_sim::testing::{paper_scene, reference_fractions, tolerance, PaperDefect};
     let defect = PaperDefect {
         p: 19,
         ..PaperDefect::linear(0, 0.09, 1.0)
     };
     let scene = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-5));
-    let out = simulate(&scene, &mut ()).expect("auto converges");
-    let exact = reference_fractions(&scene, 5e-4).unwrap();
-    let error = out.fractions.largest_difference(&exact);
-    assert!(
-        error <= 1e-5,
-        "auto is off by {error:.1e} at tolerance 1e-5"
-    );
+    assert_auto_within(&scene, 5e-4, 1e-5);
 }
 
 /// A scene from a survey of random scenes (two sharply ramped couplings, one of them cubic, and
@@ -97,9 +99,6 @@ fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
 /// are not shrinking as an order-3 method's do, and keep halving.
 #[test]
 fn auto_does_not_accept_a_pair_on_an_error_plateau() {
-    use woodpile_sim::energy::Region;
-    use woodpile_sim::run::{simulate, Scenario};
-    use woodpile_sim::testing::{reference_fractions, tolerance};
     let ramp = |k2, t0, tau| Coupling::Ramp {
         k1: 0.0,
         k2,
@@ -132,13 +131,7 @@ fn auto_does_not_accept_a_pair_on_an_error_plateau() {
         accuracy: tolerance(1e-4),
         sample_every: 1.0,
     };
-    let out = simulate(&scene, &mut ()).unwrap();
-    let reference = reference_fractions(&scene, 0.002).unwrap();
-    let error = out.fractions.largest_difference(&reference);
-    assert!(
-        error <= 1e-4,
-        "auto is off by {error:.1e} at tolerance 1e-4"
-    );
+    assert_auto_within(&scene, 0.002, 1e-4);
 }
 
 /// Scenes the audit (`make audit`) once caught `auto` passing with an estimate 4.5 to 190
@@ -149,10 +142,6 @@ fn auto_does_not_accept_a_pair_on_an_error_plateau() {
 /// takes, or refused.
 #[test]
 fn auto_holds_its_tolerance_on_the_audits_former_misses() {
-    use woodpile_sim::integrate::{Method, MethodChoice};
-    use woodpile_sim::run::{simulate, Scenario};
-    use woodpile_sim::testing::{audit_scene_at, fixed_dt, tolerance, AUDIT_REFERENCE_DT};
-    use woodpile_sim::SimError;
     let former_misses = [
         (2026, 149, 1e-7),
         (2026, 186, 1e-8),
@@ -195,9 +184,6 @@ fn auto_holds_its_tolerance_on_the_audits_former_misses() {
 /// arrive, the same scene run on does not, and an impulse on an end site is not an arrival.
 #[test]
 fn a_run_notes_when_its_wave_reaches_an_end_of_the_chain() {
-    use woodpile_sim::integrate::{Method, MethodChoice};
-    use woodpile_sim::run::{simulate, Scenario};
-    use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
     let paper = paper_scene(
         &[PaperDefect::linear(0, 10.0, 1.0)],
         MethodChoice::Named(Method::Rkn4Contact),
