@@ -24,10 +24,7 @@ use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;
 
 fn hand_picked() -> Vec<(String, Scenario)> {
-    let pd = |site, eps, p| PaperDefect {
-        p,
-        ..PaperDefect::linear(site, eps, 1.0)
-    };
+    let pd = |site, eps, p| PaperDefect::with_exponent(site, eps, 1.0, p);
     vec![
         ("standard eps=10".into(), vec![pd(0, 10.0, 1)]),
         (

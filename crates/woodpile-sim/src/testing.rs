@@ -60,11 +60,16 @@ pub struct PaperDefect {
 impl PaperDefect {
     /// A linear defect with constant kappa.
     pub fn linear(site: i64, eps: f64, kappa: f64) -> Self {
+        Self::with_exponent(site, eps, kappa, 1)
+    }
+
+    /// A defect coupled by kappa (u - v)^p with constant kappa.
+    pub fn with_exponent(site: i64, eps: f64, kappa: f64, p: u32) -> Self {
         Self {
             site,
             eps,
             coupling: Coupling::Constant(kappa),
-            p: 1,
+            p,
         }
     }
 }

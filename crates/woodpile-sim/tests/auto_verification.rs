@@ -29,10 +29,7 @@ fn assert_auto_within(scene: &Scenario, reference_dt: f64, tol: f64) {
 /// independent tighter Yoshida-6 run.
 #[test]
 fn auto_on_a_stiff_nonlinear_resonator_agrees_with_yoshida6() {
-    let defect = PaperDefect {
-        p: 13,
-        ..PaperDefect::linear(0, 0.01, 1.0)
-    };
+    let defect = PaperDefect::with_exponent(0, 0.01, 1.0, 13);
     let auto = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-6));
     let out = simulate(&auto, &mut ()).expect("auto converges");
     assert!(out.error_estimate.unwrap() <= 0.5e-6);
@@ -84,10 +81,7 @@ fn auto_halves_past_a_first_step_that_blows_up() {
 /// moments by the same 3e-5 and agreed with each other: the run passed, 3 times off.
 #[test]
 fn auto_meets_a_loose_tolerance_on_a_strongly_nonlinear_resonator() {
-    let defect = PaperDefect {
-        p: 19,
-        ..PaperDefect::linear(0, 0.09, 1.0)
-    };
+    let defect = PaperDefect::with_exponent(0, 0.09, 1.0, 19);
     let scene = paper_scene(&[defect], MethodChoice::Auto, tolerance(1e-5));
     assert_auto_within(&scene, 5e-4, 1e-5);
 }
