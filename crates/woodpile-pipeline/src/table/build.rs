@@ -154,68 +154,28 @@ pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
                 .collect()
         }
         let mismatch = || bad(format!("column `{name}` mixes kinds of values"));
+        // The closure that takes a cell of one variant apart (`None` for any other).
+        macro_rules! take {
+            ($variant:ident) => {
+                |c| match c {
+                    Cell::$variant(x) => Some(x),
+                    _ => None,
+                }
+            };
+        }
+        // List cells are never null: each is unpacked as present, then unwrapped.
         match cells.first() {
-            Some(Cell::F64(_)) | None => out.f64(
-                name,
-                unpack(
-                    cells,
-                    |c| match c {
-                        Cell::F64(x) => Some(x),
-                        _ => None,
-                    },
-                    mismatch,
-                )?,
-            ),
-            Some(Cell::I64(_)) => out.i64(
-                name,
-                unpack(
-                    cells,
-                    |c| match c {
-                        Cell::I64(x) => Some(x),
-                        _ => None,
-                    },
-                    mismatch,
-                )?,
-            ),
-            Some(Cell::Str(_)) => out.str(
-                name,
-                unpack(
-                    cells,
-                    |c| match c {
-                        Cell::Str(x) => Some(x),
-                        _ => None,
-                    },
-                    mismatch,
-                )?,
-            ),
-            Some(Cell::F64List(_)) => out.f64_list(
-                name,
-                unpack(
-                    cells,
-                    |c| match c {
-                        Cell::F64List(x) => Some(Some(x)),
-                        _ => None,
-                    },
-                    mismatch,
-                )?
-                .into_iter()
-                .flatten()
-                .collect(),
-            ),
-            Some(Cell::I64List(_)) => out.i64_list(
-                name,
-                unpack(
-                    cells,
-                    |c| match c {
-                        Cell::I64List(x) => Some(Some(x)),
-                        _ => None,
-                    },
-                    mismatch,
-                )?
-                .into_iter()
-                .flatten()
-                .collect(),
-            ),
+            Some(Cell::F64(_)) | None => out.f64(name, unpack(cells, take!(F64), mismatch)?),
+            Some(Cell::I64(_)) => out.i64(name, unpack(cells, take!(I64), mismatch)?),
+            Some(Cell::Str(_)) => out.str(name, unpack(cells, take!(Str), mismatch)?),
+            Some(Cell::F64List(_)) => {
+                let lists = unpack(cells, |c| take!(F64List)(c).map(Some), mismatch)?;
+                out.f64_list(name, lists.into_iter().flatten().collect())
+            }
+            Some(Cell::I64List(_)) => {
+                let lists = unpack(cells, |c| take!(I64List)(c).map(Some), mismatch)?;
+                out.i64_list(name, lists.into_iter().flatten().collect())
+            }
         };
     }
     out.into_frame()
