@@ -299,35 +299,39 @@ fn validate_resonator(index: usize, r: &Resonator, n_sites: usize) -> Result<(),
 }
 
 fn finite(what: &str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(ModelError::NotFinite {
-            what: what.into(),
-            value,
-        })
-    }
+    require(value.is_finite(), what, value, |what, value| {
+        ModelError::NotFinite { what, value }
+    })
 }
 
 fn positive(what: &str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        Err(ModelError::NotPositive {
-            what: what.into(),
-            value,
-        })
-    }
+    require(
+        value.is_finite() && value > 0.0,
+        what,
+        value,
+        |what, value| ModelError::NotPositive { what, value },
+    )
 }
 
 fn non_negative(what: &str, value: f64) -> Result<(), ModelError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(())
-    } else {
-        Err(ModelError::Negative {
-            what: what.into(),
-            value,
-        })
+    require(
+        value.is_finite() && value >= 0.0,
+        what,
+        value,
+        |what, value| ModelError::Negative { what, value },
+    )
+}
+
+/// `Ok` when `holds`; otherwise the error `error` makes of the quantity's name and value.
+fn require(
+    holds: bool,
+    what: &str,
+    value: f64,
+    error: fn(String, f64) -> ModelError,
+) -> Result<(), ModelError> {
+    match holds {
+        true => Ok(()),
+        false => Err(error(what.into(), value)),
     }
 }
 
