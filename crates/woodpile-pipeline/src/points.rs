@@ -370,14 +370,21 @@ mod tests {
         }
     }
 
+    /// A store in a fresh temporary folder (kept alive by the returned guard) holding
+    /// [`sample`] under the key of `name`.
+    fn store_with_sample(name: &str) -> (tempfile::TempDir, PointStore, Key) {
+        let dir = tempfile::tempdir().unwrap();
+        let store = PointStore::new(dir.path());
+        let key = Key::of(&serde_json::json!(name));
+        store.save(&key, &Ok(sample())).unwrap();
+        (dir, store, key)
+    }
+
     /// Every single-bit flip of a point file reads as absent (and is recomputed), never as a
     /// different point, a panic or an abort.
     #[test]
     fn every_flipped_bit_of_a_point_file_reads_as_absent() {
-        let dir = tempfile::tempdir().unwrap();
-        let store = PointStore::new(dir.path());
-        let key = Key::of(&serde_json::json!("flip"));
-        store.save(&key, &Ok(sample())).unwrap();
+        let (_dir, store, key) = store_with_sample("flip");
         let bytes = std::fs::read(store.path(&key)).unwrap();
         for byte in 0..bytes.len() {
             for bit in 0..8 {
@@ -391,13 +398,10 @@ mod tests {
 
     #[test]
     fn points_round_trip_bit_for_bit() {
-        let dir = tempfile::tempdir().unwrap();
-        let store = PointStore::new(dir.path());
-        let key = Key::of(&serde_json::json!(1));
-        assert_eq!(store.load(&key), None);
-        store.save(&key, &Ok(sample())).unwrap();
+        let (_dir, store, key) = store_with_sample("1");
         assert_eq!(store.load(&key), Some(Ok(sample())));
         let failed = Key::of(&serde_json::json!(2));
+        assert_eq!(store.load(&failed), None);
         store
             .save(&failed, &Err("blew up at t = 3".into()))
             .unwrap();
@@ -406,10 +410,7 @@ mod tests {
 
     #[test]
     fn damaged_or_misnamed_files_read_as_absent() {
-        let dir = tempfile::tempdir().unwrap();
-        let store = PointStore::new(dir.path());
-        let key = Key::of(&serde_json::json!("a"));
-        store.save(&key, &Ok(sample())).unwrap();
+        let (_dir, store, key) = store_with_sample("a");
         let path = store.path(&key);
         let mut bytes = std::fs::read(&path).unwrap();
         // Truncated (a torn copy) and bit-flipped files are both rejected.
