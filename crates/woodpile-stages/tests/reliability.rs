@@ -32,11 +32,7 @@ ours = { stage = "at_end", column = "E_tr", where = { eps = 1.0 } }
 /// one. Status must call it stale, and a run must draw the figure again.
 #[test]
 fn a_figure_from_an_abandoned_edit_is_never_fresh() {
-    let p = Project::new(&[
-        ("sweep", &single_defect_sweep()),
-        ("at_end", REDUCE),
-        ("figure", &FIGURE.replace("TITLE", "first")),
-    ]);
+    let p = Project::reducing(&[("figure", &FIGURE.replace("TITLE", "first"))]);
     p.run(&[]).unwrap();
     let png = p.figures().join("figure.png");
     let original = std::fs::read(&png).unwrap();
@@ -74,11 +70,7 @@ fn a_figure_from_an_abandoned_edit_is_never_fresh() {
 /// same name is still never replaced.
 #[test]
 fn a_report_is_never_stuck_on_its_own_markdown() {
-    let p = Project::new(&[
-        ("sweep", &single_defect_sweep()),
-        ("at_end", REDUCE),
-        ("rep", REPORT),
-    ]);
+    let p = Project::reducing(&[("rep", REPORT)]);
     p.run(&[]).unwrap();
     let markdown = p.root().join("REPORT.md");
     assert!(std::fs::read_to_string(&markdown)
@@ -104,9 +96,7 @@ fn a_report_is_never_stuck_on_its_own_markdown() {
 /// Two spellings of one Markdown file are one file: the second report is refused at load.
 #[test]
 fn two_reports_cannot_claim_one_file_by_spelling_it_twice() {
-    let p = Project::new(&[
-        ("sweep", &single_defect_sweep()),
-        ("at_end", REDUCE),
+    let p = Project::reducing(&[
         ("a", &REPORT.replace("REPORT.md", "d/x.md")),
         ("b", &REPORT.replace("REPORT.md", "d//x.md")),
     ]);
@@ -120,11 +110,7 @@ fn two_reports_cannot_claim_one_file_by_spelling_it_twice() {
 #[test]
 fn a_report_never_writes_through_a_symlinked_folder() {
     let elsewhere = tempfile::tempdir().unwrap();
-    let p = Project::new(&[
-        ("sweep", &single_defect_sweep()),
-        ("at_end", REDUCE),
-        ("rep", &REPORT.replace("REPORT.md", "docs/r.md")),
-    ]);
+    let p = Project::reducing(&[("rep", &REPORT.replace("REPORT.md", "docs/r.md"))]);
     std::os::unix::fs::symlink(elsewhere.path(), p.root().join("docs")).unwrap();
     let err = p.run(&[]).unwrap_err().to_string();
     assert!(err.contains("symbolic link"), "{err}");
@@ -155,7 +141,7 @@ fn symlink_loops_are_not_followed() {
 #[cfg(unix)]
 #[test]
 fn non_regular_files_in_results_are_damaged_never_read() {
-    let p = Project::new(&[("sweep", &single_defect_sweep()), ("at_end", REDUCE)]);
+    let p = Project::reducing(&[]);
     p.run(&[]).unwrap();
     let table = p.output("at_end");
     let fifo_made = |path: &Path| {
@@ -273,21 +259,13 @@ y_label = "E_tr"
     assert!(err.contains("100 panels") && err.contains("64"), "{err}");
 
     let long = FIGURE.replace("TITLE", &"{at_end.kind}".repeat(20_000));
-    let p = Project::new(&[
-        ("sweep", &single_defect_sweep()),
-        ("at_end", REDUCE),
-        ("fig", &long),
-    ]);
+    let p = Project::reducing(&[("fig", &long)]);
     let err = p.run(&[]).unwrap_err().to_string();
     assert!(err.contains("more than 100000 characters"), "{err}");
 
     // A quoted value is inserted as it is, never expanded again.
     let quoting = FIGURE.replace("TITLE", "{at_end.kind} at {at_end.params.at} {x");
-    let p = Project::new(&[
-        ("sweep", &single_defect_sweep()),
-        ("at_end", REDUCE),
-        ("fig", &quoting),
-    ]);
+    let p = Project::reducing(&[("fig", &quoting)]);
     p.run(&[]).unwrap();
     let manifest = table::read_manifest(&p.output("fig")).unwrap().unwrap();
     assert_eq!(

@@ -257,12 +257,7 @@ fn failed_points_are_reported_never_written_as_numbers() {
         .replace("dt = 0.02", "dt = 1.0");
     let p = Project::new(&[("sweep", &stiff), ("best", BEST)]);
     let events = p.counted(&[]);
-    assert!(events
-        .warnings
-        .lock()
-        .unwrap()
-        .iter()
-        .any(|w| w.contains("failed")));
+    assert!(events.warned("failed"));
     let frame = table::read(&p.output("sweep")).unwrap();
     let failure = table::str_column(&frame, "failure").unwrap();
     let e_tr = table::f64_column(&frame, "E_tr").unwrap();
@@ -333,12 +328,7 @@ fn every_run_sweeps_leftover_temporaries_even_when_all_is_fresh() {
         events.started.lock().unwrap().is_empty(),
         "nothing was stale"
     );
-    assert!(events
-        .warnings
-        .lock()
-        .unwrap()
-        .iter()
-        .any(|w| w.contains("temporary")));
+    assert!(events.warned("temporary"));
 }
 
 #[test]

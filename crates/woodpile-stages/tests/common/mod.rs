@@ -98,6 +98,17 @@ pub struct Counter {
     pub warnings: Mutex<Vec<String>>,
 }
 
+impl Counter {
+    /// Whether a warning mentioned `text`.
+    pub fn warned(&self, text: &str) -> bool {
+        self.warnings
+            .lock()
+            .unwrap()
+            .iter()
+            .any(|w| w.contains(text))
+    }
+}
+
 impl Events for Counter {
     fn stage_started(&self, stage: &str, _: &str) {
         self.started.lock().unwrap().push(stage.to_string());
@@ -107,6 +118,16 @@ impl Events for Counter {
     }
     fn warn(&self, message: &str) {
         self.warnings.lock().unwrap().push(message.to_string());
+    }
+}
+
+impl Project {
+    /// A project of [`single_defect_sweep`], its reduction at the end (`at_end`) and `more`.
+    pub fn reducing(more: &[(&str, &str)]) -> Project {
+        let sweep = single_defect_sweep();
+        let mut stages = vec![("sweep", sweep.as_str()), ("at_end", REDUCE)];
+        stages.extend_from_slice(more);
+        Project::new(&stages)
     }
 }
 
