@@ -38,17 +38,24 @@ fn rows_make_typed_columns_and_mixed_kinds_are_an_error() {
     assert!(e.to_string().contains("`x` mixes"), "{e}");
 }
 
-#[test]
-fn a_written_table_reads_back_intact() {
+/// `columns` written as a sealed table in a fresh temporary folder (kept alive by the returned
+/// guard): the folder, the table's path and the frame written.
+fn written(columns: &mut Columns) -> (tempfile::TempDir, std::path::PathBuf, DataFrame) {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("t.parquet");
-    let mut columns = Columns::new();
-    columns
-        .f64("x", vec![Some(1.0), None, Some(f64::NAN)])
-        .i64("n", vec![Some(1), Some(2), None])
-        .str("s", vec![Some("a".into()), None, Some("c".into())]);
-    let frame = columns.into_frame().unwrap();
+    let frame = std::mem::take(columns).into_frame().unwrap();
     write(&path, frame.clone(), &manifest()).unwrap();
+    (dir, path, frame)
+}
+
+#[test]
+fn a_written_table_reads_back_intact() {
+    let (_dir, path, frame) = written(
+        Columns::new()
+            .f64("x", vec![Some(1.0), None, Some(f64::NAN)])
+            .i64("n", vec![Some(1), Some(2), None])
+            .str("s", vec![Some("a".into()), None, Some("c".into())]),
+    );
     let checked = read_checked(&path).unwrap();
     assert!(checked.frame.equals_missing(&frame), "content");
     let mut m = checked.manifest.clone().unwrap();
@@ -61,19 +68,17 @@ fn a_written_table_reads_back_intact() {
 /// leaves a table that is still intact: never an abort, a panic or a different table.
 #[test]
 fn every_flipped_bit_is_caught_before_decoding() {
-    let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("t.parquet");
-    let mut columns = Columns::new();
-    columns
-        .f64("R", (0..40).map(|i| Some(f64::from(i) * 0.25)).collect())
-        .i64("point", (0..40).map(Some).collect())
-        .str(
-            "failure",
-            (0..40)
-                .map(|i| (i % 7 == 0).then(|| format!("f{i}")))
-                .collect(),
-        );
-    write(&path, columns.into_frame().unwrap(), &manifest()).unwrap();
+    let (dir, path, _) = written(
+        Columns::new()
+            .f64("R", (0..40).map(|i| Some(f64::from(i) * 0.25)).collect())
+            .i64("point", (0..40).map(Some).collect())
+            .str(
+                "failure",
+                (0..40)
+                    .map(|i| (i % 7 == 0).then(|| format!("f{i}")))
+                    .collect(),
+            ),
+    );
     let bytes = std::fs::read(&path).unwrap();
     let flipped = dir.path().join("flipped.parquet");
     for byte in 0..bytes.len() {
