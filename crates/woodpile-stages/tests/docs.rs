@@ -47,15 +47,17 @@ fn generated() -> String {
 #[test]
 fn the_stage_kind_reference_is_generated_from_the_code() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/stage-kinds.md");
-    let expected = generated();
+    assert_generated(&path, &generated(), "docs/stage-kinds.md is out of date");
+}
+
+/// Asserts that the file at `path` holds `expected`, after writing it there when `UPDATE_DOCS`
+/// is set (`make docs`); `stale` says what is wrong when it does not.
+fn assert_generated(path: &Path, expected: &str, stale: &str) {
     if std::env::var_os("UPDATE_DOCS").is_some() {
-        std::fs::write(&path, &expected).unwrap();
+        std::fs::write(path, expected).unwrap();
     }
-    let current = std::fs::read_to_string(&path).unwrap_or_default();
-    assert!(
-        current == expected,
-        "docs/stage-kinds.md is out of date: run `make docs`"
-    );
+    let current = std::fs::read_to_string(path).unwrap_or_default();
+    assert!(current == expected, "{stale}: run `make docs`");
 }
 
 /// The accuracy each README figure was computed to: for every stage upstream of the figure that
@@ -126,12 +128,9 @@ fn readme_captions_state_the_accuracy_of_the_committed_results() {
         expected.push_str(&rewritten);
         expected.push('\n');
     }
-    if std::env::var_os("UPDATE_DOCS").is_some() {
-        std::fs::write(&readme_path, &expected).unwrap();
-    }
-    let readme = std::fs::read_to_string(&readme_path).unwrap();
-    assert!(
-        readme == expected,
-        "README.md's figure captions do not state the accuracy of results/: run `make docs`"
+    assert_generated(
+        &readme_path,
+        &expected,
+        "README.md's figure captions do not state the accuracy of results/",
     );
 }
