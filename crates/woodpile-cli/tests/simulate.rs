@@ -25,11 +25,14 @@ fn simulate(text: &str) -> (Output, PathBuf) {
 }
 
 fn simulate_file(path: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_woodpile"))
-        .arg("simulate")
-        .arg(path)
-        .output()
-        .unwrap()
+    simulate_command(path).output().unwrap()
+}
+
+/// The command `woodpile simulate path`, for a caller to add to.
+fn simulate_command(path: &Path) -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_woodpile"));
+    command.arg("simulate").arg(path);
+    command
 }
 
 /// Asserts that `woodpile simulate path` is refused as bad input: exit 2, nothing on stdout,
@@ -259,17 +262,12 @@ p = 3
 "#,
     );
     let run = |simd: &str| {
-        let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
-            .arg("simulate")
-            .arg(&path)
+        let out = simulate_command(&path)
             .env("WOODPILE_SIMD", simd)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stderr}");
         let mut json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         json.as_object_mut().unwrap().remove("wall_s");
         json
