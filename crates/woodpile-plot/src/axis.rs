@@ -1,7 +1,7 @@
 //! Linear and logarithmic axes. Data are drawn in "plot space" (the value, or its log10), so
 //! one chart type serves both; the ticks are chosen here and labelled with the data's values.
 
-use crate::draw::tick;
+use crate::chart::tick;
 
 /// How an axis maps values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -1,67 +1,15 @@
 //! The figure and its line panels, generic over the backend so PNG and SVG are one picture.
 //! Heat maps are [`crate::heat`]'s; curves, markers and legends in pixels [`crate::legend`]'s.
 
-use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::axis::Scale;
+pub(crate) use crate::chart::{chart, pixel, plot_rect, text, wrap, Chart, Ticked, FONT};
 use crate::colour::{Dash, Marker};
 use crate::legend::{self, Entry, Glyph, Rect};
 use crate::style::{Corner, Legend, Style};
 use crate::{Figure, LinePanel, Mark, MarkAt, Panel};
-
-pub(crate) const FONT: &str = "sans-serif";
-
-/// A chart whose axes tick where [`Scale::ticks`] says.
-pub(crate) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Ticked, Ticked>>;
-
-/// A plot-space axis from `lo` to `hi` with its tick positions chosen in advance (plotters'
-/// own would tick a log axis at log10 values).
-#[derive(Debug, Clone)]
-pub(crate) struct Ticked {
-    lo: f64,
-    hi: f64,
-    major: Vec<f64>,
-    minor: Vec<f64>,
-}
-
-impl Ticked {
-    pub(crate) fn new(lo: f64, hi: f64, (major, minor): (Vec<f64>, Vec<f64>)) -> Ticked {
-        Ticked {
-            lo,
-            hi,
-            major,
-            minor,
-        }
-    }
-}
-
-impl Ranged for Ticked {
-    type FormatOption = DefaultFormatting;
-    type ValueType = f64;
-
-    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
-        let f = (value - self.lo) / (self.hi - self.lo);
-        limit.0 + (f * f64::from(limit.1 - limit.0)).round() as i32
-    }
-
-    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
-        if hint.weight().allow_light_points() {
-            self.minor.clone()
-        } else {
-            self.major.clone()
-        }
-    }
-
-    fn range(&self) -> std::ops::Range<f64> {
-        self.lo..self.hi
-    }
-}
-
-pub(crate) fn text<E: std::fmt::Debug>(e: E) -> String {
-    format!("{e:?}")
-}
 
 /// A panel's x and y ranges in plot space.
 pub(crate) type Ranges = ((f64, f64), (f64, f64));
@@ -180,30 +128,6 @@ pub(crate) fn figure<DB: DrawingBackend>(
     Ok(covered)
 }
 
-/// `text` broken at spaces into lines no wider than `width` pixels.
-pub(crate) fn wrap<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    text: &str,
-    width: f64,
-    font: &TextStyle<'_>,
-) -> Vec<String> {
-    let fits = |s: &str| {
-        area.estimate_text_size(s, font)
-            .map_or(true, |(w, _)| w as f64 <= width)
-    };
-    let mut lines: Vec<String> = Vec::new();
-    for word in text.split(' ') {
-        match lines.last_mut() {
-            Some(line) if fits(&format!("{line} {word}")) => {
-                line.push(' ');
-                line.push_str(word);
-            }
-            _ => lines.push(word.to_string()),
-        }
-    }
-    lines
-}
-
 /// Draws a panel's title lines (and letter) over it, in a strip of `strip_lines` lines; returns
 /// the area left for the plot.
 fn panel_title<DB: DrawingBackend>(
@@ -303,88 +227,6 @@ pub(crate) fn range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
         let half = 0.5 * lo.abs().max(1e-3);
         (lo - half, hi + half)
     }
-}
-
-/// A tick label: integers without a decimal point (`10`, not `10.0`), other values with at
-/// most four significant decimals, and never `-0`.
-pub fn tick(v: &f64) -> String {
-    let v = if v.abs() < 1e-12 { 0.0 } else { *v };
-    if (v - v.round()).abs() <= 1e-9 * v.abs().max(1.0) && v.abs() < 1e15 {
-        return format!("{}", v.round() as i64);
-    }
-    let magnitude = v.abs().log10().floor();
-    if !(-4.0..6.0).contains(&magnitude) {
-        return format!("{v:.2e}");
-    }
-    let decimals = (3.0 - magnitude).clamp(0.0, 8.0) as usize;
-    let text = format!("{v:.decimals$}");
-    let text = text.trim_end_matches('0').trim_end_matches('.');
-    if text == "-0" {
-        "0".into()
-    } else {
-        text.into()
-    }
-}
-
-/// Builds a chart on `area` over plot-space ranges, ticked by the scales, with its mesh drawn.
-pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
-    area: &'a DrawingArea<DB, Shift>,
-    (x0, x1, sx): (f64, f64, Scale),
-    (y0, y1, sy): (f64, f64, Scale),
-    style: &Style,
-    draw_mesh: Option<(&str, &str, bool)>,
-) -> Result<Chart<'a, DB>, String> {
-    let (w, h) = area.dim_in_pixel();
-    let keep_minor = |(major, minor): (Vec<f64>, Vec<f64>)| {
-        (major, if style.minor_grid { minor } else { Vec::new() })
-    };
-    let xticks = keep_minor(sx.ticks(x0, x1, ((w as f64 / style.pt(48.0)) as usize).clamp(3, 8)));
-    let yticks = keep_minor(sy.ticks(y0, y1, ((h as f64 / style.pt(28.0)) as usize).clamp(3, 8)));
-    let mut chart = ChartBuilder::on(area)
-        .margin(style.pt(4.0) as u32)
-        .x_label_area_size(style.font(2.9) as u32)
-        .y_label_area_size(style.font(4.4) as u32)
-        .build_cartesian_2d(Ticked::new(x0, x1, xticks), Ticked::new(y0, y1, yticks))
-        .map_err(text)?;
-    if let Some((x_label, y_label, grid)) = draw_mesh {
-        let xf = move |u: &f64| sx.label(*u);
-        let yf = move |u: &f64| sy.label(*u);
-        let mut mesh = chart.configure_mesh();
-        mesh.x_desc(x_label)
-            .y_desc(y_label)
-            .x_label_formatter(&xf)
-            .y_label_formatter(&yf)
-            .label_style((FONT, style.font(1.0)))
-            .axis_desc_style((FONT, style.font(1.0)))
-            .set_all_tick_mark_size(style.pt(2.0) as u32)
-            .axis_style(ShapeStyle::from(&BLACK).stroke_width(style.stroke(0.5)))
-            .bold_line_style(RGBColor(226, 226, 226).stroke_width(style.stroke(0.3)))
-            .light_line_style(RGBColor(244, 244, 244).stroke_width(style.stroke(0.25)));
-        if !grid {
-            mesh.disable_mesh();
-        }
-        mesh.draw().map_err(text)?;
-    }
-    Ok(chart)
-}
-
-/// The plotting rectangle of `chart` in backend pixels.
-pub(crate) fn plot_rect<DB: DrawingBackend, CT: CoordTranslate>(
-    chart: &ChartContext<'_, DB, CT>,
-) -> Rect {
-    let (xr, yr) = chart.plotting_area().get_pixel_range();
-    Rect {
-        x0: xr.start as f64,
-        y0: yr.start as f64,
-        x1: xr.end as f64,
-        y1: yr.end as f64,
-    }
-}
-
-/// `(x, y)` in plot space as backend pixels.
-pub(crate) fn pixel<DB: DrawingBackend>(chart: &Chart<'_, DB>, (x, y): (f64, f64)) -> (f64, f64) {
-    let (px, py) = chart.backend_coord(&(x, y));
-    (px as f64, py as f64)
 }
 
 /// Mark colours: dark grey and black read on white and on every map colour.
@@ -632,16 +474,5 @@ mod tests {
     fn ranges_pad_only_where_asked() {
         assert_eq!(range([1.0, f64::NAN, 3.0].into_iter(), 0.05), (0.9, 3.1));
         assert_eq!(range([1.0, 3.0].into_iter(), 0.0), (1.0, 3.0));
-    }
-
-    #[test]
-    fn ticks_print_integers_as_integers_and_never_minus_zero() {
-        assert_eq!(tick(&10.0), "10");
-        assert_eq!(tick(&-0.0), "0");
-        assert_eq!(tick(&-1e-17), "0");
-        assert_eq!(tick(&0.25), "0.25");
-        assert_eq!(tick(&(0.1 + 0.2)), "0.3");
-        assert_eq!(tick(&-2.5), "-2.5");
-        assert_eq!(tick(&1.5e-7), "1.50e-7");
     }
 }

@@ -322,7 +322,7 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
         .configure_mesh()
         .disable_x_axis()
         .disable_mesh()
-        .y_label_formatter(&crate::draw::tick)
+        .y_label_formatter(&crate::chart::tick)
         .label_style((FONT, style.font(1.0)))
         .set_all_tick_mark_size(style.pt(2.0) as u32)
         .draw()

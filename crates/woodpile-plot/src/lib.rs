@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 mod axis;
+mod chart;
 mod colour;
 mod draw;
 mod grid;
@@ -20,8 +21,8 @@ use std::sync::OnceLock;
 use plotters::prelude::*;
 
 pub use axis::Scale;
+pub use chart::tick;
 pub use colour::{diverging, hex_colour, viridis, Dash, Marker, SeriesStyle};
-pub use draw::tick;
 pub use grid::Grid;
 pub use heat::cell_edges;
 pub use markup::markup;
