@@ -6,7 +6,7 @@ SCRATCH := scratch/check
 # Wall times (work-precision stages) belong to the machine that measured them: not compared.
 CHECK_TOL := --abs 1e-9 --rel 1e-9 --tol wall_ms=inf --tol log10_wall_ms=inf
 
-.PHONY: help build install audit test rust-test python python-test python-bench docs figures stage status check read-check bench work-precision lint slurm-test
+.PHONY: help build install audit test rust-test python python-test python-bench docs figures stage status check read-check bench work-precision lint old-cpu-test slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -79,6 +79,9 @@ work-precision: ## Error in E_tr against wall time for every method and step (RE
 lint: ## rustfmt check and clippy with warnings as errors
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+old-cpu-test: build ## The binary on an emulated CPU without AVX2 (QEMU Nehalem; installs qemu-user): same numbers
+	WOODPILE=$(WOODPILE) bash scripts/old_cpu_test.sh
 
 slurm-test: build ## Sharded sweep on a real one-node SLURM cluster (installs slurm-wlm, munge), diffed against a local run
 	bash scripts/slurm-test/run.sh
