@@ -63,20 +63,14 @@ impl Stepper for Rk4Fused {
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);
-        let FixedStepScratch {
-            q_stage,
-            y_new,
-            evals,
-            contact,
-            ..
-        } = &mut self.scratch;
-        let (new_q, new_v) = y_new.split_at_mut(n);
+        let s = &mut self.scratch;
+        let (new_q, new_v) = s.y_new.split_at_mut(n);
         // Stage 1 is the state itself: its accelerations are taken at q directly, and the
         // first pass below writes y + (h b_1) k_1 and stage 2 from (q, v) instead of copying
         // (q, v) into four buffers first. Same operations on the same operands, same bits.
         stage_accelerations(
             model,
-            contact.as_mut(),
+            s.contact.as_mut(),
             (q, &mut self.a_stage),
             (t, 0),
             window,
@@ -88,7 +82,7 @@ impl Stepper for Rk4Fused {
                 let len = r.len();
                 let vs = &mut self.v_stage[r.clone()];
                 let as_ = &self.a_stage[r.clone()][..len];
-                let qs = &mut q_stage[r.clone()][..len];
+                let qs = &mut s.q_stage[r.clone()][..len];
                 let nq = &mut new_q[r.clone()][..len];
                 let nv = &mut new_v[r.clone()][..len];
                 let q0 = &q[r.clone()][..len];
@@ -122,15 +116,15 @@ impl Stepper for Rk4Fused {
             if stage < 3 {
                 stage_accelerations(
                     model,
-                    contact.as_mut(),
-                    (q_stage, &mut self.a_stage),
+                    s.contact.as_mut(),
+                    (&s.q_stage, &mut self.a_stage),
                     (t + C[stage + 1] * h, stage + 1),
                     window,
                 );
             }
         }
-        *evals += 4;
-        finish_step(contact.as_mut(), model, (y, y_new), h, window);
+        s.evals += 4;
+        finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), h, window);
         StepOutcome::Accepted { h_next: h }
     }
 

@@ -78,17 +78,11 @@ impl Stepper for Rkn4 {
         let StepSpan { t, h, window } = span;
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
-        let FixedStepScratch {
-            q_stage,
-            y_new,
-            evals,
-            contact,
-            ..
-        } = &mut self.scratch;
+        let s = &mut self.scratch;
         // Stage 1 is the state itself: its accelerations are taken at q, with no copy.
         stage_accelerations(
             model,
-            contact.as_mut(),
+            s.contact.as_mut(),
             (&y[..n], &mut self.a[0]),
             (t, 0),
             window,
@@ -101,7 +95,7 @@ impl Stepper for Rkn4 {
             let (q, v) = y.split_at(n);
             for r in ranges.clone() {
                 let len = r.len();
-                let qs = &mut q_stage[r.clone()][..len];
+                let qs = &mut s.q_stage[r.clone()][..len];
                 let (q0, v0) = (&q[r.clone()][..len], &v[r.clone()][..len]);
                 let a = &self.a[stage][r][..len];
                 for i in 0..len {
@@ -110,15 +104,15 @@ impl Stepper for Rkn4 {
             }
             stage_accelerations(
                 model,
-                contact.as_mut(),
-                (q_stage, &mut self.a[stage + 1]),
+                s.contact.as_mut(),
+                (&s.q_stage, &mut self.a[stage + 1]),
                 (t + C[stage + 1] * h, stage + 1),
                 window,
             );
         }
-        *evals += 3;
+        s.evals += 3;
         let (q, v) = y.split_at(n);
-        let (new_q, new_v) = y_new.split_at_mut(n);
+        let (new_q, new_v) = s.y_new.split_at_mut(n);
         let (bq1, bq2) = (h * h / 6.0, h * h / 3.0);
         let (bv1, bv2, bv3) = (h / 6.0, 2.0 * h / 3.0, h / 6.0);
         for r in ranges.clone() {
@@ -136,7 +130,7 @@ impl Stepper for Rkn4 {
                 nv[i] = v0[i] + (bv1 * a1[i] + bv2 * a2[i] + bv3 * a3[i]);
             }
         }
-        finish_step(contact.as_mut(), model, (y, y_new), h, window);
+        finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), h, window);
         StepOutcome::Accepted { h_next: h }
     }
 
