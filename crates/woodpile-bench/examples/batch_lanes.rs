@@ -23,6 +23,7 @@ use std::time::Instant;
 use woodpile_bench::drive_fixed;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::{energy_density, Fractions};
+use woodpile_sim::force::hertz_force;
 use woodpile_sim::integrate::{ContactMode, Rkn, RknTableau, DPRKN6};
 use woodpile_sim::model::{Boundary, Coupling};
 use woodpile_sim::run::Scenario;
@@ -135,12 +136,10 @@ impl Batch {
         if batch.fixed_ends {
             for l in 0..LANES {
                 if lo == 0 {
-                    let d = (-u[0][l]).max(0.0);
-                    acc_u[0][l] += if d > 0.0 { d * d.sqrt() } else { 0.0 };
+                    acc_u[0][l] += hertz_force(-u[0][l]);
                 }
                 if hi == n - 1 {
-                    let d = u[n - 1][l];
-                    acc_u[n - 1][l] -= if d > 0.0 { d * d.sqrt() } else { 0.0 };
+                    acc_u[n - 1][l] -= hertz_force(u[n - 1][l]);
                 }
             }
         }

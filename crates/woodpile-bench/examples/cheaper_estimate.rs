@@ -21,8 +21,7 @@ use woodpile_bench::on_two_cores;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::Fractions;
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::model::Coupling;
-use woodpile_sim::run::{auto_first_step, simulate, Scenario};
+use woodpile_sim::run::{accepted_estimate, auto_first_step, simulate, Scenario};
 use woodpile_sim::testing::{audit_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT};
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;
@@ -45,28 +44,12 @@ fn at_step(scene: &Scenario, method: Method, dt: f64) -> Option<(Fractions, u64)
 /// 4 dt runs).
 type Row = (f64, f64, f64, f64, f64, [u64; 3]);
 
-/// The largest estimate `auto` accepts (`run::Strictness`): half the tolerance; a sixteenth
-/// with a nonlinear resonator, a sixty-fourth with a ramped coupling beside it.
-fn accepted(scene: &Scenario, tol: f64) -> f64 {
-    let r = scene.model.resonators();
-    let nonlinear = r.iter().any(|r| r.p >= 3);
-    let ramped = r
-        .iter()
-        .any(|r| matches!(r.coupling, Coupling::Ramp { .. }));
-    match (nonlinear, ramped) {
-        (true, true) => tol / 64.0,
-        (true, false) => tol / 16.0,
-        (false, _) => 0.5 * tol,
-    }
-}
-
 /// The first two rungs of `auto`'s ladder (its first step dt0, then dt0 / 2), each judged by
 /// both pairs.
 fn measure(scene: &Scenario, tolerances: &[f64]) -> Vec<Row> {
     let Some((reference, _)) = at_step(scene, Method::Rk4Contact, AUDIT_REFERENCE_DT) else {
         return Vec::new();
     };
-    let reference = &reference;
     let q = Method::Rkn6Contact.observed_order();
     let mut rows = Vec::new();
     for &tol in tolerances {
@@ -89,13 +72,13 @@ fn measure(scene: &Scenario, tolerances: &[f64]) -> Vec<Row> {
                 })
             };
             let ((e2, evals2), (e4, evals4)) = (estimate(2.0), estimate(4.0));
-            let error = fine.largest_difference(reference);
+            let error = fine.largest_difference(&reference);
             rows.push((
                 tol,
                 error,
                 e2,
                 e4,
-                accepted(scene, tol),
+                accepted_estimate(&scene.model, tol),
                 [fine_evals, evals2, evals4],
             ));
         }

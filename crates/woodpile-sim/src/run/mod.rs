@@ -251,21 +251,33 @@ struct Strictness {
 
 impl Strictness {
     fn of(model: &Model, tol: f64) -> Strictness {
-        let resonators = model.resonators();
-        let nonlinear = resonators.iter().any(|r| r.p >= 3);
-        let ramped = resonators
-            .iter()
-            .any(|r| matches!(r.coupling, crate::model::Coupling::Ramp { .. }));
-        let accept = match (nonlinear, ramped) {
-            (true, true) => tol / 64.0,
-            (true, false) => tol / 16.0,
-            (false, _) => 0.5 * tol,
-        };
+        let (nonlinear, ramped) = resonator_kinds(model);
         Strictness {
-            accept,
+            accept: accepted_estimate(model, tol),
             needs_three_runs: nonlinear && ramped,
             off_ladder_run: nonlinear,
         }
+    }
+}
+
+/// Whether `model` has a nonlinear resonator (p >= 3), and whether it has a ramped coupling.
+fn resonator_kinds(model: &Model) -> (bool, bool) {
+    let resonators = model.resonators();
+    let nonlinear = resonators.iter().any(|r| r.p >= 3);
+    let ramped = resonators
+        .iter()
+        .any(|r| matches!(r.coupling, crate::model::Coupling::Ramp { .. }));
+    (nonlinear, ramped)
+}
+
+/// The largest error estimate `auto` accepts at tolerance `tol` on `model` ([`Strictness`]):
+/// half the tolerance; a sixteenth with a nonlinear resonator; a sixty-fourth with a ramped
+/// coupling as well.
+pub fn accepted_estimate(model: &Model, tol: f64) -> f64 {
+    match resonator_kinds(model) {
+        (true, true) => tol / 64.0,
+        (true, false) => tol / 16.0,
+        (false, _) => 0.5 * tol,
     }
 }
 
