@@ -12,14 +12,17 @@
 
 use crate::error::ModelError;
 use crate::force::{hertz_potential, odd_power};
-use crate::model::{Boundary, Model};
+use crate::model::Model;
 
 /// A "defect region" of sites [lo, hi] (inclusive, internal 0-based numbering). Energy left of
-/// it is reflected, right of it transmitted, inside it trapped.
+/// it is reflected, right of it transmitted, inside it trapped. With a striker (the chain's
+/// site 0, a body that hits the first site), the striker's own energy is a fourth share, S.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Region {
     lo: usize,
     hi: usize,
+    /// 1 when site 0 is a striker, whose energy is neither reflected nor transmitted; else 0.
+    striker_sites: usize,
 }
 
 impl Region {
@@ -31,7 +34,29 @@ impl Region {
         Ok(Self {
             lo: lo as usize,
             hi: hi as usize,
+            striker_sites: 0,
         })
+    }
+
+    /// The same region in a chain whose site 0 is a striker: its energy is the share S. The
+    /// region must not contain the striker.
+    pub fn with_striker(self) -> Result<Self, ModelError> {
+        if self.lo == 0 {
+            return Err(ModelError::BadRegion {
+                lo: 0,
+                hi: self.hi as i64,
+                n_sites: self.hi + 1,
+            });
+        }
+        Ok(Self {
+            striker_sites: 1,
+            ..self
+        })
+    }
+
+    /// Whether site 0 is a striker.
+    pub fn has_striker(&self) -> bool {
+        self.striker_sites == 1
     }
 
     /// First site of the region.
@@ -54,32 +79,44 @@ pub struct Fractions {
     pub transmitted: f64,
     /// E_tr: share inside the region.
     pub trapped: f64,
+    /// S: the striker's share (its kinetic energy and half its contact's potential); 0
+    /// without a striker.
+    pub striker: f64,
     /// The total the shares are normalised by.
     pub total: f64,
 }
 
 impl Fractions {
-    /// Splits a per-site density into the three shares of `region`.
+    /// Splits a per-site density into the shares of `region`.
     pub fn from_density(density: &[f64], region: Region) -> Self {
-        let left: f64 = density[..region.lo].iter().sum();
+        let chain = region.striker_sites;
+        let left: f64 = density[chain..region.lo].iter().sum();
         let inside: f64 = density[region.lo..=region.hi].iter().sum();
         let right: f64 = density[region.hi + 1..].iter().sum();
-        let total = left + inside + right;
+        let (striker, total) = match chain {
+            0 => (0.0, left + inside + right),
+            _ => {
+                let striker: f64 = density[..chain].iter().sum();
+                (striker, left + inside + right + striker)
+            }
+        };
         Self {
             reflected: left / total,
             transmitted: right / total,
             trapped: inside / total,
+            striker: striker / total,
             total,
         }
     }
 
-    /// The largest difference in R, T or E_tr between two runs' fractions: the error measure
-    /// of `auto`'s verification and of every accuracy check against a reference.
+    /// The largest difference in R, T, E_tr or S between two runs' fractions: the error
+    /// measure of `auto`'s verification and of every accuracy check against a reference.
     pub fn largest_difference(&self, other: &Fractions) -> f64 {
         (self.reflected - other.reflected)
             .abs()
             .max((self.transmitted - other.transmitted).abs())
             .max((self.trapped - other.trapped).abs())
+            .max((self.striker - other.striker).abs())
     }
 }
 
@@ -90,14 +127,21 @@ pub fn energy_density(model: &Model, t: f64, y: &[f64], density: &mut [f64]) {
     let q = &y[..n_dof];
     let u = &q[..n_sites];
     kinetic_density(model, y, density);
+    let boundary = model.boundary();
+    let potential = |bond: usize, r: f64| match model.contacts() {
+        None => hertz_potential(r),
+        Some(law) => law.potential(bond, r),
+    };
     for bond in 0..n_sites - 1 {
-        let half = 0.5 * hertz_potential(u[bond] - u[bond + 1]);
+        let half = 0.5 * potential(bond + 1, u[bond] - u[bond + 1]);
         density[bond] += half;
         density[bond + 1] += half;
     }
-    if model.boundary() == Boundary::Fixed {
-        density[0] += hertz_potential(-u[0]);
-        density[n_sites - 1] += hertz_potential(u[n_sites - 1]);
+    if boundary.left_wall() {
+        density[0] += potential(0, -u[0]);
+    }
+    if boundary.right_wall() {
+        density[n_sites - 1] += potential(n_sites, u[n_sites - 1]);
     }
     for (j, r) in model.resonators().iter().enumerate() {
         let stretch = u[r.site] - q[n_sites + j];
@@ -131,11 +175,18 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
     for (site, w) in qdot[..n_sites].iter().enumerate() {
         e += 0.5 * model.site_mass(site) * w * w;
     }
+    let potential = |bond: usize, r: f64| match model.contacts() {
+        None => hertz_potential(r),
+        Some(law) => law.potential(bond, r),
+    };
     for bond in 0..n_sites - 1 {
-        e += hertz_potential(u[bond] - u[bond + 1]);
+        e += potential(bond + 1, u[bond] - u[bond + 1]);
     }
-    if model.boundary() == Boundary::Fixed {
-        e += hertz_potential(-u[0]) + hertz_potential(u[n_sites - 1]);
+    match (model.boundary().left_wall(), model.boundary().right_wall()) {
+        (true, true) => e += potential(0, -u[0]) + potential(n_sites, u[n_sites - 1]),
+        (true, false) => e += potential(0, -u[0]),
+        (false, true) => e += potential(n_sites, u[n_sites - 1]),
+        (false, false) => {}
     }
     for (j, r) in model.resonators().iter().enumerate() {
         let w = qdot[n_sites + j];
@@ -159,7 +210,7 @@ pub fn total_momentum(model: &Model, y: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Resonator;
+    use crate::model::{Boundary, Resonator};
 
     #[test]
     fn density_sums_to_total_energy() {

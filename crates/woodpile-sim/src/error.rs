@@ -50,6 +50,23 @@ pub enum ModelError {
         /// The offending exponent.
         p: u32,
     },
+    /// A contact exponent outside [`crate::contact::EXPONENT_RANGE`].
+    #[error("the contact exponent must be a number from 1 to 5, got {exponent}")]
+    ContactExponent {
+        /// The offending exponent.
+        exponent: f64,
+    },
+    /// The contact law does not have one coefficient per bond of the chain.
+    #[error("{n_bonds} contact coefficients given for a chain of {n_sites} sites (needs sites + 1, walls included)")]
+    BondCount {
+        /// Number of coefficients given.
+        n_bonds: usize,
+        /// Number of sites.
+        n_sites: usize,
+    },
+    /// A precompression needs walls at both ends to hold it.
+    #[error("a precompression needs fixed walls at both ends")]
+    PrecompressionWithoutWalls,
     /// The per-site mass list does not match the number of sites.
     #[error("{n_masses} site masses given for a chain of {n_sites} sites")]
     MassCount {
@@ -148,6 +165,9 @@ pub enum StepSetBy {
     Tolerance,
     /// Resolving (or keeping stable) the fastest resonator, index into the model's resonators.
     Resonator(usize),
+    /// Resolving the chain's stiffest contact (a [`crate::ContactLaw`]: heavy precompression,
+    /// stiff contacts or light sites).
+    Contacts,
 }
 
 /// A run refused before it starts.
@@ -181,6 +201,7 @@ impl StepSetBy {
             StepSetBy::Dt => "the run's dt",
             StepSetBy::Tolerance => "the tolerance",
             StepSetBy::Resonator(_) => "the fastest resonator's frequency",
+            StepSetBy::Contacts => "the chain's stiffest contact",
         }
     }
 }

@@ -4,6 +4,7 @@
 //! evaluates a power 3/2 only for compressed contacts: at any moment only a handful of the
 //! chain's contacts are closed.
 
+use crate::contact::ContactLaw;
 use crate::model::{Boundary, Model, Window};
 
 /// Hertz contact force for an overlap `d`: `[d]_+^{3/2}`.
@@ -94,6 +95,37 @@ impl Model {
         let (acc_u, acc_v) = acc.split_at_mut(n_sites);
         let (lo, hi) = (window.lo, window.hi);
 
+        match self.contacts() {
+            None => Self::hertz_chain(self.boundary(), u, acc_u, window, bond_force),
+            Some(law) => Self::law_chain(law, self.boundary(), u, acc_u, window, bond_force),
+        }
+        for (j, r) in self.resonators().iter().enumerate() {
+            if r.site < lo || r.site > hi {
+                continue;
+            }
+            let f = r.coupling.at(t) * odd_power(u[r.site] - v[j], r.p);
+            acc_u[r.site] -= f;
+            acc_v[j] = f / r.eps;
+        }
+        if let Some(masses) = self.site_masses() {
+            for (a, m) in acc_u[lo..=hi].iter_mut().zip(&masses[lo..=hi]) {
+                *a /= m;
+            }
+        }
+    }
+
+    /// The paper's contact forces on the sites of `window` (unit coefficients, exponent 3/2,
+    /// no precompression), written into `acc_u`; with `bond_force`, every bond force too.
+    #[inline(always)]
+    fn hertz_chain(
+        boundary: Boundary,
+        u: &[f64],
+        acc_u: &mut [f64],
+        window: Window,
+        bond_force: Option<&mut [f64]>,
+    ) {
+        let (lo, hi) = (window.lo, window.hi);
+        let n_sites = u.len();
         // Each site's force is (left bond) - (right bond). Computing it in one pass with the
         // previous bond's force in a register writes every acceleration once (no store to load
         // chain), and max(d, 0)^{3/2} has no branch to mispredict on the many barely-touching
@@ -120,37 +152,63 @@ impl Model {
                     record_w[bond - 1] = f;
                     previous = f;
                 }
-                if self.boundary() == Boundary::Fixed {
-                    if lo == 0 {
-                        record[0] = hertz_force(-u[0]);
-                    }
-                    if hi == n_sites - 1 {
-                        record[n_sites] = hertz_force(u[n_sites - 1]);
-                    }
+                if lo == 0 && boundary.left_wall() {
+                    record[0] = hertz_force(-u[0]);
+                }
+                if hi == n_sites - 1 && boundary.right_wall() {
+                    record[n_sites] = hertz_force(u[n_sites - 1]);
                 }
             }
         }
         acc_w[u_w.len() - 1] = previous;
-        if self.boundary() == Boundary::Fixed {
-            if lo == 0 {
-                acc_u[0] += hertz_force(-u[0]);
-            }
-            if hi == n_sites - 1 {
-                acc_u[n_sites - 1] -= hertz_force(u[n_sites - 1]);
-            }
+        if lo == 0 && boundary.left_wall() {
+            acc_u[0] += hertz_force(-u[0]);
         }
-        for (j, r) in self.resonators().iter().enumerate() {
-            if r.site < lo || r.site > hi {
-                continue;
-            }
-            let f = r.coupling.at(t) * odd_power(u[r.site] - v[j], r.p);
-            acc_u[r.site] -= f;
-            acc_v[j] = f / r.eps;
+        if hi == n_sites - 1 && boundary.right_wall() {
+            acc_u[n_sites - 1] -= hertz_force(u[n_sites - 1]);
         }
-        if let Some(masses) = self.site_masses() {
-            for (a, m) in acc_u[lo..=hi].iter_mut().zip(&masses[lo..=hi]) {
-                *a /= m;
+    }
+
+    /// [`Model::hertz_chain`] under a [`ContactLaw`]: each bond's force beyond its static one,
+    /// a_b [δ_b + u_left − u_right]_+^α − F_b. A recorded bond force is the elastic part
+    /// a_b [c_b]_+^α, positive exactly while the contact is closed, as the contact-event scan
+    /// needs; the static part is constant over a step, so every quadrature integrates it exactly
+    /// and the event correction may leave it out.
+    #[inline(always)]
+    fn law_chain(
+        law: &ContactLaw,
+        boundary: Boundary,
+        u: &[f64],
+        acc_u: &mut [f64],
+        window: Window,
+        mut bond_force: Option<&mut [f64]>,
+    ) {
+        let (lo, hi) = (window.lo, window.hi);
+        let n_sites = u.len();
+        let mut previous = 0.0;
+        for bond in lo + 1..=hi {
+            let elastic = law.elastic(bond, u[bond - 1] - u[bond]);
+            if let Some(record) = bond_force.as_deref_mut() {
+                record[bond] = elastic;
             }
+            let f = elastic - law.static_force(bond);
+            acc_u[bond - 1] = previous - f;
+            previous = f;
+        }
+        acc_u[hi] = previous;
+        if lo == 0 && boundary.left_wall() {
+            let elastic = law.elastic(0, -u[0]);
+            if let Some(record) = bond_force.as_deref_mut() {
+                record[0] = elastic;
+            }
+            acc_u[0] += elastic - law.static_force(0);
+        }
+        if hi == n_sites - 1 && boundary.right_wall() {
+            let elastic = law.elastic(n_sites, u[n_sites - 1]);
+            if let Some(record) = bond_force.as_deref_mut() {
+                record[n_sites] = elastic;
+            }
+            acc_u[n_sites - 1] -= elastic - law.static_force(n_sites);
         }
     }
 

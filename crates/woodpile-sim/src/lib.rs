@@ -17,17 +17,20 @@
 //! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
 #![warn(missing_docs)]
 
+pub mod contact;
 pub mod energy;
 mod error;
 pub mod force;
 pub mod integrate;
 pub mod model;
 pub mod observe;
+pub mod rods;
 pub mod run;
 pub mod simd;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod units;
 
+pub use contact::ContactLaw;
 pub use error::{ModelError, OverBudget, SimError, StepSetBy};
-pub use model::{Boundary, Coupling, Model, Resonator};
+pub use model::{Boundary, Coupling, End, Model, Resonator};

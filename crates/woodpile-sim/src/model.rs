@@ -12,6 +12,7 @@
 //! The state vector is flat: `y = [q, q']` with `q = [u_0 .. u_{S-1}, v_0 .. v_{R-1}]`, so that
 //! `n_dof = S + R` and `y.len() = 2 n_dof`. Contacts push, never pull (`[x]_+ = max(x, 0)`).
 
+use crate::contact::ContactLaw;
 use crate::error::ModelError;
 
 /// What lies beyond the two end sites.
@@ -22,6 +23,65 @@ pub enum Boundary {
     Fixed,
     /// Free ends: the end sites have a single neighbour.
     Free,
+    /// One end walled and the other free (a chain struck at its free left end and resting on
+    /// a wall). Built by [`Boundary::ends`], which never makes it with equal ends.
+    Ends {
+        /// Beyond the first site.
+        left: End,
+        /// Beyond the last site.
+        right: End,
+    },
+}
+
+/// One end of the chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum End {
+    /// An immovable wall, touching through a contact.
+    Fixed,
+    /// Nothing: the end site has a single neighbour.
+    Free,
+}
+
+impl Boundary {
+    /// The boundary with these two ends: [`Boundary::Fixed`] or [`Boundary::Free`] when they
+    /// agree, so that each boundary has one spelling.
+    pub fn ends(left: End, right: End) -> Boundary {
+        match (left, right) {
+            (End::Fixed, End::Fixed) => Boundary::Fixed,
+            (End::Free, End::Free) => Boundary::Free,
+            (left, right) => Boundary::Ends { left, right },
+        }
+    }
+
+    /// The end beyond the first site.
+    pub fn left(self) -> End {
+        match self {
+            Boundary::Fixed => End::Fixed,
+            Boundary::Free => End::Free,
+            Boundary::Ends { left, .. } => left,
+        }
+    }
+
+    /// The end beyond the last site.
+    pub fn right(self) -> End {
+        match self {
+            Boundary::Fixed => End::Fixed,
+            Boundary::Free => End::Free,
+            Boundary::Ends { right, .. } => right,
+        }
+    }
+
+    /// Whether a wall lies beyond the first site.
+    #[inline(always)]
+    pub fn left_wall(self) -> bool {
+        self.left() == End::Fixed
+    }
+
+    /// Whether a wall lies beyond the last site.
+    #[inline(always)]
+    pub fn right_wall(self) -> bool {
+        self.right() == End::Fixed
+    }
 }
 
 /// The resonator coupling strength kappa, constant or switched on by a tanh ramp.
@@ -130,6 +190,9 @@ pub struct Model {
     site_masses: Option<Vec<f64>>,
     /// 1/mass for every degree of freedom (sites then resonators).
     inv_mass: Vec<f64>,
+    /// Contacts beyond the paper's (per-contact coefficients, an exponent, precompression);
+    /// `None` for the paper's chain, which keeps its own force loop and bits.
+    contacts: Option<Box<ContactLaw>>,
 }
 
 impl Model {
@@ -179,7 +242,31 @@ impl Model {
             resonators,
             site_masses,
             inv_mass,
+            contacts: None,
         })
+    }
+
+    /// The same chain with the contact law `law` instead of the paper's: one coefficient per
+    /// bond (sites + 1, walls included), its exponent and its precompression. A
+    /// precompression needs walls at both ends.
+    pub fn with_contacts(mut self, law: ContactLaw) -> Result<Self, ModelError> {
+        if law.n_bonds() != self.n_sites + 1 {
+            return Err(ModelError::BondCount {
+                n_bonds: law.n_bonds(),
+                n_sites: self.n_sites,
+            });
+        }
+        if law.precompression() > 0.0 && self.boundary != Boundary::Fixed {
+            return Err(ModelError::PrecompressionWithoutWalls);
+        }
+        self.contacts = Some(Box::new(law));
+        Ok(self)
+    }
+
+    /// The contact law, when the chain is not the paper's.
+    #[inline(always)]
+    pub fn contacts(&self) -> Option<&ContactLaw> {
+        self.contacts.as_deref()
     }
 
     /// Number of chain sites S.
@@ -246,6 +333,30 @@ impl Model {
         self.resonators
             .iter()
             .map(|r| r.omega_within(self.site_mass(r.site), energy))
+            .fold(0.0, f64::max)
+    }
+
+    /// The fastest a contact of a chain under a [`ContactLaw`] vibrates in a motion of total
+    /// energy `energy`: sqrt(k (1/m_left + 1/m_right)) at the stiffness k the bond has at the
+    /// largest overlap the energy allows ([`ContactLaw::overlap_within`]); a wall counts as
+    /// infinitely heavy. 0 for the paper's chain, whose steps are calibrated on it.
+    pub fn max_contact_omega(&self, energy: f64) -> f64 {
+        let Some(law) = self.contacts() else {
+            return 0.0;
+        };
+        let n = self.n_sites;
+        let walls = [self.boundary.left_wall(), self.boundary.right_wall()];
+        (0..=n)
+            .filter(|&bond| (bond > 0 || walls[0]) && (bond < n || walls[1]))
+            .map(|bond| {
+                let inverse_masses = [bond.checked_sub(1), (bond < n).then_some(bond)]
+                    .into_iter()
+                    .flatten()
+                    .map(|site| 1.0 / self.site_mass(site))
+                    .sum::<f64>();
+                let c = law.overlap_within(bond, energy);
+                (law.stiffness(bond, c) * inverse_masses).sqrt()
+            })
             .fold(0.0, f64::max)
     }
 

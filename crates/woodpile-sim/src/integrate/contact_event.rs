@@ -152,6 +152,13 @@ pub(crate) fn first_crossing(path: &BondPath, h: f64, after: f64) -> Option<f64>
 
 /// `(∫_0^h F(d(s)) ds, ∫_0^h (h - s) F(d(s)) ds)` along the Hermite path, F = [d]_+^{3/2}.
 pub(crate) fn path_integrals(path: &BondPath, h: f64) -> (f64, f64) {
+    path_integrals_of(path, h, |d| d * d.sqrt())
+}
+
+/// [`path_integrals`] of the force `force(d)` of a positive overlap d, which must vanish like
+/// a power d^α (α ≥ 1) as d closes: under the smoothing substitution the integrand then goes
+/// like x^{2α}, smooth enough for the 16-point rule.
+pub(crate) fn path_integrals_of(path: &BondPath, h: f64, force: impl Fn(f64) -> f64) -> (f64, f64) {
     let cubic = Cubic::hermite(path, h);
     // Break points: 0, the critical points, 1; then the roots inside each monotone piece.
     let (knots, n_knots) = cubic.monotone_knots();
@@ -179,8 +186,7 @@ pub(crate) fn path_integrals(path: &BondPath, h: f64) -> (f64, f64) {
             let smooth = x * x * (3.0 - 2.0 * x);
             let xi = a + (b - a) * smooth;
             let jacobian = 6.0 * x * (1.0 - x) * (b - a);
-            let d = cubic.at(xi).max(0.0);
-            let f = d * d.sqrt();
+            let f = force(cubic.at(xi).max(0.0));
             impulse += w * jacobian * f;
             moment += w * jacobian * (1.0 - xi) * f;
         }

@@ -6,8 +6,9 @@
 //! A method supplies only its quadrature: what its stage weights make of a bond's `S` stage
 //! forces, as an impulse `h Σ b_i F_i` and a position change `h² Σ b̄_i F_i`.
 
-use super::contact_event::{first_crossing, path_integrals, BondPath};
-use crate::model::{Boundary, Model, Window};
+use super::contact_event::{first_crossing, path_integrals, path_integrals_of, BondPath};
+use crate::contact::ContactLaw;
+use crate::model::{Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
 pub(crate) type Quadrature<const S: usize> = fn([f64; S], f64) -> (f64, f64);
@@ -28,9 +29,32 @@ pub(crate) fn changes_contact<const S: usize>(stage_forces: [f64; S], d_end: f64
     touching > 0 && touching <= S
 }
 
-fn negligible<const S: usize>(stage_forces: [f64; S], d_end: f64) -> bool {
-    let end = d_end.max(0.0);
-    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end * end.sqrt() < NEGLIGIBLE_FORCE
+fn negligible<const S: usize>(stage_forces: [f64; S], end_force: f64) -> bool {
+    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force < NEGLIGIBLE_FORCE
+}
+
+/// A bond's elastic force at the end of its path, and its impulse and moment along it: the
+/// paper's [d]_+^{3/2}, or the chain's [`ContactLaw`] (coefficient, exponent, and the static
+/// overlap added to the path by [`bond_path`]).
+fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
+    match model.contacts() {
+        None => {
+            let end = path.d1.max(0.0);
+            end * end.sqrt()
+        }
+        Some(law) => law.coefficient(bond) * law.power(path.d1),
+    }
+}
+
+fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, f64) {
+    match model.contacts() {
+        None => path_integrals(path, h),
+        Some(law) => {
+            let a = law.coefficient(bond);
+            let (impulse, moment) = path_integrals_of(path, h, |d| law.power(d));
+            (a * impulse, a * moment)
+        }
+    }
 }
 
 /// What a contact-event method keeps per step: every bond force of its `S` stages (indexing
@@ -99,11 +123,11 @@ impl<const S: usize> ContactEvents<S> {
         pending.clear();
         for &(bond, left, right) in &self.changed {
             let stage = self.stage_forces(bond);
-            let path = bond_path((q, v), (new_q, new_v), left, right);
-            if negligible(stage, path.d1) {
+            let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
+            if negligible(stage, end_force(model, bond, &path)) {
                 continue;
             }
-            let (impulse, moment) = path_integrals(&path, h);
+            let (impulse, moment) = bond_integrals(model, bond, &path, h);
             let (q0, q1) = quadrature(stage, h);
             pending.push((left, right, impulse - q0, moment - q1));
         }
@@ -140,8 +164,8 @@ impl<const S: usize> ContactEvents<S> {
         let (new_q, new_v) = end.split_at(n);
         let mut first: Option<f64> = None;
         for &(bond, left, right) in &self.changed {
-            let path = bond_path((q, v), (new_q, new_v), left, right);
-            if negligible(self.stage_forces(bond), path.d1) {
+            let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
+            if negligible(self.stage_forces(bond), end_force(model, bond, &path)) {
                 continue;
             }
             if let Some(x) = first_crossing(&path, h, after) {
@@ -182,62 +206,85 @@ impl<const S: usize> ContactEvents<S> {
         changed.clear();
         let inner = |i: usize| (lo + i + 1, Some(lo + i), Some(lo + i + 1));
         let n_bonds = hi - lo;
-        const BLOCK: usize = 4;
+        // Under precompression a bond's overlap is its static overlap plus left − right.
+        let offsets = model
+            .contacts()
+            .map(ContactLaw::static_overlaps)
+            .filter(|delta| delta.iter().any(|&d| d > 0.0));
         let mut start = 0;
-        while start + BLOCK <= n_bonds {
-            let block = start..start + BLOCK;
-            let forces: [&[f64; BLOCK]; S] =
-                std::array::from_fn(|s| block_of(&stage_slices[s][block.clone()]));
-            let mut mask = block_changes(
-                block_of(&left_q[block.clone()]),
-                block_of(&right_q[block]),
-                forces,
-            );
-            while mask != 0 {
-                changed.push(inner(start + mask.trailing_zeros() as usize));
-                mask &= mask - 1;
+        if offsets.is_none() {
+            const BLOCK: usize = 4;
+            while start + BLOCK <= n_bonds {
+                let block = start..start + BLOCK;
+                let forces: [&[f64; BLOCK]; S] =
+                    std::array::from_fn(|s| block_of(&stage_slices[s][block.clone()]));
+                let mut mask = block_changes(
+                    block_of(&left_q[block.clone()]),
+                    block_of(&right_q[block]),
+                    forces,
+                );
+                while mask != 0 {
+                    changed.push(inner(start + mask.trailing_zeros() as usize));
+                    mask &= mask - 1;
+                }
+                start += BLOCK;
             }
-            start += BLOCK;
         }
-        // The last bonds, fewer than a block: the scalar test.
+        // The last bonds, fewer than a block, or every bond of a precompressed chain: the
+        // scalar test.
+        let offset = |bond: usize| offsets.map_or(0.0, |delta| delta[bond]);
         changed.extend(
             (start..n_bonds)
                 .filter(|&i| {
-                    changes_contact::<S>(
-                        std::array::from_fn(|s| stage_slices[s][i]),
-                        left_q[i] - right_q[i],
-                    )
+                    let d_end = match offsets {
+                        None => left_q[i] - right_q[i],
+                        Some(delta) => delta[lo + i + 1] + (left_q[i] - right_q[i]),
+                    };
+                    changes_contact::<S>(std::array::from_fn(|s| stage_slices[s][i]), d_end)
                 })
                 .map(inner),
         );
-        if model.boundary() == Boundary::Fixed {
-            let wall_changed = |bond: usize, d_end: f64| {
-                changes_contact::<S>(std::array::from_fn(|s| forces[s][bond]), d_end)
-            };
-            if lo == 0 && wall_changed(0, -new_q[0]) {
-                changed.push((0, None, Some(0)));
-            }
-            if hi == n_sites - 1 && wall_changed(n_sites, new_q[n_sites - 1]) {
-                changed.push((n_sites, Some(n_sites - 1), None));
-            }
+        let wall_changed = |bond: usize, d_end: f64| {
+            changes_contact::<S>(std::array::from_fn(|s| forces[s][bond]), d_end)
+        };
+        let boundary = model.boundary();
+        if lo == 0 && boundary.left_wall() && wall_changed(0, offset(0) - new_q[0]) {
+            changed.push((0, None, Some(0)));
+        }
+        let last = n_sites - 1;
+        if hi == last
+            && boundary.right_wall()
+            && wall_changed(n_sites, offset(n_sites) + new_q[last])
+        {
+            changed.push((n_sites, Some(last), None));
         }
     }
 }
 
 /// A bond's overlap and rate at both ends of a step, from the states (positions, velocities) at
-/// its start and end: left member minus right member, a wall counting as at rest.
+/// its start and end: left member minus right member, a wall counting as at rest, plus the
+/// bond's static overlap under a precompressed [`ContactLaw`].
 fn bond_path(
+    model: &Model,
+    bond: usize,
     (q, v): (&[f64], &[f64]),
     (new_q, new_v): (&[f64], &[f64]),
-    left: Option<usize>,
-    right: Option<usize>,
+    (left, right): (Option<usize>, Option<usize>),
 ) -> BondPath {
     let member = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
-    BondPath {
+    let path = BondPath {
         d0: member(q, left) - member(q, right),
         rate0: member(v, left) - member(v, right),
         d1: member(new_q, left) - member(new_q, right),
         rate1: member(new_v, left) - member(new_v, right),
+    };
+    match model.contacts().map(|law| law.static_overlap(bond)) {
+        Some(delta) if delta > 0.0 => BondPath {
+            d0: path.d0 + delta,
+            d1: path.d1 + delta,
+            ..path
+        },
+        _ => path,
     }
 }
 

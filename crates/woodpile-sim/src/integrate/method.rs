@@ -348,8 +348,13 @@ impl Plan {
     /// pair out of the regime where both runs miss the resonator's stiff moments by the same
     /// amount and agree (p = 19, eps = 0.09 at tolerance 1e-5: both runs off by 3e-5, their
     /// difference 2.6e-6).
+    ///
+    /// A chain under a [`crate::ContactLaw`] is held to the same bound on its stiffest
+    /// contact ([`Model::max_contact_omega`]); the paper's chain has none and is not capped.
     pub fn resolving_dt(model: &Model, energy: f64) -> f64 {
-        let omega = model.max_resonator_omega(energy);
+        let omega = model
+            .max_resonator_omega(energy)
+            .max(model.max_contact_omega(energy));
         if omega > 0.0 {
             MAX_OMEGA_DT / omega
         } else {

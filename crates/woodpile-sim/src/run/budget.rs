@@ -39,7 +39,10 @@ pub fn check(scenario: &Scenario) -> Result<(), SimError> {
         (MethodChoice::Named(_), Some(dt)) => (dt, cause(scenario, dt, for_tolerance)),
         // An adaptive method cannot step past its stability limit on the fastest resonator.
         (MethodChoice::Named(method), None) => {
-            let omega = model.max_resonator_omega(scenario.impact_energy());
+            let energy = scenario.impact_energy();
+            let omega = model
+                .max_resonator_omega(energy)
+                .max(model.max_contact_omega(energy));
             let dt = if omega > 0.0 {
                 method.stability_limit() / omega
             } else {
@@ -69,6 +72,9 @@ fn cause(scenario: &Scenario, dt: f64, for_tolerance: f64) -> StepSetBy {
     }
     let energy = scenario.impact_energy();
     let model = &scenario.model;
+    if model.max_contact_omega(energy) >= model.max_resonator_omega(energy) {
+        return StepSetBy::Contacts;
+    }
     let fastest = model
         .resonators()
         .iter()

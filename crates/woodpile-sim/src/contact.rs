@@ -1,0 +1,257 @@
+//! The contacts of a chain as an experiment builds it: one coefficient per contact, any
+//! exponent, and a static precompression (a chain issue's model; docs/scene.md, `[chain]` and
+//! `[[segment]]`).
+//!
+//! ```text
+//! force of contact b:     a_b [c_b]_+^α − F_b,   c_b = δ_b + u_left − u_right,   F_b = a_b δ_b^α
+//! potential of contact b: a_b/(α+1) ([c_b]_+^{α+1} − δ_b^{α+1}) − F_b r,   r = u_left − u_right
+//! ```
+//!
+//! With a static force F0 held by walls at both ends, each contact's static overlap is
+//! δ_b = (F0 / a_b)^{1/α}, so every contact carries F0 and the rest state u = 0 is an
+//! equilibrium. Each contact subtracts its own static force F_b (equal to F0 up to rounding)
+//! rather than F0 itself: then a site at rest feels exactly zero force, so the sites ahead of
+//! the wave stay exactly at rest and the driver's active window skips them without changing a
+//! bit. The paper's chain (every a_b = 1, α = 3/2, no precompression) has no `ContactLaw` at
+//! all: it keeps its own loop and its own bits ([`crate::model::Model::contacts`]).
+//!
+//! Bonds are numbered as the recorded bond forces are: bond 0 is the left wall, bond b
+//! (1 ≤ b < S) joins sites b − 1 and b, bond S is the right wall.
+
+use crate::error::ModelError;
+
+/// Smallest and largest contact exponent accepted: α = 1 is a one-sided linear spring; above 5
+/// no granular contact law is in use, and the powers of a unit overlap lose precision.
+pub const EXPONENT_RANGE: (f64, f64) = (1.0, 5.0);
+
+/// The power `[d]_+^α`, with the common exponents written out (3/2 as `d √d`, exactly as the
+/// paper's loop computes it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Power {
+    Linear,
+    ThreeHalves,
+    Square,
+    General(f64),
+}
+
+impl Power {
+    fn of(exponent: f64) -> Power {
+        match exponent {
+            1.0 => Power::Linear,
+            1.5 => Power::ThreeHalves,
+            2.0 => Power::Square,
+            alpha => Power::General(alpha),
+        }
+    }
+
+    /// `[d]_+^α`.
+    #[inline(always)]
+    fn at(self, d: f64) -> f64 {
+        let d = d.max(0.0);
+        match self {
+            Power::Linear => d,
+            Power::ThreeHalves => d * d.sqrt(),
+            Power::Square => d * d,
+            Power::General(alpha) => d.powf(alpha),
+        }
+    }
+}
+
+/// Per-contact coefficients, one exponent and a precompression: see the module documentation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactLaw {
+    exponent: f64,
+    power: Power,
+    precompression: f64,
+    /// a_b for bonds 0..=S.
+    coefficient: Vec<f64>,
+    /// δ_b for bonds 0..=S (0 without precompression).
+    static_overlap: Vec<f64>,
+    /// F_b = a_b [δ_b]^α for bonds 0..=S.
+    static_force: Vec<f64>,
+}
+
+impl ContactLaw {
+    /// The contacts of a chain of `coefficients.len() - 1` sites: `coefficients[b]` is a_b in
+    /// the bond numbering of the module documentation (walls included, whether or not the ends
+    /// are walls), `exponent` is α and `precompression` the static force F0 (0 for none).
+    pub fn new(
+        coefficients: Vec<f64>,
+        exponent: f64,
+        precompression: f64,
+    ) -> Result<ContactLaw, ModelError> {
+        let (lowest, highest) = EXPONENT_RANGE;
+        if !(exponent >= lowest && exponent <= highest) {
+            return Err(ModelError::ContactExponent { exponent });
+        }
+        for (bond, &a) in coefficients.iter().enumerate() {
+            if !(a.is_finite() && a > 0.0) {
+                return Err(ModelError::NotPositive {
+                    what: format!("coefficient of contact {bond}"),
+                    value: a,
+                });
+            }
+        }
+        if !(precompression.is_finite() && precompression >= 0.0) {
+            return Err(ModelError::Negative {
+                what: "precompression".into(),
+                value: precompression,
+            });
+        }
+        let power = Power::of(exponent);
+        let static_overlap: Vec<f64> = coefficients
+            .iter()
+            .map(|&a| match precompression {
+                0.0 => 0.0,
+                f0 => (f0 / a).powf(1.0 / exponent),
+            })
+            .collect();
+        let static_force = coefficients
+            .iter()
+            .zip(&static_overlap)
+            .map(|(&a, &delta)| a * power.at(delta))
+            .collect();
+        Ok(ContactLaw {
+            exponent,
+            power,
+            precompression,
+            coefficient: coefficients,
+            static_overlap,
+            static_force,
+        })
+    }
+
+    /// Number of bonds, walls included (sites + 1).
+    pub fn n_bonds(&self) -> usize {
+        self.coefficient.len()
+    }
+
+    /// The exponent α.
+    pub fn exponent(&self) -> f64 {
+        self.exponent
+    }
+
+    /// The static force F0 (0 without precompression).
+    pub fn precompression(&self) -> f64 {
+        self.precompression
+    }
+
+    /// a_b.
+    pub fn coefficient(&self, bond: usize) -> f64 {
+        self.coefficient[bond]
+    }
+
+    /// δ_b, the static overlap of bond `bond`.
+    #[inline(always)]
+    pub fn static_overlap(&self, bond: usize) -> f64 {
+        self.static_overlap[bond]
+    }
+
+    /// F_b = a_b δ_b^α, the static force bond `bond` carries (F0 up to rounding).
+    #[inline(always)]
+    pub fn static_force(&self, bond: usize) -> f64 {
+        self.static_force[bond]
+    }
+
+    /// The static overlaps of every bond (0..=S).
+    pub(crate) fn static_overlaps(&self) -> &[f64] {
+        &self.static_overlap
+    }
+
+    /// `[c]_+^α` for a total overlap `c` (the elastic force of a unit coefficient).
+    #[inline(always)]
+    pub fn power(&self, c: f64) -> f64 {
+        self.power.at(c)
+    }
+
+    /// The elastic force a_b [δ_b + r]_+^α of bond `bond` at relative displacement `r`
+    /// (left member minus right member): what the contact-event correction integrates.
+    #[inline(always)]
+    pub fn elastic(&self, bond: usize, r: f64) -> f64 {
+        self.coefficient[bond] * self.power.at(self.static_overlap[bond] + r)
+    }
+
+    /// The force bond `bond` adds to the rest state's: [`ContactLaw::elastic`] − F_b. Zero,
+    /// exactly, at r = 0.
+    #[inline(always)]
+    pub fn net_force(&self, bond: usize, r: f64) -> f64 {
+        self.elastic(bond, r) - self.static_force[bond]
+    }
+
+    /// The potential of bond `bond` measured from the rest state:
+    /// a_b/(α+1) ([δ_b + r]_+^{α+1} − δ_b^{α+1}) − F_b r. Its derivative in r is
+    /// [`ContactLaw::net_force`].
+    pub fn potential(&self, bond: usize, r: f64) -> f64 {
+        let (a, delta) = (self.coefficient[bond], self.static_overlap[bond]);
+        let c = (delta + r).max(0.0);
+        let rise = c * self.power.at(c) - delta * self.power.at(delta);
+        a / (self.exponent + 1.0) * rise - self.static_force[bond] * r
+    }
+
+    /// The stiffness α a_b c^{α−1} of bond `bond` at total overlap `c` (> 0).
+    pub fn stiffness(&self, bond: usize, c: f64) -> f64 {
+        self.exponent * self.coefficient[bond] * c.max(0.0).powf(self.exponent - 1.0)
+    }
+
+    /// A bound on the total overlap bond `bond` reaches when it holds all of `energy` on top
+    /// of its static state. Since (δ + r)^α ≥ δ^α + r^α for α ≥ 1, the potential of a
+    /// compression r is at least a r^{α+1}/(α+1), so r ≤ ((α+1) energy / a)^{1/(α+1)}.
+    pub fn overlap_within(&self, bond: usize, energy: f64) -> f64 {
+        let alpha1 = self.exponent + 1.0;
+        let r = (alpha1 * energy.max(0.0) / self.coefficient[bond]).powf(1.0 / alpha1);
+        self.static_overlap[bond] + r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_static_state_is_an_exact_equilibrium() {
+        let law = ContactLaw::new(vec![0.7, 1.0, 2.3, 0.4], 1.5, 0.8).unwrap();
+        for bond in 0..4 {
+            assert_eq!(law.net_force(bond, 0.0), 0.0);
+            assert_eq!(law.potential(bond, 0.0), 0.0);
+            // Every contact carries the static force, up to rounding.
+            let carried = law.elastic(bond, 0.0);
+            assert!((carried - 0.8).abs() < 1e-15, "bond {bond}: {carried}");
+        }
+    }
+
+    #[test]
+    fn force_is_the_derivative_of_the_potential() {
+        for (exponent, f0) in [(1.5, 0.0), (1.5, 0.3), (1.0, 0.2), (2.5, 0.0), (3.7, 1.1)] {
+            let law = ContactLaw::new(vec![1.3, 0.6], exponent, f0).unwrap();
+            for r in [-0.4, -0.05, 0.02, 0.3, 0.9] {
+                let h = 1e-6;
+                let slope = (law.potential(1, r + h) - law.potential(1, r - h)) / (2.0 * h);
+                let force = law.net_force(1, r);
+                assert!(
+                    (slope - force).abs() < 1e-7,
+                    "alpha {exponent}, F0 {f0}, r {r}: {slope} vs {force}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn three_halves_is_the_papers_power() {
+        let law = ContactLaw::new(vec![1.0, 1.0], 1.5, 0.0).unwrap();
+        for d in [0.0, 0.013, 0.5, 1.7] {
+            assert_eq!(law.elastic(1, d), crate::force::hertz_force(d));
+        }
+        assert_eq!(law.elastic(1, -0.2), 0.0);
+    }
+
+    #[test]
+    fn bad_laws_are_refused() {
+        assert!(matches!(
+            ContactLaw::new(vec![1.0], 0.9, 0.0),
+            Err(ModelError::ContactExponent { .. })
+        ));
+        assert!(ContactLaw::new(vec![1.0], f64::NAN, 0.0).is_err());
+        assert!(ContactLaw::new(vec![1.0, 0.0], 1.5, 0.0).is_err());
+        assert!(ContactLaw::new(vec![1.0], 1.5, -1.0).is_err());
+    }
+}
