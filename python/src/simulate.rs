@@ -20,7 +20,7 @@ use crate::{SceneError, SimulationError};
 /// --
 ///
 /// The native call behind `woodpile.simulate`: a dict with `report` (the CLI's JSON text),
-/// `series` (t, R, T, E_tr, E arrays) and, when a field is asked for, `t`, `sites`,
+/// `series` (t, R, T, E_tr, E arrays, and S with a striker) and, when a field is asked for, `t`, `sites`,
 /// `velocity` and `displacement`.
 #[pyfunction]
 #[pyo3(signature = (scene, fields = false, field_sites = None))]
@@ -77,6 +77,9 @@ pub(crate) fn simulate<'py>(
     columns.set_item("R", series.reflected.into_pyarray(py))?;
     columns.set_item("T", series.transmitted.into_pyarray(py))?;
     columns.set_item("E_tr", series.trapped.into_pyarray(py))?;
+    if scene.scenario.region.has_striker() {
+        columns.set_item("S", series.striker.into_pyarray(py))?;
+    }
     columns.set_item("E", series.energy.into_pyarray(py))?;
     out.set_item("series", columns)?;
     if let Some(field) = field {

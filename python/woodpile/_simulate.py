@@ -23,7 +23,8 @@ class SimulationResult:
     ``as_dict()`` returns that object exactly.
 
     Attributes:
-        series: a DataFrame with columns ``t``, ``R``, ``T``, ``E_tr``, ``E`` at every
+        S: the striker's share at ``t_end`` for a scene with a ``[striker]``, else None.
+        series: a DataFrame with columns ``t``, ``R``, ``T``, ``E_tr`` (``S`` with a striker), ``E`` at every
             ``run.sample_every``. R, T and E_tr are the shares of the energy left of,
             right of and inside the region at that time (R = 1 before the wave arrives).
         t: the sample times (a float64 array).
@@ -35,6 +36,7 @@ class SimulationResult:
     R: float
     T: float
     E_tr: float
+    S: Optional[float]
     E_initial: float
     E_final: float
     error_estimate: Optional[float]
@@ -67,6 +69,7 @@ class SimulationResult:
         for key, value in self._report.items():
             setattr(self, key, value)
         self.physical = self._report.get("physical")
+        self.S = self._report.get("S")
         self._series_columns: Dict[str, np.ndarray] = raw["series"]
         self._series: Optional[pd.DataFrame] = None
         self.t = raw.get("t", self._series_columns["t"])
@@ -80,7 +83,8 @@ class SimulationResult:
         arrays the simulation returned, made a DataFrame on first access."""
         if self._series is None:
             columns = self._series_columns
-            self._series = pd.DataFrame({name: columns[name] for name in ("t", "R", "T", "E_tr", "E")})
+            names = ("t", "R", "T", "E_tr", "S", "E")
+            self._series = pd.DataFrame({name: columns[name] for name in names if name in columns})
         return self._series
 
     def as_dict(self) -> Dict[str, Any]:

@@ -182,6 +182,7 @@ fn numba_side(
             reflected: get("R"),
             transmitted: get("T"),
             trapped: get("E_tr"),
+            striker: 0.0,
             total: reference.total,
         };
         worst = worst.max(numba.largest_difference(reference));

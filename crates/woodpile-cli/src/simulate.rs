@@ -26,7 +26,7 @@ pub(crate) struct Args {
     #[arg(long)]
     pretty: bool,
     /// Also write R, T, E_tr and E at every `run.sample_every` to this parquet file
-    /// (columns t, R, T, E_tr, E).
+    /// (columns t, R, T, E_tr, E; and S, the striker's share, with a `[striker]`).
     #[arg(long, value_name = "OUT.parquet")]
     series: Option<PathBuf>,
     /// Also write every site's displacement and velocity at every sample to this parquet file
@@ -138,8 +138,11 @@ fn write_series(
         .f64("t", some(&series.t))
         .f64("R", some(&series.reflected))
         .f64("T", some(&series.transmitted))
-        .f64("E_tr", some(&series.trapped))
-        .f64("E", some(&series.energy));
+        .f64("E_tr", some(&series.trapped));
+    if scene.scenario.region.has_striker() {
+        columns.f64("S", some(&series.striker));
+    }
+    columns.f64("E", some(&series.energy));
     let frame = columns.into_frame().map_err(Failure::simulation)?;
     table::write(
         path,

@@ -12,7 +12,7 @@ use std::fmt;
 use serde_json::{json, Map, Value};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
-use woodpile_sim::Boundary;
+use woodpile_sim::{Boundary, End};
 
 /// The version every cache key includes. Bump [`NUMERICS_REVISION`] whenever a change can alter
 /// a computed number without changing a stage file: every cached result then goes stale.
@@ -198,9 +198,18 @@ pub fn scene_json(scene: &Scene) -> Value {
         MethodChoice::Auto => "auto",
         MethodChoice::Named(m) => m.name(),
     };
-    json!({
+    let end = |end: End| match end {
+        End::Fixed => "fixed",
+        End::Free => "free",
+    };
+    let boundary = match model.boundary() {
+        Boundary::Fixed => json!("fixed"),
+        Boundary::Free => json!("free"),
+        Boundary::Ends { left, right } => json!({"left": end(left), "right": end(right)}),
+    };
+    let mut canonical = json!({
         "sites": model.n_sites(),
-        "boundary": match model.boundary() { Boundary::Fixed => "fixed", Boundary::Free => "free" },
+        "boundary": boundary,
         "masses": if unit_masses { Value::Null } else { json!(masses) },
         "resonators": resonators,
         "impulse": {"site": s.impulse_site, "velocity": s.impulse_velocity},
@@ -211,7 +220,21 @@ pub fn scene_json(scene: &Scene) -> Value {
         "tolerance_explicit": s.accuracy.tolerance_explicit,
         "dt": s.accuracy.dt,
         "sample_every": s.sample_every,
-    })
+    });
+    // The chain's new keys join the key only when a scene declares them, so that every
+    // earlier scene keeps its key (and its cached point).
+    if let Some(law) = model.contacts() {
+        let coefficients: Vec<f64> = (0..law.n_bonds()).map(|b| law.coefficient(b)).collect();
+        canonical["contacts"] = json!({
+            "coefficients": coefficients,
+            "exponent": law.exponent(),
+            "precompression": law.precompression(),
+        });
+    }
+    if s.region.has_striker() {
+        canonical["striker"] = json!(true);
+    }
+    canonical
 }
 
 #[cfg(test)]

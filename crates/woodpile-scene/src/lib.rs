@@ -12,7 +12,7 @@ pub mod report;
 mod resolve;
 pub mod template;
 
-pub use resolve::{DerivedDefect, Physical, Scene};
+pub use resolve::{DerivedDefect, Physical, Scene, DEFAULT_RESONATOR_SHARE};
 
 use std::path::{Path, PathBuf};
 

@@ -14,6 +14,9 @@ pub(crate) struct SceneFile {
     pub run: Option<Run>,
     pub fractions: Option<FractionsTable>,
     pub physical: Option<Physical>,
+    #[serde(default)]
+    pub segment: Vec<Segment>,
+    pub striker: Option<Striker>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -23,7 +26,70 @@ pub(crate) struct Chain {
     /// `[first, last]` paper sites: an asymmetric chain (the woodpile experiment's 40 rods),
     /// instead of `n`.
     pub sites: Option<Vec<i64>>,
-    pub boundary: Option<String>,
+    /// `"fixed"`, `"free"` or `{ left = .., right = .. }`, read by hand for precise messages.
+    pub boundary: Option<toml::Value>,
+    /// The exponent alpha of every contact.
+    pub exponent: Option<f64>,
+    /// The static force F0 held by the walls.
+    pub precompression: Option<f64>,
+    /// The coefficient a of the two wall contacts.
+    pub wall_contact: Option<f64>,
+}
+
+/// Site properties over a range of paper sites.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Segment {
+    pub sites: Option<Vec<i64>>,
+    /// A number, or a list repeated from the segment's first site.
+    pub mass: Option<toml::Value>,
+    /// A number, or a list repeated from the segment's first contact.
+    pub contact: Option<toml::Value>,
+}
+
+/// A body that strikes the first site, instead of `[impulse]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Striker {
+    pub mass: Option<f64>,
+    pub velocity: Option<f64>,
+    pub contact: Option<f64>,
+    /// SI scenes: a sphere whose Hertz coefficient against the first rod is derived.
+    pub sphere: Option<Sphere>,
+}
+
+/// A spherical striker of an SI scene.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Sphere {
+    pub diameter: Option<f64>,
+    pub material: Option<Material>,
+}
+
+/// An elastic material in SI units.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Material {
+    pub youngs_modulus: Option<f64>,
+    pub poisson_ratio: Option<f64>,
+    pub density: Option<f64>,
+}
+
+/// A rod's geometry in metres.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Rod {
+    pub length: Option<f64>,
+    pub diameter: Option<f64>,
+}
+
+/// A defect rod of an SI scene: its length, and optionally its own diameter and material.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DefectRod {
+    pub length: Option<f64>,
+    pub diameter: Option<f64>,
+    pub material: Option<Material>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -48,6 +114,10 @@ pub(crate) struct Defect {
     pub resonator_mass: Option<f64>,
     /// Physical scenes: spring constant K in N/m^p.
     pub stiffness: Option<f64>,
+    /// Physical scenes: the defect rod's geometry, instead of mass, resonator_mass, stiffness.
+    pub rod: Option<DefectRod>,
+    /// Physical scenes with `rod`: the share of the rod's mass carried by the resonator.
+    pub resonator_share: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -71,9 +141,13 @@ pub(crate) struct FractionsTable {
 #[serde(deny_unknown_fields)]
 pub(crate) struct Physical {
     /// Hertz contact constant a in N/m^{3/2}.
-    pub contact: f64,
+    pub contact: Option<f64>,
     /// Mass M of a regular site in kg (the reference mass).
-    pub mass: f64,
-    /// Impact velocity V in m/s.
-    pub velocity: f64,
+    pub mass: Option<f64>,
+    /// Impact velocity V in m/s (a striker's velocity instead, when there is one).
+    pub velocity: Option<f64>,
+    /// The regular rods' material, with `rod`, instead of `contact` and `mass`.
+    pub material: Option<Material>,
+    /// The regular rods' geometry.
+    pub rod: Option<Rod>,
 }

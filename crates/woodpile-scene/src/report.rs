@@ -40,6 +40,9 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         "t_end": scenario.t_end,
         "version": env!("CARGO_PKG_VERSION"),
     });
+    if scenario.region.has_striker() {
+        report["S"] = json!(f.striker);
+    }
     if let Some(p) = &scene.physical {
         report["physical"] = json!({
             "length_scale_m": p.scales.length_m(),
@@ -48,6 +51,9 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
             "t_end_s": scenario.t_end * p.scales.time_s(),
             "defects": p.defects,
         });
+        for (name, value) in &p.derived {
+            report["physical"][name] = json!(value);
+        }
     }
     report
 }

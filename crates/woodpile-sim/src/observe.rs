@@ -41,6 +41,8 @@ pub struct FractionSeries {
     pub transmitted: Vec<f64>,
     /// Share inside the region.
     pub trapped: Vec<f64>,
+    /// The striker's share S (all zero without a striker).
+    pub striker: Vec<f64>,
     /// The energy split at each sample (total, or kinetic).
     pub energy: Vec<f64>,
 }
@@ -65,6 +67,7 @@ impl FractionSeries {
             reflected: Vec::new(),
             transmitted: Vec::new(),
             trapped: Vec::new(),
+            striker: Vec::new(),
             energy: Vec::new(),
         }
     }
@@ -88,6 +91,7 @@ impl Observer for FractionSeries {
         self.reflected.push(f.reflected * factor);
         self.transmitted.push(f.transmitted * factor);
         self.trapped.push(f.trapped * factor);
+        self.striker.push(f.striker * factor);
         self.energy.push(f.total);
     }
 
@@ -97,6 +101,7 @@ impl Observer for FractionSeries {
             &mut self.reflected,
             &mut self.transmitted,
             &mut self.trapped,
+            &mut self.striker,
             &mut self.energy,
         ] {
             v.clear();

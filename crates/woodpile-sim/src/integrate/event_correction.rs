@@ -76,9 +76,15 @@ pub(crate) struct ContactEvents<const S: usize> {
 impl<const S: usize> ContactEvents<S> {
     /// Scratch for `model`'s bonds, corrected with the method's `quadrature`.
     pub fn new(model: &Model, quadrature: Quadrature<S>) -> Self {
-        let bonds = model.n_sites() + 1;
+        // A bond outside the window is at rest and carries its static force (0 but under
+        // precompression): what its record must read when the window grows over it and a
+        // reused stage (FSAL) was recorded before it did.
+        let at_rest: Vec<f64> = match model.contacts() {
+            None => vec![0.0; model.n_sites() + 1],
+            Some(law) => (0..law.n_bonds()).map(|b| law.static_force(b)).collect(),
+        };
         Self {
-            stage_force: std::array::from_fn(|_| vec![0.0; bonds]),
+            stage_force: std::array::from_fn(|_| at_rest.clone()),
             quadrature,
             pending: Vec::new(),
             events: 0,

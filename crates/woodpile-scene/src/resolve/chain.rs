@@ -1,0 +1,283 @@
+//! `[chain]` and `[[segment]]`: which sites there are, what lies beyond the ends, each site's
+//! mass and each contact's coefficient, the exponent and the precompression.
+
+use woodpile_sim::model::{Boundary, End};
+use woodpile_sim::ContactLaw;
+
+use super::check::{invalid, non_negative, positive, positive_pattern, required, Invalid};
+use super::physical::Si;
+use crate::raw;
+
+/// Default chain: sites -100..100.
+const DEFAULT_N: i64 = 100;
+/// Longest chain accepted: far beyond any paper scene, small enough to never exhaust memory.
+pub(crate) const MAX_N: i64 = 5_000_000;
+
+/// Where the paper's sites sit in the simulator's numbering. A striker, when there is one, is
+/// index 0, one before the first paper site; the paper's sites follow it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
+    /// The first paper site.
+    pub first: i64,
+    /// The last paper site.
+    pub last: i64,
+    /// 1 with a striker, else 0.
+    pub striker_sites: usize,
+}
+
+impl Layout {
+    /// Sites in the simulator, the striker included.
+    pub fn n_sites(&self) -> usize {
+        (self.last - self.first + 1) as usize + self.striker_sites
+    }
+
+    /// The paper number the simulator's index 0 has (the striker's is first − 1).
+    pub fn index_zero(&self) -> i64 {
+        self.first - self.striker_sites as i64
+    }
+
+    /// The simulator's index of paper site `site`, or why it is not on the chain.
+    pub fn index(&self, key: &str, site: i64) -> Result<usize, Invalid> {
+        let (first, last) = (self.first, self.last);
+        if (first..=last).contains(&site) {
+            Ok((site - first) as usize + self.striker_sites)
+        } else {
+            Err(invalid(
+                key,
+                format!("site {site} is off the chain (sites run from {first} to {last})"),
+            ))
+        }
+    }
+}
+
+/// The first and last paper sites: `chain.n` (sites -n..n) or `chain.sites = [first, last]`.
+pub(crate) fn sites(chain: Option<&raw::Chain>) -> Result<(i64, i64), Invalid> {
+    let (n, sites) = chain.map_or((None, None), |c| (c.n, c.sites.as_deref()));
+    match (n, sites) {
+        (Some(_), Some(_)) => Err(invalid(
+            "chain.sites",
+            "give either chain.n (sites -n..n) or chain.sites = [first, last], not both",
+        )),
+        (_, Some(&[first, last])) => {
+            if first >= last || last.checked_sub(first).is_none_or(|w| w > 2 * MAX_N) {
+                return Err(invalid(
+                    "chain.sites",
+                    format!("must be [first, last] with first < last and at most {} sites, got [{first}, {last}]", 2 * MAX_N + 1),
+                ));
+            }
+            Ok((first, last))
+        }
+        (_, Some(other)) => Err(invalid(
+            "chain.sites",
+            format!("must be [first, last], got {} values", other.len()),
+        )),
+        (n, None) => {
+            let n = n.unwrap_or(DEFAULT_N);
+            if !(1..=MAX_N).contains(&n) {
+                return Err(invalid(
+                    "chain.n",
+                    format!("must be an integer in 1..={MAX_N}, got {n}"),
+                ));
+            }
+            Ok((-n, n))
+        }
+    }
+}
+
+/// `chain.boundary`: `"fixed"` (the default), `"free"`, or `{ left = .., right = .. }`.
+pub(crate) fn boundary(chain: Option<&raw::Chain>) -> Result<Boundary, Invalid> {
+    let end = |key: &str, value: &toml::Value| match value.as_str() {
+        Some("fixed") => Ok(End::Fixed),
+        Some("free") => Ok(End::Free),
+        _ => Err(invalid(
+            key,
+            format!("must be \"fixed\" or \"free\", got {value}"),
+        )),
+    };
+    match chain.and_then(|c| c.boundary.as_ref()) {
+        None => Ok(Boundary::Fixed),
+        Some(toml::Value::Table(ends)) => {
+            if let Some(other) = ends
+                .keys()
+                .find(|k| !["left", "right"].contains(&k.as_str()))
+            {
+                return Err(invalid(
+                    format!("chain.boundary.{other}"),
+                    "unknown key; the ends are left and right",
+                ));
+            }
+            let side = |name: &str| {
+                let key = format!("chain.boundary.{name}");
+                end(&key, required(&key, ends.get(name))?)
+            };
+            Ok(Boundary::ends(side("left")?, side("right")?))
+        }
+        Some(value) => {
+            let both = end("chain.boundary", value)?;
+            Ok(Boundary::ends(both, both))
+        }
+    }
+}
+
+/// Each site's mass and each bond's coefficient (bond numbering of `woodpile_sim::contact`),
+/// relative to the regular site's, as the sections of a scene set them.
+#[derive(Debug, Clone)]
+pub(crate) struct Sites {
+    pub masses: Vec<f64>,
+    pub contacts: Vec<f64>,
+    /// Whether any key set a contact coefficient (then the chain needs a `ContactLaw`).
+    pub contacts_set: bool,
+    /// The defect whose SI `mass` set a site's mass, to refuse a segment that sets it too.
+    pub mass_from_defect: Vec<Option<usize>>,
+}
+
+impl Sites {
+    /// Unit masses and contacts for `layout`.
+    pub fn regular(layout: &Layout) -> Sites {
+        let n = layout.n_sites();
+        Sites {
+            masses: vec![1.0; n],
+            contacts: vec![1.0; n + 1],
+            contacts_set: false,
+            mass_from_defect: vec![None; n],
+        }
+    }
+
+    /// Sets the coefficient of `bond`.
+    pub fn set_contact(&mut self, bond: usize, a: f64) {
+        self.contacts[bond] = a;
+        self.contacts_set = true;
+    }
+}
+
+/// Applies every `[[segment]]`: masses over its sites, coefficients over the contacts between
+/// them, each a number or a pattern repeated from the segment's start. SI scenes give kg and
+/// N/m^{3/2}.
+pub(crate) fn segments(
+    segments: &[raw::Segment],
+    layout: &Layout,
+    si: Option<&Si>,
+    sites: &mut Sites,
+) -> Result<(), Invalid> {
+    let mut covered: Vec<(i64, i64, usize)> = Vec::new();
+    for (i, segment) in segments.iter().enumerate() {
+        let key = |k: &str| format!("segment[{i}].{k}");
+        let range = required(&key("sites"), segment.sites.as_deref())?;
+        let &[lo, hi] = range else {
+            return Err(invalid(
+                key("sites"),
+                format!("must be [first, last], got {} values", range.len()),
+            ));
+        };
+        if lo > hi {
+            return Err(invalid(
+                key("sites"),
+                format!("first {lo} is after last {hi}"),
+            ));
+        }
+        let start = layout.index(&key("sites"), lo)?;
+        let end = layout.index(&key("sites"), hi)?;
+        if let Some((a, b, j)) = covered.iter().find(|(a, b, _)| lo <= *b && *a <= hi) {
+            return Err(invalid(
+                key("sites"),
+                format!(
+                    "[{lo}, {hi}] overlaps segment[{j}]'s [{a}, {b}]: segments may not overlap"
+                ),
+            ));
+        }
+        covered.push((lo, hi, i));
+        if let Some(mass) = &segment.mass {
+            let pattern = positive_pattern(&key("mass"), mass)?;
+            for (k, index) in (start..=end).enumerate() {
+                if let Some(d) = sites.mass_from_defect[index] {
+                    return Err(invalid(
+                        key("mass"),
+                        format!(
+                            "site {} has its mass from defect[{d}].mass: give it once",
+                            lo + k as i64
+                        ),
+                    ));
+                }
+                let m = pattern[k % pattern.len()];
+                sites.masses[index] = si.map_or(m, |si| si.scales.mass_ratio(m));
+            }
+        }
+        if let Some(contact) = &segment.contact {
+            let pattern = positive_pattern(&key("contact"), contact)?;
+            // The contact between index j and j + 1 is bond j + 1.
+            for (k, bond) in (start + 1..=end).enumerate() {
+                let a = pattern[k % pattern.len()];
+                sites.set_contact(bond, si.map_or(a, |si| a / si.scales.hertz));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The contact law a scene declares, or `None` when it declares none of the chain's new keys
+/// (then the chain is the paper's and keeps its bits). Walls carry `chain.wall_contact`.
+pub(crate) fn contact_law(
+    chain: Option<&raw::Chain>,
+    boundary: Boundary,
+    has_striker: bool,
+    si: Option<&Si>,
+    sites: &mut Sites,
+) -> Result<Option<ContactLaw>, Invalid> {
+    let (exponent, precompression, wall_contact) = chain.map_or((None, None, None), |c| {
+        (c.exponent, c.precompression, c.wall_contact)
+    });
+    let declared = exponent.is_some()
+        || precompression.is_some()
+        || wall_contact.is_some()
+        || sites.contacts_set;
+    if !declared {
+        return Ok(None);
+    }
+    let exponent = match exponent {
+        None => 1.5,
+        Some(alpha) if !(1.0..=5.0).contains(&alpha) => {
+            return Err(invalid(
+                "chain.exponent",
+                format!("must be a number from 1 to 5, got {alpha}"),
+            ))
+        }
+        Some(alpha) if si.is_some() && alpha != 1.5 => {
+            return Err(invalid(
+                "chain.exponent",
+                format!("is {alpha}, but an SI ([physical]) scene is scaled by the Hertz law's 3/2: give other exponents in a dimensionless scene"),
+            ))
+        }
+        Some(alpha) => alpha,
+    };
+    let force_scale = si.map_or(1.0, |si| {
+        si.scales.mass_kg * si.scales.velocity * si.scales.velocity / si.scales.length_m()
+    });
+    let precompression = match precompression {
+        None => 0.0,
+        Some(f0) => non_negative("chain.precompression", f0)? / force_scale,
+    };
+    if precompression > 0.0 {
+        if boundary != Boundary::Fixed {
+            return Err(invalid(
+                "chain.precompression",
+                "needs fixed walls at both ends to hold it (chain.boundary = \"fixed\")",
+            ));
+        }
+        if has_striker {
+            return Err(invalid(
+                "chain.precompression",
+                "cannot be combined with a [striker], whose chain has a free left end",
+            ));
+        }
+    }
+    if let Some(a) = wall_contact {
+        let a = positive("chain.wall_contact", a)?;
+        let a = si.map_or(a, |si| a / si.scales.hertz);
+        let last = sites.contacts.len() - 1;
+        sites.set_contact(0, a);
+        sites.set_contact(last, a);
+    }
+    ContactLaw::new(sites.contacts.clone(), exponent, precompression)
+        .map(Some)
+        .map_err(|e| invalid("chain", e.to_string()))
+}

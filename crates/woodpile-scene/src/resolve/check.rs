@@ -1,0 +1,88 @@
+//! The checks every section of a scene shares: an invalid key is `(key, reason)`, and numbers
+//! are finite, positive or non-negative, or one of a list.
+
+/// A key the model cannot accept, and why: the caller adds the file.
+pub(crate) type Invalid = (String, String);
+
+pub(crate) fn invalid(key: impl Into<String>, reason: impl Into<String>) -> Invalid {
+    (key.into(), reason.into())
+}
+
+pub(crate) fn finite(key: &str, x: f64) -> Result<f64, Invalid> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(invalid(key, format!("must be a finite number, got {x}")))
+    }
+}
+
+pub(crate) fn positive(key: &str, x: f64) -> Result<f64, Invalid> {
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(invalid(key, format!("must be finite and > 0, got {x}")))
+    }
+}
+
+pub(crate) fn non_negative(key: &str, x: f64) -> Result<f64, Invalid> {
+    if x.is_finite() && x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(invalid(key, format!("must be finite and >= 0, got {x}")))
+    }
+}
+
+/// `value`, which is required at `key`.
+pub(crate) fn required<T>(key: &str, value: Option<T>) -> Result<T, Invalid> {
+    value.ok_or_else(|| invalid(key, "is required"))
+}
+
+/// A TOML number (an integer is taken as a float).
+pub(crate) fn number(key: &str, value: &toml::Value) -> Result<f64, Invalid> {
+    match value {
+        toml::Value::Float(x) => Ok(*x),
+        toml::Value::Integer(i) => Ok(*i as f64),
+        other => Err(invalid(
+            key,
+            format!("must be a number, got {}", other.type_str()),
+        )),
+    }
+}
+
+/// A number or a non-empty list of numbers (a pattern repeated along a segment), each > 0.
+pub(crate) fn positive_pattern(key: &str, value: &toml::Value) -> Result<Vec<f64>, Invalid> {
+    let values = match value {
+        toml::Value::Array(items) if items.is_empty() => {
+            return Err(invalid(
+                key,
+                "must be a number or a non-empty list of numbers",
+            ))
+        }
+        toml::Value::Array(items) => items
+            .iter()
+            .enumerate()
+            .map(|(i, v)| number(&format!("{key}[{i}]"), v))
+            .collect::<Result<Vec<_>, _>>()?,
+        v => vec![number(key, v)?],
+    };
+    for (i, &x) in values.iter().enumerate() {
+        let at = match values.len() {
+            1 => key.to_string(),
+            _ => format!("{key}[{i}]"),
+        };
+        positive(&at, x)?;
+    }
+    Ok(values)
+}
+
+/// Rejects the first of `keys` that is present: those keys do not belong in this kind of scene.
+pub(crate) fn reject_present(
+    key: &dyn Fn(&str) -> String,
+    keys: &[(&str, bool)],
+    reason: &str,
+) -> Result<(), Invalid> {
+    match keys.iter().find(|(_, present)| *present) {
+        Some((name, _)) => Err(invalid(key(name), reason)),
+        None => Ok(()),
+    }
+}

@@ -1,0 +1,192 @@
+//! From the raw file to a validated [`Scene`]: defaults, paper numbering, typed enums.
+//!
+//! One module per section of the file, each with the keys it owns: [`chain`] (`[chain]`,
+//! `[[segment]]`), [`physical`] (`[physical]`, rods and materials), [`defects`]
+//! (`[[defect]]`), [`excitation`] (`[impulse]`, `[striker]`) and [`run`] (`[run]`,
+//! `[fractions]`, the budget). A new key goes into its section's module; [`resolve`] only
+//! calls them in order.
+//!
+//! Paper numbering: sites n = -N..N with N = `chain.n` (or `chain.sites = [first, last]`); the
+//! simulator's index is n - first, or n - first + 1 with a striker, which is index 0.
+
+mod chain;
+mod check;
+mod defects;
+mod excitation;
+mod physical;
+mod run;
+
+use woodpile_sim::energy::Region;
+use woodpile_sim::model::Model;
+use woodpile_sim::run::Scenario;
+use woodpile_sim::units::Scales;
+
+use crate::raw;
+use check::{invalid, Invalid};
+
+pub use physical::DEFAULT_RESONATOR_SHARE;
+
+/// A validated scene: the simulator's [`Scenario`] plus what the file said in paper terms.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// What to simulate.
+    pub scenario: Scenario,
+    /// The paper number of the first site (-N for a chain -N..N): paper site n is index
+    /// n - first_site.
+    pub first_site: i64,
+    /// The paper number of the last site.
+    pub last_site: i64,
+    /// The region in paper numbering.
+    pub region_paper: [i64; 2],
+    /// SI scales and derived parameters, for physical scenes.
+    pub physical: Option<Physical>,
+}
+
+impl Scene {
+    /// The internal indices of the paper sites `lo..=hi`, or why they are not a range of the
+    /// chain's sites.
+    pub fn site_range(&self, lo: i64, hi: i64) -> Result<(usize, usize), String> {
+        let (first, last) = (self.first_site, self.last_site);
+        if lo > hi || lo < first || hi > last {
+            return Err(format!(
+                "need {first} <= lo <= hi <= {last} (the chain's paper sites)"
+            ));
+        }
+        Ok(((lo - first) as usize, (hi - first) as usize))
+    }
+}
+
+/// What a physical scene derived from its SI parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Physical {
+    /// The rescaling.
+    pub scales: Scales,
+    /// Per defect: the dimensionless values derived from SI.
+    pub defects: Vec<DerivedDefect>,
+    /// Other values derived from SI input (the regular rods' mass, contact and bending mode,
+    /// the striker's mass and contact), by name, for the JSON's `physical` block.
+    pub derived: Vec<(String, f64)>,
+}
+
+/// Dimensionless parameters derived for one defect of a physical scene. Serialised (field
+/// names as keys) by `woodpile simulate` and in sweep manifests; a defect given by its rod
+/// also lists what its bending mode gave.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct DerivedDefect {
+    /// Paper site.
+    pub site: i64,
+    /// Host mass ratio M_defect / M.
+    pub host_mass_ratio: f64,
+    /// eps = m / M (M the regular site mass).
+    pub eps: f64,
+    /// kappa = K L^{p+1} / (M V^2).
+    pub kappa: f64,
+    /// A rod defect's host mass M in kg.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub host_mass_kg: Option<f64>,
+    /// A rod defect's resonator mass m in kg.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resonator_mass_kg: Option<f64>,
+    /// A rod defect's spring K = (2 pi f1)^2 M m / (M + m) in N/m.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stiffness_n_per_m: Option<f64>,
+    /// A rod defect's first free-free bending frequency f1 in Hz.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bending_f1_hz: Option<f64>,
+    /// A rod defect of its own diameter or material: its contacts' coefficient over the
+    /// regular one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact_ratio: Option<f64>,
+}
+
+pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
+    let chain_table = file.chain.as_ref();
+    let (first, last) = chain::sites(chain_table)?;
+    let si = physical::si(file.physical.as_ref(), file.striker.as_ref())?;
+    let boundary = chain::boundary(chain_table)?;
+    let layout = chain::Layout {
+        first,
+        last,
+        striker_sites: usize::from(file.striker.is_some()),
+    };
+    let mut sites = chain::Sites::regular(&layout);
+    let (resonators, derived) =
+        defects::resonators(&file.defect, &layout, si.as_ref(), &mut sites)?;
+    chain::segments(&file.segment, &layout, si.as_ref(), &mut sites)?;
+    let (impulse_site, impulse_velocity) = match &file.striker {
+        None => excitation::impulse(file.impulse.as_ref(), &layout, si.as_ref())?,
+        Some(striker) => excitation::striker(
+            striker,
+            file.impulse.is_some(),
+            boundary,
+            si.as_ref(),
+            &mut sites,
+        )?,
+    };
+    let law = chain::contact_law(
+        chain_table,
+        boundary,
+        file.striker.is_some(),
+        si.as_ref(),
+        &mut sites,
+    )?;
+    let striker_values = file
+        .striker
+        .as_ref()
+        .map(|_| (sites.masses[0], sites.contacts[1]));
+    let model = Model::with_masses(layout.n_sites(), boundary, resonators, Some(sites.masses))
+        .map_err(|e| invalid("defect", e.to_string()))?;
+    let model = match law {
+        None => model,
+        Some(law) => model
+            .with_contacts(law)
+            .map_err(|e| invalid("chain", e.to_string()))?,
+    };
+
+    let settings = run::settings(file.run)?;
+    let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
+    let mut region = Region::new(lo as i64, hi as i64, layout.n_sites())
+        .map_err(|e| invalid("fractions.region", e.to_string()))?;
+    if file.striker.is_some() {
+        region = region
+            .with_striker()
+            .map_err(|e| invalid("fractions.region", e.to_string()))?;
+    }
+    let scenario = Scenario {
+        model,
+        impulse_site,
+        impulse_velocity,
+        t_end: settings.t_end,
+        region,
+        method: settings.method,
+        accuracy: settings.accuracy,
+        sample_every: settings.sample_every,
+    };
+    run::within_budget(&scenario, settings.sample_every_given)?;
+    let physical = si.map(|si| {
+        let mut values = si.derived;
+        if let Some((mass, contact)) = striker_values {
+            values.push(("striker_mass".into(), mass));
+            values.push(("striker_contact".into(), contact));
+        }
+        if let Some(law) = scenario
+            .model
+            .contacts()
+            .filter(|l| l.precompression() > 0.0)
+        {
+            values.push(("precompression".into(), law.precompression()));
+        }
+        Physical {
+            scales: si.scales,
+            defects: derived,
+            derived: values,
+        }
+    });
+    Ok(Scene {
+        scenario,
+        first_site: layout.index_zero(),
+        last_site: last,
+        region_paper,
+        physical,
+    })
+}

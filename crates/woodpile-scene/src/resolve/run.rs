@@ -1,0 +1,169 @@
+//! `[run]` and `[fractions]`: the horizon, the method and its accuracy, the sampling, and the
+//! region whose energy counts as trapped; and the budget check that refuses an endless run.
+
+use woodpile_sim::integrate::MAX_STEPS;
+use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
+use woodpile_sim::run::Scenario;
+use woodpile_sim::SimError;
+use woodpile_sim::{OverBudget, StepSetBy};
+
+use super::chain::Layout;
+use super::check::{invalid, positive, Invalid};
+use crate::raw;
+
+const DEFAULT_T_END: f64 = 150.0;
+const DEFAULT_TOLERANCE: f64 = 1e-8;
+const DEFAULT_SAMPLE_EVERY: f64 = 1.0;
+/// Smallest tolerance accepted: the fractions are sums of hundreds of energies, each known to
+/// about 1e-16 relative, so a finer target could never be verified.
+const MIN_TOLERANCE: f64 = 1e-13;
+
+/// What `[run]` asks for.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RunSettings {
+    pub t_end: f64,
+    pub method: MethodChoice,
+    pub accuracy: Accuracy,
+    pub sample_every: f64,
+    /// Whether the file gave `sample_every` (then it, not `t_end`, is named when samples run over).
+    pub sample_every_given: bool,
+}
+
+/// The `[run]` table with its defaults.
+pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
+    let run = run.unwrap_or(raw::Run {
+        t_end: None,
+        method: None,
+        tolerance: None,
+        dt: None,
+        sample_every: None,
+    });
+    let t_end = positive("run.t_end", run.t_end.unwrap_or(DEFAULT_T_END))?;
+    let method = match run.method.as_deref().unwrap_or("auto") {
+        "auto" => MethodChoice::Auto,
+        name => MethodChoice::Named(Method::from_name(name).ok_or_else(|| {
+            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+            invalid(
+                "run.method",
+                format!(
+                    "unknown method \"{name}\"; expected \"auto\" or one of {}",
+                    names.join(", ")
+                ),
+            )
+        })?),
+    };
+    let tolerance = positive("run.tolerance", run.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
+    if tolerance < MIN_TOLERANCE {
+        return Err(invalid(
+            "run.tolerance",
+            format!("{tolerance:e} is below {MIN_TOLERANCE:e}: fractions summed over a chain in double precision cannot be verified that closely"),
+        ));
+    }
+    let dt = run.dt.map(|dt| positive("run.dt", dt)).transpose()?;
+    if let Some(dt) = dt {
+        match method {
+            MethodChoice::Auto => {
+                return Err(invalid(
+                    "run.dt",
+                    "needs a fixed-step method; \"auto\" chooses its own step from run.tolerance",
+                ))
+            }
+            MethodChoice::Named(m) if m.is_adaptive() => {
+                return Err(invalid(
+                    "run.dt",
+                    format!(
+                        "method \"{}\" is adaptive and takes run.tolerance, not dt",
+                        m.name()
+                    ),
+                ))
+            }
+            _ if dt > t_end => {
+                return Err(invalid(
+                    "run.dt",
+                    format!("{dt} is longer than run.t_end = {t_end}"),
+                ))
+            }
+            _ => {}
+        }
+    }
+    let sample_every = positive(
+        "run.sample_every",
+        run.sample_every.unwrap_or(DEFAULT_SAMPLE_EVERY),
+    )?;
+    Ok(RunSettings {
+        t_end,
+        method,
+        accuracy: Accuracy {
+            tolerance,
+            tolerance_explicit: run.tolerance.is_some(),
+            dt,
+        },
+        sample_every,
+        sample_every_given: run.sample_every.is_some(),
+    })
+}
+
+/// `fractions.region` in paper sites (default: the paper's, around the defects) and as the
+/// simulator's indices.
+pub(crate) fn region(
+    fractions: Option<raw::FractionsTable>,
+    defects: &[raw::Defect],
+    layout: &Layout,
+) -> Result<([i64; 2], (usize, usize)), Invalid> {
+    let region_paper = match fractions.and_then(|f| f.region) {
+        Some(r) => {
+            let [lo, hi] = r[..] else {
+                return Err(invalid(
+                    "fractions.region",
+                    format!("must be [lo, hi], got {} values", r.len()),
+                ));
+            };
+            if lo > hi {
+                return Err(invalid(
+                    "fractions.region",
+                    format!("lo = {lo} is greater than hi = {hi}"),
+                ));
+            }
+            [lo, hi]
+        }
+        None => default_region(defects),
+    };
+    let lo = layout.index("fractions.region", region_paper[0])?;
+    let hi = layout.index("fractions.region", region_paper[1])?;
+    Ok((region_paper, (lo, hi)))
+}
+
+/// Refuses a scene whose run could never finish within the simulator's budgets, naming the key
+/// that makes it so (`t_end` when even the largest step of any method would be too many).
+pub(crate) fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Result<(), Invalid> {
+    let error = match woodpile_sim::run::budget::check(scenario) {
+        Ok(()) => return Ok(()),
+        Err(SimError::OverBudget(over)) => over,
+        Err(other) => return Err(invalid("run", other.to_string())),
+    };
+    let longest_step = 0.25;
+    let key = match &error {
+        OverBudget::Samples { .. } if sample_every_given => "run.sample_every".to_string(),
+        OverBudget::Samples { .. } => "run.t_end".to_string(),
+        OverBudget::Steps { .. } if scenario.t_end / longest_step > MAX_STEPS as f64 => {
+            "run.t_end".to_string()
+        }
+        OverBudget::Steps { set_by, .. } => match set_by {
+            StepSetBy::Dt => "run.dt".to_string(),
+            StepSetBy::Tolerance => "run.tolerance".to_string(),
+            StepSetBy::Resonator(i) => format!("defect[{i}]"),
+            StepSetBy::Contacts => "chain".to_string(),
+        },
+    };
+    Err(invalid(key, error.to_string()))
+}
+
+/// The paper's region (Eqs. 10 and 11) spans the defects and one neighbour on each side, [min - 1, max + 1]
+/// (adjacent defects 0..L give [-1, L + 1]; separated d1 < d2 give [d1 - 1, d2 + 1]). Without
+/// defects, the single-defect region [-1, 1].
+fn default_region(defects: &[raw::Defect]) -> [i64; 2] {
+    let sites = defects.iter().filter_map(|d| d.site);
+    let lo = sites.clone().min().unwrap_or(0);
+    let hi = sites.max().unwrap_or(0);
+    [lo - 1, hi + 1]
+}
