@@ -314,3 +314,109 @@ sample_every = 0.05
         "the heavy striker kept {striker_share}"
     );
 }
+
+/// Each refusal names its key: the scene format's contract for the chain's new keys.
+#[test]
+fn bad_chains_are_refused_naming_the_key() {
+    let key_of = |text: &str| match woodpile_scene::parse(text, Path::new("s.toml")) {
+        Err(woodpile_scene::SceneError::Invalid { key, .. }) => key,
+        other => panic!("expected an invalid key for {text:?}, got {other:?}"),
+    };
+    let striker = "[striker]\nmass = 2.0\n";
+    let free_left = "[chain]\nboundary = { left = \"free\", right = \"fixed\" }\n";
+    let cases = [
+        ("[chain]\nboundary = \"free\"\nprecompression = 1.0\n", "chain.precompression"),
+        (
+            "[chain]\nboundary = { left = \"free\", right = \"fixed\" }\nprecompression = 1.0\n[striker]\nmass = 2.0\n",
+            "chain.precompression",
+        ),
+        (striker, "striker"),
+        (&format!("{free_left}{striker}[impulse]\nsite = 0\n"), "impulse"),
+        (
+            "[[segment]]\nsites = [0, 10]\nmass = 2.0\n[[segment]]\nsites = [10, 20]\nmass = 1.0\n",
+            "segment[1].sites",
+        ),
+        ("[[segment]]\nsites = [90, 101]\nmass = 2.0\n", "segment[0].sites"),
+        ("[[segment]]\nsites = [0, 3]\nmass = [1.0, 0.0]\n", "segment[0].mass[1]"),
+        ("[[segment]]\nsites = [0, 3]\ncontact = -1.0\n", "segment[0].contact"),
+        ("[chain]\nexponent = 0.5\n", "chain.exponent"),
+        ("[chain]\nexponent = 6.0\n", "chain.exponent"),
+        ("[chain]\nexponent = nan\n", "chain.exponent"),
+        ("[chain]\nwall_contact = 0.0\n", "chain.wall_contact"),
+        ("[chain]\nprecompression = -1.0\n", "chain.precompression"),
+        ("[chain]\nboundary = { left = \"free\", right = \"sticky\" }\n", "chain.boundary.right"),
+        (&format!("{free_left}[striker]\nmass = -2.0\n"), "striker.mass"),
+        (&format!("{free_left}[striker]\nvelocity = 1.0\n"), "striker.mass"),
+        (
+            "[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[[defect]]\nsite = 0\nmass = 1e-3\nresonator_mass = 1e-3\nstiffness = 1e6\n[[segment]]\nsites = [-2, 2]\nmass = 2e-3\n",
+            "segment[0].mass",
+        ),
+        (
+            "[physical]\nvelocity = 1.0\nmaterial = { youngs_modulus = 72e9, poisson_ratio = 0.17, density = 2200.0 }\nrod = { length = 0.02, diameter = 0.005 }\n[[defect]]\nsite = 0\nrod = { length = 0.04 }\nresonator_share = 1.5\n",
+            "defect[0].resonator_share",
+        ),
+        (
+            "[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[[defect]]\nsite = 0\nrod = { length = 0.04 }\n",
+            "defect[0].rod.diameter",
+        ),
+        (
+            "[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[chain]\nexponent = 2.0\n",
+            "chain.exponent",
+        ),
+    ];
+    for (text, key) in cases {
+        assert_eq!(key_of(text), key, "for {text:?}");
+    }
+}
+
+/// The woodpile as the experiment built it, from geometry: the rods' mass and coefficient, the
+/// 40 mm defect's bending mode, and the glass sphere's contact, listed in the scene's physical
+/// values.
+#[test]
+fn rods_and_a_sphere_from_their_geometry() {
+    let scene = scene(
+        r#"
+[chain]
+sites = [-20, 19]
+boundary = { left = "free", right = "fixed" }
+[physical]
+material = { youngs_modulus = 72e9, poisson_ratio = 0.17, density = 2200.0 }
+rod = { length = 0.02, diameter = 0.005 }
+[striker]
+velocity = 1.98
+sphere = { diameter = 0.01, material = { youngs_modulus = 70e9, poisson_ratio = 0.23, density = 2500.0 } }
+[[defect]]
+site = 0
+rod = { length = 0.04 }
+[run]
+t_end = 60.0
+tolerance = 1e-6
+"#,
+    );
+    let physical = scene.physical.as_ref().unwrap();
+    let value = |name: &str| {
+        physical
+            .derived
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("no {name}"))
+            .1
+    };
+    assert!((value("contact_N_per_m1.5") - 2.47e9).abs() < 0.005 * 2.47e9);
+    // The sphere (1.31 g) is about one and a half regular rods (0.864 g).
+    let striker_mass = value("striker_mass");
+    assert!(
+        (striker_mass - 1.309 / 0.8639).abs() < 0.01,
+        "{striker_mass}"
+    );
+    let defect = physical.defects[0];
+    assert!((defect.bending_f1_hz.unwrap() - 15.2e3).abs() < 0.02 * 15.2e3);
+    assert!(
+        (defect.eps - 0.894 / 0.8639).abs() < 0.01,
+        "eps {}",
+        defect.eps
+    );
+    let out = simulate(&scene.scenario, &mut ()).unwrap();
+    let f = out.fractions;
+    assert!((f.reflected + f.transmitted + f.trapped + f.striker - 1.0).abs() < 1e-12);
+}
