@@ -70,8 +70,9 @@ bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, batc
 	$(CARGO) run --release -q -p woodpile-bench --example batch_lanes -- 16 0.215
 	$(CARGO) bench -p woodpile-bench
 
-audit: ## auto against an independent reference on 200 random scenes at 1e-5..1e-8 (about 7 min)
+audit: ## auto against an independent reference: 200 random scenes at 1e-5..1e-8, then 100 of the experiment's chain (about 12 min)
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
+	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --chain 100 2026 1e-5,1e-6,1e-7,1e-8
 
 work-precision: ## Error in E_tr against wall time for every method and step (README table)
 	$(CARGO) run --release -p woodpile-sim --example work_precision

@@ -12,8 +12,13 @@
 //! (a second method of another order and quadrature); their difference is the reference's
 //! error bound, reported per scene.
 //!
+//! With `--chain` first, the scenes are those of the experiment's chain
+//! (`woodpile_sim::testing::chain_audit_scene`): the same draws given another contact exponent,
+//! masses and contact coefficients in a repeated pattern, wall contacts, and a precompression
+//! or a striker.
+//!
 //! ```text
-//! cargo run --release -p woodpile-bench --example auto_audit [-- SCENES [SEED [TOLERANCES [ONLY]]]]
+//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain] SCENES [SEED [TOLERANCES [ONLY]]]]
 //! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
@@ -24,7 +29,7 @@ use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::Coupling;
 use woodpile_sim::run::{simulate, Scenario};
 use woodpile_sim::testing::{
-    audit_scene as random_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT as REFERENCE_DT,
+    audit_scene, chain_audit_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT as REFERENCE_DT,
 };
 use woodpile_sim::SimError;
 
@@ -122,7 +127,14 @@ fn audit(k: usize, scene: &Scenario, tolerances: &[f64]) -> Audit {
 }
 
 fn main() {
-    let mut args = std::env::args().skip(1);
+    let mut args = std::env::args().skip(1).peekable();
+    let draw: fn(&mut Lcg) -> Scenario = match args.peek().map(String::as_str) {
+        Some("--chain") => {
+            args.next();
+            chain_audit_scene
+        }
+        _ => audit_scene,
+    };
     let n: usize = args.next().map_or(200, |s| s.parse().unwrap());
     let seed: u64 = args.next().map_or(2026, |s| s.parse().unwrap());
     let tolerances: Vec<f64> = args.next().map_or(vec![1e-5, 1e-6, 1e-7, 1e-8], |s| {
@@ -134,7 +146,7 @@ fn main() {
         .map(|s| s.split(',').map(|k| k.parse().unwrap()).collect());
     let mut rng = Lcg(seed);
     let scenes: Vec<(usize, Scenario)> = (0..n)
-        .map(|k| (k, random_scene(&mut rng)))
+        .map(|k| (k, draw(&mut rng)))
         .filter(|(k, _)| only.as_ref().is_none_or(|o| o.contains(k)))
         .collect();
     let audits = on_two_cores(&scenes, |(k, scene)| audit(*k, scene, &tolerances));

@@ -311,3 +311,66 @@ pub fn audit_scene_at(seed: u64, k: usize) -> Scenario {
     }
     audit_scene(&mut rng)
 }
+
+/// One scene of the audit of the experiment's chain (`auto_audit --chain`): an audit scene
+/// ([`audit_scene`]) given, with further draws, every feature of a [`crate::ContactLaw`] and a
+/// striker: an exponent from 1 to 3, a repeated pattern of two masses (ratio 0.3 to 3) and two
+/// contact coefficients (0.5 to 2), wall contacts (0.5 to 2), and either a precompression
+/// (F0 from 1e-3 to 0.5, on a walled chain) or, on a third of the rest, a striker (mass 0.3 to
+/// 10, contact 0.5 to 2) at a free left end in place of the impulse.
+pub fn chain_audit_scene(rng: &mut Lcg) -> Scenario {
+    let base = audit_scene(rng);
+    let exponent = 1.0 + 2.0 * rng.uniform();
+    let masses = [1.0, rng.log_uniform(0.3, 3.0)];
+    let contacts = [rng.log_uniform(0.5, 2.0), rng.log_uniform(0.5, 2.0)];
+    let wall = rng.log_uniform(0.5, 2.0);
+    let precompress = rng.uniform() < 0.5;
+    let f0 = rng.log_uniform(1e-3, 0.5);
+    let strike = !precompress && rng.uniform() < 1.0 / 3.0;
+    let (striker_mass, striker_contact) = (rng.log_uniform(0.3, 10.0), rng.log_uniform(0.5, 2.0));
+
+    let old = &base.model;
+    let shift = usize::from(strike);
+    let n_sites = old.n_sites() + shift;
+    let boundary = match (strike, precompress) {
+        (true, _) => Boundary::ends(crate::End::Free, old.boundary().right()),
+        (false, true) => Boundary::Fixed,
+        (false, false) => old.boundary(),
+    };
+    let mut site_masses: Vec<f64> = (0..n_sites).map(|i| masses[i % 2]).collect();
+    let mut coefficients: Vec<f64> = (0..=n_sites).map(|b| contacts[b % 2]).collect();
+    (coefficients[0], coefficients[n_sites]) = (wall, wall);
+    if strike {
+        site_masses[0] = striker_mass;
+        coefficients[1] = striker_contact;
+    }
+    let resonators = old
+        .resonators()
+        .iter()
+        .map(|r| Resonator {
+            site: r.site + shift,
+            ..*r
+        })
+        .collect();
+    let law = crate::ContactLaw::new(coefficients, exponent, if precompress { f0 } else { 0.0 })
+        .expect("a valid survey contact law");
+    let model = Model::with_masses(n_sites, boundary, resonators, Some(site_masses))
+        .and_then(|m| m.with_contacts(law))
+        .expect("a valid survey model");
+    let region = Region::new(
+        (base.region.lo() + shift) as i64,
+        (base.region.hi() + shift) as i64,
+        n_sites,
+    )
+    .expect("a valid survey region");
+    Scenario {
+        model,
+        impulse_site: if strike { 0 } else { base.impulse_site },
+        region: if strike {
+            region.with_striker().expect("a region right of the striker")
+        } else {
+            region
+        },
+        ..base
+    }
+}
