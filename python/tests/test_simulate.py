@@ -125,3 +125,29 @@ def test_help_reads_well():
     assert woodpile.sweep.__doc__ and woodpile.Pipeline.__doc__
     stub = Path(woodpile.__file__).with_name("_core.pyi")
     assert stub.is_file() and Path(woodpile.__file__).with_name("py.typed").is_file()
+
+
+STRUCK = {
+    "chain": {"n": 40, "boundary": {"left": "free", "right": "fixed"}, "exponent": 1.5},
+    "segment": [{"sites": [-40, 40], "mass": [1.0, 0.5], "contact": [1.0, 1.5]}],
+    "striker": {"mass": 3.0, "velocity": 1.0, "contact": 1.2},
+    "defect": [{"site": 0, "eps": 1.0}],
+    "run": {"t_end": 60.0, "tolerance": 1e-7},
+}
+
+
+def test_a_striker_reports_its_share_in_the_result_and_the_series():
+    r = woodpile.simulate(STRUCK)
+    assert r.S is not None and 0.0 <= r.S <= 1.0
+    assert abs(r.R + r.T + r.E_tr + r.S - 1.0) < 1e-12
+    assert list(r.series.columns) == ["t", "R", "T", "E_tr", "S", "E"]
+    assert r.series["S"].iloc[-1] == r.S
+    # A scene without a striker has no S.
+    plain = woodpile.simulate(STANDARD)
+    assert plain.S is None and "S" not in plain.series.columns
+
+
+def test_a_bad_chain_key_is_a_scene_error_naming_it():
+    scene = dict(STRUCK, chain={"n": 40, "boundary": "fixed"})
+    with pytest.raises(woodpile.SceneError, match="striker"):
+        woodpile.simulate(scene)

@@ -103,3 +103,16 @@ def test_ctrl_c_raises_keyboard_interrupt_inside_one_long_simulation():
             woodpile.simulate(scene)
     finally:
         timer.cancel()
+
+
+def test_a_sweep_over_a_striker_key_matches_simulate():
+    template = {
+        "chain": {"n": 40, "boundary": {"left": "free", "right": "fixed"}},
+        "striker": {"mass": "$mass", "velocity": 1.0},
+        "defect": [{"site": 0, "eps": 1.0}],
+        "run": {"t_end": 50.0, "tolerance": 1e-6},
+    }
+    table = woodpile.sweep(template, {"mass": [1.0, 10.0]})
+    assert table.failure.isna().all()
+    heavy = woodpile.simulate(dict(template, striker={"mass": 10.0, "velocity": 1.0}))
+    assert (table.iloc[1].R, table.iloc[1].E_tr) == (heavy.R, heavy.E_tr)
