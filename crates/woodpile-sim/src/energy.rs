@@ -120,6 +120,15 @@ impl Fractions {
     }
 }
 
+/// The potential of bond `bond` (numbering of [`crate::contact`]) at relative displacement
+/// `r`: the paper's (2/5) [r]_+^{5/2}, or the chain's [`crate::ContactLaw`].
+fn bond_potential(model: &Model, bond: usize, r: f64) -> f64 {
+    match model.contacts() {
+        None => hertz_potential(r),
+        Some(law) => law.potential(bond, r),
+    }
+}
+
 /// Energy density per site (length `n_sites`) of state `y` at time `t`, written into `density`.
 pub fn energy_density(model: &Model, t: f64, y: &[f64], density: &mut [f64]) {
     let n_sites = model.n_sites();
@@ -128,10 +137,7 @@ pub fn energy_density(model: &Model, t: f64, y: &[f64], density: &mut [f64]) {
     let u = &q[..n_sites];
     kinetic_density(model, y, density);
     let boundary = model.boundary();
-    let potential = |bond: usize, r: f64| match model.contacts() {
-        None => hertz_potential(r),
-        Some(law) => law.potential(bond, r),
-    };
+    let potential = |bond: usize, r: f64| bond_potential(model, bond, r);
     for bond in 0..n_sites - 1 {
         let half = 0.5 * potential(bond + 1, u[bond] - u[bond + 1]);
         density[bond] += half;
@@ -175,10 +181,7 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
     for (site, w) in qdot[..n_sites].iter().enumerate() {
         e += 0.5 * model.site_mass(site) * w * w;
     }
-    let potential = |bond: usize, r: f64| match model.contacts() {
-        None => hertz_potential(r),
-        Some(law) => law.potential(bond, r),
-    };
+    let potential = |bond: usize, r: f64| bond_potential(model, bond, r);
     for bond in 0..n_sites - 1 {
         e += potential(bond + 1, u[bond] - u[bond + 1]);
     }

@@ -367,7 +367,9 @@ pub fn chain_audit_scene(rng: &mut Lcg) -> Scenario {
         model,
         impulse_site: if strike { 0 } else { base.impulse_site },
         region: if strike {
-            region.with_striker().expect("a region right of the striker")
+            region
+                .with_striker()
+                .expect("a region right of the striker")
         } else {
             region
         },
