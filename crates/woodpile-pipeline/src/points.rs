@@ -8,7 +8,8 @@
 //!
 //! The format is private to this module (the stage outputs are the public parquet): magic
 //! `WPPT`, a format byte, the 64-hex key, the outcome, then the checksum. Floats are stored as
-//! their exact bits.
+//! their exact bits. A point's series are five columns (t, R, T, E_tr, E), or six with a
+//! striker's S: the length tells which, so points without a striker keep their bytes.
 
 use std::path::{Path, PathBuf};
 
@@ -59,6 +60,9 @@ pub struct PointData {
     pub trapped: Vec<f64>,
     /// E(t).
     pub energy: Vec<f64>,
+    /// S(t), the striker's share: only for a scene with a striker, so that a paper point's
+    /// data (and file) is what it was before strikers existed.
+    pub striker: Option<Vec<f64>>,
 }
 
 /// Which energy a sweep's fractions split.
@@ -118,6 +122,7 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
         reflected: series.reflected,
         transmitted: series.transmitted,
         trapped: series.trapped,
+        striker: s.region.has_striker().then_some(series.striker),
         energy: series.energy,
     })
 }
@@ -260,7 +265,8 @@ fn encode(key: &Key, result: &PointResult) -> Vec<u8> {
             put_f64(&mut w, p.e_initial);
             put_f64(&mut w, p.e_final);
             w.extend_from_slice(&(p.t.len() as u64).to_le_bytes());
-            for column in [&p.t, &p.reflected, &p.transmitted, &p.trapped, &p.energy] {
+            let columns = [&p.t, &p.reflected, &p.transmitted, &p.trapped, &p.energy];
+            for column in columns.into_iter().chain(&p.striker) {
                 column.iter().for_each(|&x| put_f64(&mut w, x));
             }
         }
@@ -298,9 +304,11 @@ fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
             let (steps, rhs_evals) = (r.u64()?, r.u64()?);
             let (e_initial, e_final) = (r.f64()?, r.f64()?);
             let n = usize::try_from(r.u64()?).ok()?;
-            if r.bytes.len() != n.checked_mul(5 * 8)? {
-                return None;
-            }
+            let with_striker = match r.bytes.len() {
+                len if len == n.checked_mul(5 * 8)? => false,
+                len if len == n.checked_mul(6 * 8)? => true,
+                _ => return None,
+            };
             let mut column = || (0..n).map(|_| r.f64()).collect::<Option<Vec<f64>>>();
             Ok(PointData {
                 method,
@@ -316,6 +324,10 @@ fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
                 transmitted: column()?,
                 trapped: column()?,
                 energy: column()?,
+                striker: match with_striker {
+                    true => Some(column()?),
+                    false => None,
+                },
             })
         }
         _ => return None,
@@ -367,6 +379,7 @@ mod tests {
             transmitted: vec![0.0, 0.2],
             trapped: vec![1.0, 0.7],
             energy: vec![0.5, 0.5],
+            striker: None,
         }
     }
 
@@ -406,6 +419,19 @@ mod tests {
             .save(&failed, &Err("blew up at t = 3".into()))
             .unwrap();
         assert_eq!(store.load(&failed), Some(Err("blew up at t = 3".into())));
+    }
+
+    /// A striker's S is a sixth column, read back as such; a point without one keeps five.
+    #[test]
+    fn a_strikers_share_round_trips() {
+        let (_dir, store, _) = store_with_sample("five");
+        let key = Key::of(&serde_json::json!("six"));
+        let with = PointData {
+            striker: Some(vec![0.0, 0.25]),
+            ..sample()
+        };
+        store.save(&key, &Ok(with.clone())).unwrap();
+        assert_eq!(store.load(&key), Some(Ok(with)));
     }
 
     #[test]

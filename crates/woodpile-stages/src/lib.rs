@@ -25,6 +25,7 @@ pub mod spacetime;
 pub mod stability;
 pub mod sweep;
 pub mod table;
+pub mod vary;
 pub mod workprecision;
 
 /// Every kind, in pipeline order: its name in stage files, and its parser.
@@ -51,6 +52,7 @@ pub static KINDS: &Registry = &[
     }),
     ("design", |f, _| Ok(Arc::new(design::Design::parse(f)?))),
     ("table", |f, _| Ok(Arc::new(table::Table::parse(f)?))),
+    ("vary", |f, _| Ok(Arc::new(vary::Vary::parse(f)?))),
 ];
 
 /// The name of every kind, in pipeline order.

@@ -16,7 +16,8 @@
 //!
 //! An optional `series = "kinetic"` records kinetic-energy shares divided by the impact energy
 //! (what the woodpile experiment measures, paper Fig. 2 c, f) instead of total-energy fractions;
-//! the columns keep their names (`R`, `T`, `E_tr`, `E`).
+//! the columns keep their names (`R`, `T`, `E_tr`, `E`). Scenes with a `[striker]` add the
+//! striker's share `S` after `E_tr` (R + T + E_tr + S = 1).
 //!
 //! Points are cached one by one in the [`PointStore`] under the key of their resolved scene,
 //! so a sweep resumes after a kill and sweeps that share scenes share the work. Points are
@@ -57,6 +58,8 @@ pub struct Sweep {
     pub series: Series,
     template: Template,
     file: PathBuf,
+    /// Whether its scenes have a striker: the table then has the striker's share `S`.
+    with_striker: bool,
 }
 
 impl Sweep {
@@ -76,21 +79,45 @@ impl Sweep {
             }
         };
         let scene: toml::Table = fields.required("scene")?;
-        let template =
-            Template::new(scene, &axes).map_err(|(key, reason)| fields.error(&key, reason))?;
-        let sweep = Sweep {
-            axes,
-            series,
-            template,
-            file: fields.file().to_path_buf(),
-        };
-        // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
-        // the grid exercise the extremes of every axis.
-        sweep.scene_at(0)?;
+        let sweep = Sweep::over(axes, series, scene, fields.file())?;
         let last = sweep.scene_at(sweep.count() - 1)?;
         woodpile_scene::grid::check_sweep_memory(sweep.count(), &last)
             .map_err(|reason| fields.error("axes", reason))?;
         Ok(sweep)
+    }
+
+    /// The sweep of `scene` (a scene table with "$axis" placeholders, from `file`) over
+    /// `axes`, checked at the corners of the grid.
+    pub fn over(
+        axes: Vec<Axis>,
+        series: Series,
+        scene: toml::Table,
+        file: &std::path::Path,
+    ) -> Result<Sweep> {
+        let template = Template::new(scene, &axes).map_err(|(key, reason)| {
+            PipelineError::Definition {
+                file: file.to_path_buf(),
+                key,
+                reason,
+                source: None,
+            }
+        })?;
+        let sweep = Sweep {
+            axes,
+            series,
+            template,
+            file: file.to_path_buf(),
+            with_striker: false,
+        };
+        // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
+        // the grid exercise the extremes of every axis. A placeholder cannot add or remove a
+        // table, so the first scene says whether every scene has a striker.
+        let with_striker = sweep.scene_at(0)?.scenario.region.has_striker();
+        sweep.scene_at(sweep.count() - 1)?;
+        Ok(Sweep {
+            with_striker,
+            ..sweep
+        })
     }
 
     /// Number of grid points.
@@ -211,6 +238,7 @@ impl Sweep {
                     key,
                     result,
                     sample: k,
+                    with_striker: self.with_striker,
                 });
             }
         }
@@ -226,6 +254,7 @@ struct SampleRow<'a> {
     key: &'a Key,
     result: &'a PointResult,
     sample: usize,
+    with_striker: bool,
 }
 
 impl Row for SampleRow<'_> {
@@ -249,6 +278,12 @@ impl Row for SampleRow<'_> {
                 at(|p| &p.transmitted).into(),
             ),
             (Fraction::Trapped.column(), at(|p| &p.trapped).into()),
+        ]);
+        if self.with_striker {
+            let share = ok.and_then(|p| p.striker.as_ref().map(|s| s[self.sample]));
+            cells.push((columns::STRIKER, share.into()));
+        }
+        cells.extend([
             (columns::ENERGY, at(|p| &p.energy).into()),
             (columns::METHOD, ok.map(|p| p.method.clone()).into()),
             (columns::DT, ok.and_then(|p| p.dt).into()),

@@ -61,7 +61,7 @@ fn assert_generated(path: &Path, expected: &str, stale: &str) {
 }
 
 /// The accuracy each README figure was computed to: for every stage upstream of the figure that
-/// simulates (sweeps, space-time maps, the design search), the tolerance and the largest error
+/// simulates (sweeps, space-time maps, varied optima, the design search), the tolerance and the largest error
 /// estimate its manifest in `results/` records. `None` for a figure with no such stage.
 fn accuracy_caption(
     pipeline: &woodpile_pipeline::Pipeline,
@@ -84,7 +84,7 @@ fn accuracy_caption(
                 .unwrap_or_else(|| panic!("results/{name}.parquet has no manifest"));
             let number = |key: &str| manifest.summary.get(key).and_then(|v| v.as_f64());
             match manifest.kind.as_str() {
-                "sweep" | "spacetime" => Some(format!(
+                "sweep" | "spacetime" | "vary" => Some(format!(
                     "`{name}` at tolerance {:e}, largest error estimate {:.1e}",
                     number("tolerance")?,
                     number("max_error_estimate")?

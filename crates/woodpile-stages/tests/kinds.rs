@@ -260,3 +260,78 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
     std::fs::remove_file(&best).unwrap();
     assert!(matches!(p.state("trap"), State::Stale(_)));
 }
+
+/// The optimum of [`single_defect_sweep_to`]`(3.0)` varied: squeezed by a precompression, and
+/// struck by a body instead of given a velocity.
+fn vary_project(vary: &str) -> Project {
+    let coarse = single_defect_sweep_to(3.0);
+    let optimum = "kind = \"optimize\"\ninputs = [\"at_end\"]\nover = [\"eps\"]\ntolerance = 1e-7\n";
+    Project::new(&[
+        ("sweep", &coarse),
+        ("at_end", REDUCE),
+        ("optimum", optimum),
+        ("varied", vary),
+    ])
+}
+
+const PRECOMPRESSED: &str = r#"
+kind = "vary"
+inputs = ["optimum"]
+[axes]
+F0 = [0.0, 0.5]
+[set]
+chain = { boundary = "fixed", precompression = "$F0" }
+"#;
+
+/// A vary stage simulates an optimum's best scene with `[set]` laid over it: at F0 = 0 it is
+/// the best scene itself (the optimum's own E_tr, which the optimiser computed on its own), a
+/// precompression changes it, and a striker's table carries S with R + T + E_tr + S = 1.
+#[test]
+fn vary_simulates_a_best_scene_with_set_laid_over_it() {
+    let p = vary_project(PRECOMPRESSED);
+    p.counted(&[]);
+    let best = table::read(&p.output("optimum")).unwrap();
+    let best_e_tr = table::f64_column(&best, "E_tr").unwrap()[1].unwrap();
+    let out = table::read(&p.output("varied")).unwrap();
+    let design = table::str_column(&out, "design").unwrap();
+    assert!(design.iter().all(|d| d.as_deref() == Some("optimum")));
+    let (f0, t) = (table::f64_column(&out, "F0").unwrap(), table::f64_column(&out, "t").unwrap());
+    let e_tr = table::f64_column(&out, "E_tr").unwrap();
+    let at_end = |f: f64| (0..out.height()).find(|&r| f0[r] == Some(f) && t[r] == Some(12.0)).unwrap();
+    assert_eq!(e_tr[at_end(0.0)], Some(best_e_tr), "F0 = 0 is the best scene itself");
+    assert!((e_tr[at_end(0.5)].unwrap() - best_e_tr).abs() > 1e-3, "a precompression changes it");
+
+    let struck = r#"
+kind = "vary"
+inputs = ["optimum"]
+unset = ["impulse", "chain.n"]
+[axes]
+M = [1.0, 4.0]
+[set]
+chain = { sites = [-5, 12], boundary = { left = "free", right = "fixed" } }
+striker = { mass = "$M", velocity = 1.0 }
+"#;
+    let p = vary_project(struck);
+    p.counted(&[]);
+    let out = table::read(&p.output("varied")).unwrap();
+    let sum: Vec<f64> = ["R", "T", "E_tr", "S"]
+        .iter()
+        .map(|c| table::f64_column(&out, c).unwrap())
+        .fold(vec![0.0; out.height()], |acc, col| {
+            acc.iter().zip(col).map(|(a, x)| a + x.unwrap()).collect()
+        });
+    assert!(sum.iter().all(|s| (s - 1.0).abs() < 1e-9), "{sum:?}");
+}
+
+/// What a vary stage refuses: an input that found no best scene, a placeholder naming no axis
+/// (at load), and a key to unset that the best scene does not have (when it runs).
+#[test]
+fn vary_refuses_what_it_cannot_vary() {
+    let e = load_error(&[("sweep", SWEEP), ("varied", &PRECOMPRESSED.replace("optimum", "sweep"))]);
+    assert!(e.contains("varied.toml") && e.contains("optimize or design stages"), "{e}");
+    let e = load_error(&[("sweep", SWEEP), ("varied", &PRECOMPRESSED.replace("\"$F0\"", "\"$F1\""))]);
+    assert!(e.contains("set.chain.precompression") && e.contains("`$F1` names no axis"), "{e}");
+    let p = vary_project(&PRECOMPRESSED.replace("[axes]", "unset = [\"run.sample_evry\"]\n[axes]"));
+    let e = p.run(&[]).unwrap_err().to_string();
+    assert!(e.contains("`run.sample_evry` names no key of `optimum`'s best scene"), "{e}");
+}

@@ -5,11 +5,20 @@ use polars::prelude::*;
 
 use crate::error::{PipelineError, Result};
 
-/// A column of `frame` as floats (integers converted), nulls kept.
+/// A column of `frame` as floats (integers converted), nulls kept. A text column is refused:
+/// cast, its every value would read as null and a figure would silently draw nothing.
 pub fn f64_column(frame: &DataFrame, name: &str) -> Result<Vec<Option<f64>>> {
     let column = frame
         .column(name)
-        .map_err(|_| PipelineError::stage("table", missing_column(frame, name)))?
+        .map_err(|_| PipelineError::stage("table", missing_column(frame, name)))?;
+    let dtype = column.dtype();
+    if !(dtype.is_primitive_numeric() || dtype.is_bool() || dtype.is_null()) {
+        return Err(PipelineError::stage(
+            "table",
+            format!("column `{name}` holds {}, not numbers", column.dtype()),
+        ));
+    }
+    let column = column
         .cast(&DataType::Float64)
         .map_err(|e| PipelineError::stage("table", format!("column `{name}`: {e}")))?;
     let values = column

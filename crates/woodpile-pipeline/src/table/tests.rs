@@ -38,6 +38,14 @@ fn rows_make_typed_columns_and_mixed_kinds_are_an_error() {
     assert!(e.to_string().contains("`x` mixes"), "{e}");
 }
 
+/// Text read as numbers is refused, not cast to nulls (a figure of it drew nothing, silently).
+#[test]
+fn a_text_column_is_not_read_as_numbers() {
+    let frame = rows_frame(&[Pair(1, None, true)]).unwrap();
+    let e = f64_column(&frame, "x").unwrap_err();
+    assert!(e.to_string().contains("column `x` holds str, not numbers"), "{e}");
+}
+
 /// `columns` written as a sealed table in a fresh temporary folder (kept alive by the returned
 /// guard): the folder, the table's path and the frame written.
 fn written(columns: &mut Columns) -> (tempfile::TempDir, std::path::PathBuf, DataFrame) {

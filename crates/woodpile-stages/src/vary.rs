@@ -1,0 +1,218 @@
+//! `kind = "vary"`: the best scenes that `optimize` and `design` stages found, varied along
+//! axes their searches did not have (a precompression, a striker's mass). Each input's
+//! `results/<stage>.best.toml` gets `[set]` laid over it and its `unset` keys removed, and is
+//! then simulated at every point of `[axes]`, as a sweep would.
+//!
+//! ```toml
+//! kind = "vary"
+//! inputs = ["f7_coarse_optimum", "trap_design"]   # optimize or design stages
+//! unset = ["impulse"]                             # optional: dotted keys of the best scenes to drop
+//! [axes]
+//! M = { from = 1.0, to = 100.0, count = 9, log = true }
+//! [set]                                           # laid over each best scene, "$axis" placeholders
+//! striker = { mass = "$M", velocity = 1.0 }
+//! chain = { boundary = { left = "free", right = "fixed" } }
+//! ```
+//!
+//! `[set]` merges into the best scene table by table: a key inside a table that both have
+//! replaces only that key, and any other value (arrays of tables such as `[[defect]]`
+//! included) replaces the best scene's whole value. An `unset` key that the best scene does not
+//! have is an error, so that a misspelt key cannot silently leave the scene as it was.
+//!
+//! Output: each input's sweep table (one row per sample of each point, `S` after `E_tr` with a
+//! striker), stacked in the order of `inputs`, after a `design` column naming the input stage
+//! and `design_index`, its place in `inputs` (a figure draws a curve per design with `series =
+//! "design_index"` and `series_label = "design"`).
+//! Points are cached and shared as a sweep's are.
+
+use std::path::Path;
+
+use polars::prelude::{Column, DataFrame};
+use serde_json::json;
+use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::grid::{parse_axes, Axis};
+use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck, PointGrid, PointsAt};
+use woodpile_pipeline::points::{PointStats, Series};
+use woodpile_pipeline::stage::Stage;
+use woodpile_pipeline::template::Template;
+use woodpile_pipeline::Output;
+use woodpile_sim::integrate::MethodChoice;
+
+use crate::sweep::Sweep;
+
+/// The column naming the input stage whose best scene a row varies.
+pub const DESIGN: &str = "design";
+/// Its place in `inputs`, from 0: what a figure's `series` draws one curve per.
+pub const DESIGN_INDEX: &str = "design_index";
+
+/// A parsed vary stage.
+#[derive(Debug, Clone)]
+pub struct Vary {
+    axes: Vec<Axis>,
+    set: toml::Table,
+    unset: Vec<String>,
+    file: std::path::PathBuf,
+}
+
+impl Vary {
+    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Vary> {
+        let table: toml::Table = fields.required("axes")?;
+        let axes = parse_axes(fields.nested("axes", table))?;
+        let set: toml::Table = fields.required("set")?;
+        // Every placeholder names an axis and every axis is used, before any input exists.
+        Template::new(set.clone(), &axes).map_err(|(key, reason)| {
+            let key = key.strip_prefix("scene").map_or(key.clone(), |k| format!("set{k}"));
+            fields.error(&key, reason)
+        })?;
+        let unset: Vec<String> = fields.optional("unset")?.unwrap_or_default();
+        if let Some(bad) = unset.iter().find(|k| k.split('.').any(str::is_empty)) {
+            return Err(fields.error("unset", format!("`{bad}` is not a dotted key")));
+        }
+        Ok(Vary {
+            axes,
+            set,
+            unset,
+            file: fields.file().to_path_buf(),
+        })
+    }
+
+    /// The sweep of `design`'s best scene (in `results`), varied.
+    fn sweep_of(&self, stage: &str, design: &str, results: &Path) -> Result<Sweep> {
+        let path = woodpile_pipeline::layout::best_path(results, design);
+        let text = woodpile_scene::read_input(&path)
+            .map_err(|reason| PipelineError::stage(stage, format!("{}: {reason}", path.display())))?;
+        let mut scene: toml::Table = toml::from_str(&text)
+            .map_err(|e| PipelineError::stage(stage, format!("{}: {e}", path.display())))?;
+        for key in &self.unset {
+            remove_dotted(&mut scene, key).map_err(|reason| {
+                PipelineError::stage(stage, format!("unset: `{key}` {reason} of `{design}`'s best scene"))
+            })?;
+        }
+        overlay(&mut scene, &self.set);
+        Sweep::over(self.axes.clone(), Series::Energy, scene, &self.file).map_err(|e| {
+            PipelineError::stage(stage, format!("`{design}`'s best scene, varied: {e}"))
+        })
+    }
+}
+
+/// Lays `set` over `base`: tables that both have merge key by key, anything else replaces.
+fn overlay(base: &mut toml::Table, set: &toml::Table) {
+    for (key, value) in set {
+        match (base.get_mut(key), value) {
+            (Some(toml::Value::Table(inner)), toml::Value::Table(over)) => overlay(inner, over),
+            _ => {
+                base.insert(key.clone(), value.clone());
+            }
+        }
+    }
+}
+
+/// Removes the dotted `key` from `table`; the error says why it could not.
+fn remove_dotted(table: &mut toml::Table, key: &str) -> std::result::Result<(), &'static str> {
+    match key.split_once('.') {
+        None => table.remove(key).map(|_| ()).ok_or("names no key"),
+        Some((head, rest)) => match table.get_mut(head) {
+            Some(toml::Value::Table(inner)) => remove_dotted(inner, rest),
+            _ => Err("names no table"),
+        },
+    }
+}
+
+/// `frame` with first columns `design` and `design_index` holding `name` and `index` on
+/// every row.
+fn with_design(frame: DataFrame, name: &str, index: usize) -> Result<DataFrame> {
+    let mut columns = vec![
+        Column::new(DESIGN.into(), vec![name; frame.height()]),
+        Column::new(DESIGN_INDEX.into(), vec![index as i64; frame.height()]),
+    ];
+    columns.extend(frame.columns().iter().cloned());
+    DataFrame::new_infer_height(columns).map_err(|e| PipelineError::stage(name, e.to_string()))
+}
+
+impl Kind for Vary {
+    fn check_inputs(&self, stage: &Stage, inputs: &Inputs<'_>) -> KindCheck {
+        let searches = ["optimize", "design"];
+        match stage.inputs.iter().find(|i| !searches.contains(&inputs.kind_of(i))) {
+            None if !stage.inputs.is_empty() => Ok(()),
+            _ => wrong_inputs("a vary stage reads one or more optimize or design stages, whose best scenes it varies"),
+        }
+    }
+
+    fn sharing(&self) -> woodpile_pipeline::kind::Sharing {
+        woodpile_pipeline::kind::Sharing::Parallel
+    }
+
+    fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let at = PointsAt {
+            stage: ctx.name(),
+            store: ctx.store,
+            events: ctx.events,
+        };
+        let mut stacked: Option<DataFrame> = None;
+        let mut stats = PointStats::default();
+        let mut tolerance = None;
+        for (index, design) in ctx.stage.inputs.iter().enumerate() {
+            let sweep = self.sweep_of(ctx.name(), design, ctx.results)?;
+            let all: Vec<usize> = (0..sweep.count()).collect();
+            let first = sweep.scene_at(0)?.scenario;
+            let asked = first.method == MethodChoice::Auto || first.accuracy.tolerance_explicit;
+            tolerance = tolerance.or(asked.then_some(first.accuracy.tolerance));
+            let (frame, part) = sweep.run_points(at, &all)?;
+            let frame = with_design(frame, design, index)?;
+            stats = stats.merge(part);
+            stacked = Some(match stacked {
+                None => frame,
+                Some(f) => f
+                    .vstack(&frame)
+                    .map_err(|e| PipelineError::stage(ctx.name(), e.to_string()))?,
+            });
+        }
+        let frame = stacked.ok_or_else(|| PipelineError::stage(ctx.name(), "no inputs"))?;
+        Ok(Output::table(
+            frame,
+            json!({
+                "points": stats.points,
+                "failed": stats.failed,
+                "designs": ctx.stage.inputs,
+                "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
+                "tolerance": tolerance,
+                "rhs_evals": stats.rhs_evals,
+                "max_error_estimate": stats.max_error_estimate,
+                "max_energy_drift": stats.max_energy_drift,
+            }),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> toml::Table {
+        toml::from_str(text).unwrap()
+    }
+
+    #[test]
+    fn set_merges_tables_and_replaces_everything_else() {
+        let mut base = table("chain = { n = 100, boundary = \"fixed\" }\n[[defect]]\nsite = 0\neps = 1.0\n");
+        overlay(
+            &mut base,
+            &table("chain = { precompression = 0.5 }\n[[defect]]\nsite = 3\neps = 2.0\n"),
+        );
+        assert_eq!(
+            base,
+            table("chain = { n = 100, boundary = \"fixed\", precompression = 0.5 }\n[[defect]]\nsite = 3\neps = 2.0\n")
+        );
+    }
+
+    #[test]
+    fn unset_removes_a_dotted_key_and_names_a_missing_one() {
+        let mut base = table("impulse = { site = -25 }\nrun = { t_end = 150.0, sample_every = 10.0 }\n");
+        remove_dotted(&mut base, "run.sample_every").unwrap();
+        remove_dotted(&mut base, "impulse").unwrap();
+        assert_eq!(base, table("run = { t_end = 150.0 }\n"));
+        assert_eq!(remove_dotted(&mut base, "run.tolerance"), Err("names no key"));
+        assert_eq!(remove_dotted(&mut base, "striker.mass"), Err("names no table"));
+    }
+}
