@@ -6,7 +6,7 @@ SCRATCH := scratch/check
 # Wall times (work-precision stages) belong to the machine that measured them: not compared.
 CHECK_TOL := --abs 1e-9 --rel 1e-9 --tol wall_ms=inf --tol log10_wall_ms=inf
 
-.PHONY: help build install audit test rust-test python python-test python-bench docs figures stage status check read-check bench work-precision lint old-cpu-test slurm-test
+.PHONY: help build install audit test rust-test python python-test python-bench docs figures stage status check read-check bench unused-cost work-precision lint old-cpu-test slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -68,7 +68,18 @@ bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, batc
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
 	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py
 	$(CARGO) run --release -q -p woodpile-bench --example batch_lanes -- 16 0.215
+	$(MAKE) --no-print-directory unused-cost
 	$(CARGO) bench -p woodpile-bench
+
+# The last commit before the experiment's chain (striker, precompression, segments, exponent).
+COST_BASE := b4562e1
+OLD_TARGET := $(abspath $(or $(CARGO_TARGET_DIR),target))/old
+
+unused-cost: build ## What the experiment chain's features cost scenes that do not use them: COST_BASE's binary against this one
+	rm -rf $(BASELINE)/old-src && mkdir -p $(BASELINE)/old-src
+	git archive $(COST_BASE) | tar -x -C $(BASELINE)/old-src
+	cd $(BASELINE)/old-src && CARGO_TARGET_DIR=$(OLD_TARGET) $(CARGO) build --release -q -p woodpile-cli
+	$(CARGO) run --release -q -p woodpile-bench --example unused_cost -- $(OLD_TARGET)/release/woodpile $(WOODPILE)
 
 audit: ## auto against an independent reference: 200 random scenes at 1e-5..1e-8, then 100 of the experiment's chain (about 12 min)
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8

@@ -6,6 +6,7 @@ use woodpile_sim::run::Scenario;
 use woodpile_sim::testing::Lcg;
 
 use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::pipeline::Pipeline;
 
 use crate::sweep::Sweep;
@@ -37,6 +38,33 @@ pub fn sampled_scenes(
     per_sweep: usize,
     seed: u64,
 ) -> Result<Vec<(String, Scenario)>> {
+    drawn(pipeline, sweeps, per_sweep, seed, |sweep, values| {
+        Ok(sweep.scene_with(values, None)?.scenario)
+    })
+}
+
+/// The scenes of [`sampled_scenes`] as scene files' tables (what `woodpile simulate` reads),
+/// for benchmarks that run a binary rather than the library.
+pub fn sampled_scene_tables(
+    pipeline: &Pipeline,
+    sweeps: &[(&str, &str)],
+    per_sweep: usize,
+    seed: u64,
+) -> Result<Vec<(String, toml::Table)>> {
+    drawn(pipeline, sweeps, per_sweep, seed, |sweep, values| {
+        sweep.table_with(values, None)
+    })
+}
+
+/// `per_sweep` rounds of one point of each sweep, drawn with `seed`, each given to `make` and
+/// labelled by the sweep and the values.
+fn drawn<T>(
+    pipeline: &Pipeline,
+    sweeps: &[(&str, &str)],
+    per_sweep: usize,
+    seed: u64,
+    make: impl Fn(&Sweep, &[AxisValue]) -> Result<T>,
+) -> Result<Vec<(String, T)>> {
     let mut rng = Lcg(seed);
     let mut scenes = Vec::with_capacity(per_sweep * sweeps.len());
     for _ in 0..per_sweep {
@@ -55,8 +83,7 @@ pub fn sampled_scenes(
                 .zip(&values)
                 .map(|(a, v)| format!("{}={v}", a.name))
                 .collect();
-            let scene = sweep.scene_with(&values, None)?;
-            scenes.push((format!("{label} {}", named.join(" ")), scene.scenario));
+            scenes.push((format!("{label} {}", named.join(" ")), make(sweep, &values)?));
         }
     }
     Ok(scenes)

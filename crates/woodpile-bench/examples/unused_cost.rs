@@ -1,0 +1,105 @@
+//! What the experiment's chain (a striker, precompression, segments, any exponent, per-end
+//! walls) costs the scenes that declare none of it: two `woodpile` binaries, one built before
+//! those features and one after, run on the same scene files side by side in one run.
+//!
+//! Scenes: the paper sample of `make bench` (8 seeded points each of F4, F7 coarse and F7
+//! fine, at the sweeps' own settings) and the standard scene (`scenes/single_eps10.toml`,
+//! `auto` at 1e-8). Each scene file is run by `woodpile simulate`, and its time is the
+//! simulation's own (`wall_s` in the JSON, without the process's start). The binaries alternate
+//! within every round, which side starts alternates between rounds, and each side's time is
+//! its best round. Both must print the same fractions, bit for bit: the paper's numbers do not
+//! change.
+//!
+//! ```text
+//! cargo run --release -p woodpile-bench --example unused_cost -- OLD_BINARY NEW_BINARY [ROUNDS]
+//! ```
+#![allow(clippy::print_stdout, clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use woodpile_bench::paper::PAPER_SWEEPS;
+use woodpile_pipeline::Pipeline;
+use woodpile_stages::sampling::sampled_scene_tables;
+use woodpile_stages::KINDS;
+
+/// Points drawn from each sweep, and the seed: the paper sample of `make bench`.
+const PER_SWEEP: usize = 8;
+const SEED: u64 = 2026;
+/// The keys two binaries must print alike (the numbers; not times or versions).
+const SAME: [&str; 6] = ["R", "T", "E_tr", "E_final", "steps", "method"];
+
+/// Runs `binary` on `scene`: its simulation time (s) and the JSON values that must agree.
+fn simulate(binary: &Path, scene: &Path) -> (f64, Vec<serde_json::Value>) {
+    let out = Command::new(binary).arg("simulate").arg(scene).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{} simulate {}: {}",
+        binary.display(),
+        scene.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let same = SAME.iter().map(|k| json[*k].clone()).collect();
+    (json["wall_s"].as_f64().unwrap(), same)
+}
+
+/// The sample's scene files, written under `dir`, labelled; then the standard scene.
+fn scene_files(dir: &Path) -> Vec<(String, PathBuf)> {
+    let pipeline = Pipeline::load("pipeline".as_ref(), KINDS).unwrap();
+    let tables = sampled_scene_tables(&pipeline, PAPER_SWEEPS, PER_SWEEP, SEED).unwrap();
+    let mut files: Vec<(String, PathBuf)> = tables
+        .into_iter()
+        .enumerate()
+        .map(|(i, (label, table))| {
+            let path = dir.join(format!("scene_{i:02}.toml"));
+            std::fs::write(&path, toml::to_string(&table).unwrap()).unwrap();
+            (label, path)
+        })
+        .collect();
+    files.push(("standard scene".into(), "scenes/single_eps10.toml".into()));
+    files
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let (old, new) = (PathBuf::from(&args[1]), PathBuf::from(&args[2]));
+    let rounds: usize = args.get(3).map_or(15, |r| r.parse().unwrap());
+    let dir = std::env::temp_dir().join(format!("woodpile_unused_cost_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scenes = scene_files(&dir);
+    let sample = scenes.len() - 1;
+    // best[side][group]: group 0 the paper sample, 1 the standard scene.
+    let mut best = [[f64::INFINITY; 2]; 2];
+    for round in 0..rounds {
+        let mut total = [[0.0; 2]; 2];
+        for (i, (label, scene)) in scenes.iter().enumerate() {
+            let order = if round % 2 == 0 { [0, 1] } else { [1, 0] };
+            let mut printed = [Vec::new(), Vec::new()];
+            for side in order {
+                let binary = if side == 0 { &old } else { &new };
+                let (seconds, same) = simulate(binary, scene);
+                total[side][usize::from(i == sample)] += seconds;
+                printed[side] = same;
+            }
+            assert_eq!(printed[0], printed[1], "{label}: the two binaries disagree");
+        }
+        for side in 0..2 {
+            for group in 0..2 {
+                best[side][group] = best[side][group].min(total[side][group]);
+            }
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    println!("Unused features' cost: {rounds} rounds, each side's best, simulation time only; the same fractions, steps and methods from both\n");
+    println!("| scenes | before (ms) | after (ms) | after / before |");
+    println!("|---|---|---|---|");
+    let groups = [
+        format!("paper sample ({sample} scenes: F4, F7 coarse, F7 fine)"),
+        "standard scene (auto, 1e-8)".to_string(),
+    ];
+    for (group, name) in groups.iter().enumerate() {
+        let (before, after) = (best[0][group] * 1e3, best[1][group] * 1e3);
+        println!("| {name} | {before:.1} | {after:.1} | {:.3} |", after / before);
+    }
+}
