@@ -45,6 +45,7 @@ pub(crate) struct Args {
 
 pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     let scene = woodpile_scene::load(&args.scene).map_err(Failure::input)?;
+    check_outputs(args).map_err(Failure::input)?;
     let s = &scene.scenario;
     let sites = field_sites(&scene, args.sites.as_deref()).map_err(Failure::input)?;
     if args.field.is_some() {
@@ -79,6 +80,44 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     };
     say!("{}", text.map_err(Failure::simulation)?);
     Ok(())
+}
+
+/// Refuses `--series` and `--field` targets that a write (a rename over the path) would
+/// wrongly replace: anything but a regular file (a device, a FIFO, a folder), a symbolic link,
+/// the scene being read, or the other output (one table would silently lose the other).
+fn check_outputs(args: &Args) -> anyhow::Result<()> {
+    let outputs = [("--series", &args.series), ("--field", &args.field)];
+    for (flag, path) in outputs.iter().filter_map(|(f, p)| Some((*f, p.as_ref()?))) {
+        if let Ok(meta) = std::fs::symlink_metadata(path) {
+            let what = match meta.file_type() {
+                t if t.is_symlink() => Some("a symbolic link"),
+                t if !t.is_file() => Some("not a regular file"),
+                _ => None,
+            };
+            if let Some(what) = what {
+                return Err(anyhow!("{flag} {}: {what}; name a new file or a regular one to replace", path.display()));
+            }
+        }
+        if same_file(path, &args.scene) {
+            return Err(anyhow!("{flag} {}: is the scene being read", path.display()));
+        }
+    }
+    if let (Some(series), Some(field)) = (&args.series, &args.field) {
+        if same_file(series, field) {
+            return Err(anyhow!("--series and --field name the same file, {}: one table would replace the other", field.display()));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` are one file: the same inode when both exist, else the same absolute
+/// path.
+fn same_file(a: &Path, b: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (std::fs::metadata(a), std::fs::metadata(b)) {
+        (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+        _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
+    }
 }
 
 /// The internal site range of `--sites LO,HI` (paper numbering), or the whole chain.

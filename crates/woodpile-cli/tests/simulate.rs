@@ -274,3 +274,43 @@ p = 3
     };
     assert_eq!(run("baseline"), run("auto"));
 }
+
+/// `--series` and `--field` never rename over what is not theirs to replace: a FIFO, a device,
+/// a symbolic link, the scene being read, or each other. Each is refused with exit 2 naming the
+/// flag, before anything runs, and the target is left as it was.
+#[test]
+fn outputs_that_are_not_plain_new_files_are_refused() {
+    let scene = scene_file("[run]\nt_end = 5.0\n");
+    let dir = scene.parent().unwrap().join(format!("outputs{}", COUNTER.fetch_add(1, Ordering::SeqCst)));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("fifo");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let target = dir.join("kept.parquet");
+    std::fs::write(&target, "mine").unwrap();
+    let link = dir.join("link.parquet");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let same = dir.join("both.parquet");
+    let cases: [(&[&Path], &str); 6] = [
+        (&[&fifo], "not a regular file"),
+        (&[&dir], "not a regular file"),
+        (&[&link], "a symbolic link"),
+        (&[&scene], "is the scene being read"),
+        (&[&same, &same], "name the same file"),
+        (&[Path::new("/dev/null")], "not a regular file"),
+    ];
+    for (paths, needle) in cases {
+        let mut command = simulate_command(&scene);
+        command.arg("--series").arg(paths[0]);
+        if let Some(field) = paths.get(1) {
+            command.arg("--field").arg(field);
+        }
+        let out = command.output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{paths:?}: {stderr}");
+        assert!(stderr.contains(needle) && out.stdout.is_empty(), "{paths:?}: {stderr}");
+    }
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "mine");
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::read_to_string(&scene).unwrap().contains("t_end"));
+    assert!(!same.exists());
+}
