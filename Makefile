@@ -25,13 +25,13 @@ python: ## Install the Python package into .venv, as the README says (pip instal
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check ./python
 
-python-test: python ## The Python package's tests and the quickstart notebook, in .venv
+python-test: python build ## The Python package's tests and the quickstart notebook, in .venv (Pipeline drives this clone's woodpile)
 	$(PY) -m pip install --quiet --disable-pip-version-check pytest matplotlib nbclient nbformat ipykernel
-	$(PY) -m pytest -q -p no:cacheprovider python/tests
-	$(PY) scripts/run_notebook.py examples/quickstart.ipynb
+	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) -m pytest -q -p no:cacheprovider python/tests
+	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) scripts/run_notebook.py examples/quickstart.ipynb
 
-python-bench: python ## woodpile.simulate and woodpile.sweep against the Rust calls (docs/performance.md)
-	$(PY) python/benches/bench.py
+python-bench: python build ## woodpile.simulate and woodpile.sweep against the Rust calls (docs/performance.md)
+	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) python/benches/bench.py
 
 docs: ## Regenerate docs/stage-kinds.md and the README's accuracy captions
 	UPDATE_DOCS=1 $(CARGO) test --release -p woodpile-stages -p woodpile-cli --test docs

@@ -33,9 +33,19 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
     m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
+    m.add_function(wrap_pyfunction!(table_integrity, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
-    // The clone this module was built from: where `Pipeline` finds (or builds) the `woodpile`
-    // command that runs stages, so that `pip install ./python` alone is enough.
-    m.add("SOURCE_DIR", concat!(env!("CARGO_MANIFEST_DIR"), "/.."))?;
     Ok(())
+}
+
+/// Whether a table's bytes match the seal in their manifest: "intact", "damaged" or
+/// "unchecked" (no seal: not a woodpile table). The engine's own check, so that
+/// `Pipeline.read` refuses exactly the files `woodpile status` calls damaged.
+#[pyfunction]
+fn table_integrity(data: &[u8]) -> &'static str {
+    match woodpile_seal::integrity(data) {
+        woodpile_seal::Integrity::Intact => "intact",
+        woodpile_seal::Integrity::Damaged => "damaged",
+        woodpile_seal::Integrity::Unchecked => "unchecked",
+    }
 }

@@ -1,6 +1,7 @@
 """Shared fixtures: the repository's scene files, the `woodpile` command, a small pipeline."""
 
 import json
+import os
 import subprocess
 from pathlib import Path
 
@@ -10,6 +11,12 @@ from woodpile._pipeline import find_woodpile
 
 REPO = Path(__file__).resolve().parents[2]
 SCENES = sorted((REPO / "scenes").glob("*.toml"))
+
+# The package never searches build folders; its tests use this clone's release build when no
+# command is named (`make python-test` names it).
+_BUILT = REPO / "target" / "release" / "woodpile"
+if _BUILT.is_file():
+    os.environ.setdefault("WOODPILE_BIN", str(_BUILT))
 
 
 @pytest.fixture(scope="session")

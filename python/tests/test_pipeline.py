@@ -48,3 +48,53 @@ def test_errors(small_pipeline):
     (small_pipeline / "pipeline" / "broken.toml").write_text('kind = "sweep"\n')
     with pytest.raises(woodpile.SceneError, match="broken.toml"):
         p.status()
+
+
+def test_read_and_manifest_check_the_seal(small_pipeline):
+    """A table whose bytes no longer match its seal raises, as `status` calls it damaged,
+    instead of handing back a silently different DataFrame."""
+    p = woodpile.Pipeline(small_pipeline)
+    p.run()
+    path = p.table_path("small_fractions")
+    data = bytearray(path.read_bytes())
+    data[len(data) // 3] ^= 0x01
+    path.write_bytes(bytes(data))
+    assert p.status().set_index("stage").loc["small_fractions", "state"] == "damaged"
+    with pytest.raises(ValueError, match="damaged"):
+        p.read("small_fractions")
+    with pytest.raises(ValueError, match="damaged"):
+        p.manifest("small_fractions")
+
+
+def test_a_relative_root_is_the_project_and_names_are_never_flags(small_pipeline, monkeypatch):
+    """`Pipeline("proj")` from the folder above works (the command runs inside the project,
+    where a relative path would be taken twice), and a stage named "--force" is a name."""
+    monkeypatch.chdir(small_pipeline.parent)
+    p = woodpile.Pipeline(small_pipeline.name)
+    assert (p.status().state == "missing").all()
+    p.run("small_sweep")
+    assert (small_pipeline / "results" / "small_sweep.parquet").is_file()
+    assert not (small_pipeline / small_pipeline.name).exists()
+    with pytest.raises(woodpile.SceneError, match="--force"):
+        p.run("--force")
+    assert p.status().set_index("stage").loc["small_fractions", "state"] == "missing"
+
+
+def test_the_command_is_never_taken_from_a_build_folder(monkeypatch, tmp_path):
+    """`$WOODPILE_BIN`, then the package's own, then PATH: never `CARGO_TARGET_DIR`, never built."""
+    from woodpile import _pipeline
+
+    planted = tmp_path / "release" / "woodpile"
+    planted.parent.mkdir()
+    planted.write_text("#!/bin/sh\necho planted\n")
+    planted.chmod(0o755)
+    monkeypatch.setenv("CARGO_TARGET_DIR", str(tmp_path))
+    monkeypatch.delenv("WOODPILE_BIN", raising=False)
+    monkeypatch.setenv("PATH", str(tmp_path / "empty"))
+    if _pipeline._packaged_binary().is_file():
+        assert _pipeline.find_woodpile() == str(_pipeline._packaged_binary())
+    else:
+        with pytest.raises(FileNotFoundError, match="WOODPILE_BIN"):
+            _pipeline.find_woodpile()
+    monkeypatch.setenv("WOODPILE_BIN", "/opt/woodpile")
+    assert _pipeline.find_woodpile() == "/opt/woodpile"

@@ -2,18 +2,19 @@
 
 Running stages needs the whole engine (polars included), which the Python module does not
 compile: ``status`` and ``run`` call the ``woodpile`` command, and ``read`` and ``manifest``
-open the parquet tables with pyarrow. The command is found as ``$WOODPILE_BIN``, else the
-release build of the clone this package was built from, else ``woodpile`` on the PATH; if
-none exists, it is built once from that clone with cargo.
+open the parquet tables with pyarrow, after checking each table's seal as the engine does.
+The command is ``$WOODPILE_BIN``, else the one installed with the package, else ``woodpile`` on
+the PATH. Nothing is ever built at run time, and no build folder is searched: a path baked in at
+install time, or named by ``CARGO_TARGET_DIR``, could be anyone's.
 """
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 from typing import Any, Dict, List, Optional, Sequence, Union
 
@@ -24,38 +25,25 @@ from . import _core
 PathLike = Union[str, "os.PathLike[str]"]
 
 
-def _clone() -> Path:
-    return Path(_core.SOURCE_DIR).resolve()
-
-
-def _clone_binary() -> Path:
-    target = os.environ.get("CARGO_TARGET_DIR") or str(_clone() / "target")
-    return Path(target) / "release" / "woodpile"
+def _packaged_binary() -> Path:
+    """Where a wheel puts the ``woodpile`` command: inside the package."""
+    return Path(__file__).resolve().parent / "bin" / "woodpile"
 
 
 def find_woodpile() -> str:
-    """The path of the ``woodpile`` command this package drives (building it if needed)."""
+    """The path of the ``woodpile`` command this package drives: ``$WOODPILE_BIN``, else the
+    one installed with the package, else ``woodpile`` on the PATH."""
     explicit = os.environ.get("WOODPILE_BIN")
     if explicit:
         return explicit
-    built = _clone_binary()
-    if built.is_file():
-        return str(built)
+    packaged = _packaged_binary()
+    if packaged.is_file() and os.access(packaged, os.X_OK):
+        return str(packaged)
     on_path = shutil.which("woodpile")
     if on_path:
         return on_path
-    if (_clone() / "Cargo.toml").is_file() and shutil.which("cargo"):
-        print(
-            f"woodpile: building the woodpile command once (cargo build --release -p woodpile-cli in {_clone()})",
-            file=sys.stderr,
-        )
-        subprocess.run(
-            ["cargo", "build", "--release", "-p", "woodpile-cli"], cwd=_clone(), check=True
-        )
-        if built.is_file():
-            return str(built)
     raise FileNotFoundError(
-        "the woodpile command was not found: set WOODPILE_BIN, or run `make install` in a clone"
+        "the woodpile command was not found: set WOODPILE_BIN to its path, or run `make install` in a clone to put it on the PATH"
     )
 
 
@@ -80,7 +68,9 @@ class Pipeline:
         figures: PathLike = "figures",
         woodpile: Optional[PathLike] = None,
     ) -> None:
-        self.root = Path(root)
+        # Absolute once, here: the command runs in ``root``, where a relative folder would be
+        # taken twice (``proj/proj/results``).
+        self.root = Path(root).absolute()
         self.pipeline_dir = self.root / pipeline
         self.results_dir = self.root / results
         self.figures_dir = self.root / figures
@@ -89,7 +79,7 @@ class Pipeline:
     def __repr__(self) -> str:
         return f"Pipeline({str(self.root)!r})"
 
-    def _command(self, args: Sequence[str]) -> str:
+    def _command(self, args: Sequence[str], names: Sequence[str] = ()) -> str:
         binary = self._woodpile or find_woodpile()
         self._woodpile = binary
         where = [
@@ -97,8 +87,9 @@ class Pipeline:
             "--results", str(self.results_dir),
             "--figures", str(self.figures_dir),
         ]
+        tail = ["--", *names] if names else []
         done = subprocess.run(
-            [binary, *args, *where], cwd=self.root, capture_output=True, text=True
+            [binary, *args, *where, *tail], cwd=self.root, capture_output=True, text=True
         )
         if done.returncode == 2:
             raise _core.SceneError(_message(done.stderr))
@@ -126,33 +117,45 @@ class Pipeline:
         Raises ``SceneError`` for a bad stage definition and ``SimulationError`` when a
         stage fails (the message names every failure)."""
         names: List[str] = [] if stage is None else [stage] if isinstance(stage, str) else list(stage)
-        args = ["run", *names, "--json"]
+        args = ["run", "--json"]
         if force:
             args.append("--force")
         if dry_run:
             args.append("--dry-run")
-        return json.loads(self._command(args))
+        # After `--`, a name is a name: "--force" cannot pass for the flag.
+        return json.loads(self._command(args, names))
 
     def table_path(self, stage: str) -> Path:
         """Where ``stage``'s table is (``results/<stage>.parquet``)."""
         return self.results_dir / f"{stage}.parquet"
 
-    def read(self, stage: str) -> pd.DataFrame:
-        """``stage``'s table as a DataFrame (run the stage first if it is missing)."""
+    def _sealed(self, stage: str) -> "tuple[Path, bytes]":
+        """The bytes of ``stage``'s table, checked against their seal before anything decodes
+        them (the engine's check: a damaged table raises, as ``status`` calls it damaged)."""
         path = self.table_path(stage)
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no table for stage `{stage}` (run it first)")
-        return pd.read_parquet(path, engine="pyarrow")
+        data = path.read_bytes()
+        if _core.table_integrity(data) == "damaged":
+            raise ValueError(
+                f"{path}: damaged: its bytes no longer match the seal in its manifest (run the stage again)"
+            )
+        return path, data
+
+    def read(self, stage: str) -> pd.DataFrame:
+        """``stage``'s table as a pandas DataFrame (run the stage first if it is missing).
+        Raises ``ValueError`` if the file no longer matches its seal."""
+        _, data = self._sealed(stage)
+        return pd.read_parquet(io.BytesIO(data), engine="pyarrow")
 
     def manifest(self, stage: str) -> Dict[str, Any]:
         """``stage``'s manifest: ``stage``, ``kind``, ``key``, ``code_version``, ``params``,
-        ``inputs`` (upstream stage -> key), ``summary`` and ``checksum`` (its seal)."""
+        ``inputs`` (upstream stage -> key), ``summary`` and ``checksum`` (the seal of the
+        whole file). Raises ``ValueError`` if the file no longer matches its seal."""
         import pyarrow.parquet as pq
 
-        path = self.table_path(stage)
-        if not path.is_file():
-            raise FileNotFoundError(f"{path}: no table for stage `{stage}` (run it first)")
-        metadata = pq.read_metadata(path).metadata or {}
+        path, data = self._sealed(stage)
+        metadata = pq.read_metadata(io.BytesIO(data)).metadata or {}
         text = metadata.get(b"woodpile")
         if text is None:
             raise ValueError(f"{path}: not a woodpile table (no manifest in its metadata)")

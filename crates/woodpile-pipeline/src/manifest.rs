@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use serde_json::Value;
 
 /// The parquet metadata key holding the manifest.
-pub const METADATA_KEY: &str = "woodpile";
+pub use woodpile_seal::METADATA_KEY;
 
 /// A stage output's description of itself.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

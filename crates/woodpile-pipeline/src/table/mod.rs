@@ -37,12 +37,6 @@ pub fn write(path: &Path, mut frame: DataFrame, manifest: &Manifest) -> Result<(
     atomic::write(path, &bytes)
 }
 
-/// The seal's placeholder while it is computed: 64 characters, as the seal itself.
-const UNSEALED: &str = "unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-unsealed-u";
-const SEAL_LEN: usize = 64;
-/// What precedes the seal in the manifest's text (its last field).
-const SEAL_MARK: &[u8] = b"\"checksum\":\"";
-
 /// The largest table woodpile reads: a thousand times its largest result. A file beyond it is
 /// refused unread, so no decoder is asked to allocate for it.
 pub const MAX_TABLE_BYTES: u64 = 1 << 30;
@@ -58,37 +52,8 @@ fn encode(frame: &mut DataFrame, manifest_text: String) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Where the seal's 64 characters start in a sealed file: after the last `"checksum":"`
-/// (the manifest's last field, in the footer near the end of the file).
-fn seal_position(bytes: &[u8]) -> Option<usize> {
-    let at = bytes
-        .windows(SEAL_MARK.len())
-        .rposition(|w| w == SEAL_MARK)?
-        + SEAL_MARK.len();
-    (at + SEAL_LEN <= bytes.len()).then_some(at)
-}
-
-/// The seal of a file whose seal starts at `at`: blake3 of every byte, with the seal's own
-/// 64 characters read as [`UNSEALED`]. A changed byte anywhere (data, footer, manifest) breaks it.
-fn seal(bytes: &[u8], at: usize) -> String {
-    let mut hasher = blake3::Hasher::new();
-    hasher.update(b"woodpile table seal 2\n");
-    hasher.update(&bytes[..at]);
-    hasher.update(UNSEALED.as_bytes());
-    hasher.update(&bytes[at + SEAL_LEN..]);
-    hasher.finalize().to_hex().to_string()
-}
-
-/// Whether a table's bytes still match the seal its manifest recorded.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Integrity {
-    /// They do.
-    Intact,
-    /// They do not: the file was damaged (or edited) after it was written. It is not decoded.
-    Damaged,
-    /// There is no seal to check against: not a woodpile table.
-    Unchecked,
-}
+pub use woodpile_seal::Integrity;
+use woodpile_seal::{position as seal_position, seal, SEAL_LEN, UNSEALED};
 
 /// A table as read, with its manifest and whether its bytes match the manifest's seal.
 #[derive(Debug)]
@@ -102,22 +67,12 @@ pub struct Checked {
 }
 
 /// The bytes of the table at `path` (a regular file of at most [`MAX_TABLE_BYTES`]) and
-/// whether they match their seal, checked before anything decodes them. A file that carries
-/// woodpile's marks (the `woodpile` metadata key or a seal field) but no matching seal is
-/// damaged; only a file with neither is unchecked (a foreign parquet file).
+/// whether they match their seal ([`woodpile_seal::integrity`]), checked before anything
+/// decodes them.
 fn sealed_bytes(path: &Path) -> Result<(Vec<u8>, Integrity)> {
     let bytes = regular::read(path, MAX_TABLE_BYTES).map_err(|e| PipelineError::io(path, e))?;
-    let integrity = match seal_position(&bytes) {
-        Some(at) if bytes[at..at + SEAL_LEN] == *seal(&bytes, at).as_bytes() => Integrity::Intact,
-        Some(_) => Integrity::Damaged,
-        None if contains(&bytes, METADATA_KEY.as_bytes()) => Integrity::Damaged,
-        None => Integrity::Unchecked,
-    };
+    let integrity = woodpile_seal::integrity(&bytes);
     Ok((bytes, integrity))
-}
-
-fn contains(haystack: &[u8], needle: &[u8]) -> bool {
-    haystack.windows(needle.len()).any(|w| w == needle)
 }
 
 /// Runs a polars decoder on bytes: some damaged files make it panic rather than return an
