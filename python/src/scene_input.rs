@@ -80,7 +80,11 @@ impl Source {
             })?,
         };
         toml::from_str(&text).map_err(|e| {
-            SceneError::new_err(format!("{}: {}", label.display(), e.to_string().trim_end()))
+            SceneError::new_err(format!(
+                "{}: {}",
+                label.display(),
+                woodpile_scene::syntax_reason(&e, &text)
+            ))
         })
     }
 }

@@ -72,7 +72,7 @@ fn find_project_file() -> anyhow::Result<Option<(PathBuf, toml::Table)>> {
         let text = woodpile_scene::read_input(&path)
             .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
         let table: toml::Table = toml::from_str(&text)
-            .map_err(|e| anyhow!("{}: {}", path.display(), e.to_string().trim_end()))?;
+            .map_err(|e| anyhow!("{}: {}", path.display(), woodpile_scene::syntax_reason(&e, &text)))?;
         if let Some(key) = table
             .keys()
             .find(|k| !["pipeline", "results", "figures"].contains(&k.as_str()))

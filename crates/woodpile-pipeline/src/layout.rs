@@ -63,3 +63,42 @@ pub const LOCK_FILE: &str = ".woodpile.lock";
 pub fn lock_path(results: &Path) -> PathBuf {
     results.join(LOCK_FILE)
 }
+
+/// Whether `reference` is a relative path of plain names (`.` allowed, no `..`, not absolute,
+/// at least one name): the form of every path a stage file may name inside the project.
+pub fn is_plain_relative(reference: &str) -> bool {
+    let path = Path::new(reference);
+    let plain = path.components().all(|c| {
+        matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    });
+    plain
+        && path
+            .components()
+            .any(|c| matches!(c, std::path::Component::Normal(_)))
+}
+
+/// The file a stage file names as `reference`, inside the project at `root`: a plain relative
+/// path ([`is_plain_relative`]) with no symbolic link on the way, so a cloned project cannot
+/// make woodpile read `/proc/self/environ` or `../../etc/passwd`. The error is the reason.
+pub fn contained(root: &Path, reference: &str) -> Result<PathBuf, String> {
+    if !is_plain_relative(reference) {
+        return Err(format!(
+            "`{reference}` must be a relative path inside the project (no `..`, not absolute)"
+        ));
+    }
+    let mut path = root.to_path_buf();
+    for part in Path::new(reference).components() {
+        path.push(part);
+        let linked = std::fs::symlink_metadata(&path).is_ok_and(|m| m.file_type().is_symlink());
+        if linked {
+            return Err(format!(
+                "`{reference}` passes through a symbolic link ({}): it must stay inside the project",
+                path.display()
+            ));
+        }
+    }
+    Ok(path)
+}

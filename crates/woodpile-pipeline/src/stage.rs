@@ -139,8 +139,8 @@ pub(crate) fn read_text(file: &Path) -> Result<String> {
 pub(crate) fn parse_table(text: &str, file: &Path) -> Result<toml::Table> {
     toml::from_str(text).map_err(|e| PipelineError::Syntax {
         file: file.to_path_buf(),
-        reason: e.to_string().trim_end().to_string(),
-        source: Some(Box::new(e)),
+        reason: woodpile_scene::syntax_reason(&e, text),
+        source: None,
     })
 }
 
@@ -189,14 +189,15 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
         },
         _ => return Ok(()),
     };
-    let path = root.join(&reference);
+    let path = crate::layout::contained(root, &reference)
+        .map_err(|reason| definition(file, key, &reason))?;
     let text = woodpile_scene::read_input(&path)
         .map_err(|e| definition(file, key, &format!("{}: cannot read: {e}", path.display())))?;
     let mut scene: toml::Table = toml::from_str(&text).map_err(|e| {
         definition(
             file,
             key,
-            &format!("{}: {}", path.display(), e.to_string().trim_end()),
+            &format!("{}: {}", path.display(), woodpile_scene::syntax_reason(&e, &text)),
         )
     })?;
     merge(&mut scene, overrides);

@@ -90,11 +90,40 @@ pub fn read_input(path: &Path) -> Result<String, String> {
     Ok(text)
 }
 
+/// A TOML error as one line, `line L, column C: message`, without the quoted source line
+/// that the parser's own text carries: an input can be any file (`/proc/self/environ`,
+/// `/etc/passwd`), and an error must never print what it read. Control characters in the
+/// message (a key can hold any) are escaped, so that nothing read reaches the terminal raw.
+pub fn syntax_reason(error: &toml::de::Error, text: &str) -> String {
+    let message = escape_controls(error.message().trim_end());
+    match error.span() {
+        Some(span) => {
+            let before = &text.as_bytes()[..span.start.min(text.len())];
+            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+            let column = before.iter().rev().take_while(|&&b| b != b'\n').count() + 1;
+            format!("line {line}, column {column}: {message}")
+        }
+        None => message,
+    }
+}
+
+/// `text` with every control character (ESC, CR, BEL ... but not a plain space) written as
+/// an escape, so that a message quoting a file's key or value cannot move the cursor, recolour
+/// or rewrite the terminal it is printed to.
+pub fn escape_controls(text: &str) -> String {
+    text.chars()
+        .flat_map(|c| match c.is_control() && c != '\n' {
+            true => c.escape_default().collect::<Vec<_>>(),
+            false => vec![c],
+        })
+        .collect()
+}
+
 /// Parses and validates scene TOML `text`; `path` only names the source in errors.
 pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
     let raw: raw::SceneFile = toml::from_str(text).map_err(|e| SceneError::Syntax {
         file: path.to_path_buf(),
-        reason: e.to_string().trim_end().to_string(),
+        reason: syntax_reason(&e, text),
     })?;
     validated(raw, path)
 }
@@ -107,7 +136,7 @@ pub fn from_table(table: toml::Table, path: &Path) -> Result<Scene, SceneError> 
             .try_into()
             .map_err(|e: toml::de::Error| SceneError::Syntax {
                 file: path.to_path_buf(),
-                reason: e.to_string().trim_end().to_string(),
+                reason: escape_controls(e.message().trim_end()),
             })?;
     validated(raw, path)
 }

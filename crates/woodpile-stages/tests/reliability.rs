@@ -292,3 +292,31 @@ fn an_edited_best_design_file_is_noticed() {
     assert_eq!(std::fs::read_to_string(&best).unwrap(), found);
     assert_eq!(p.state("trap"), State::Fresh);
 }
+
+/// A stage's scene file stays inside the project: an absolute path, a `..` or a symbolic link
+/// on the way is refused naming the key, and a file that is not TOML is reported by line and
+/// column, never by what it holds (`/proc/self/environ` would print the environment).
+#[test]
+fn a_stage_scene_file_stays_inside_the_project_and_is_never_echoed() {
+    let with_file = |file: &str| {
+        format!("kind = \"sweep\"\n[scene]\nfile = \"{file}\"\nrun = {{ t_end = 5.0 }}\n")
+    };
+    for (file, reason) in [
+        ("/proc/self/environ", "must be a relative path inside the project"),
+        ("../../../../etc/passwd", "must be a relative path inside the project"),
+    ] {
+        let e = load_error(&[("sweep", &with_file(file))]);
+        assert!(e.contains("scene.file") && e.contains(reason), "{e}");
+    }
+    let p = Project::new(&[("sweep", &with_file("linked/secret.toml"))]);
+    let outside = tempfile::tempdir().unwrap();
+    std::fs::write(outside.path().join("secret.toml"), "password=hunter2 x\n").unwrap();
+    std::os::unix::fs::symlink(outside.path(), p.root().join("linked")).unwrap();
+    let e = p.run(&[]).unwrap_err().to_string();
+    assert!(e.contains("symbolic link") && !e.contains("hunter2"), "{e}");
+
+    let p = Project::new(&[("sweep", &with_file("notes.toml"))]);
+    std::fs::write(p.root().join("notes.toml"), "SECRET_TOKEN=abc123 and more\n").unwrap();
+    let e = p.run(&[]).unwrap_err().to_string();
+    assert!(e.contains("line 1, column") && !e.contains("abc123"), "{e}");
+}

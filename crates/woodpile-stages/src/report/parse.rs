@@ -13,15 +13,7 @@ use super::{Convention, Paper, Quote, Read, Source};
 /// table or figure.
 pub(super) fn check_markdown_path(markdown: &str) -> std::result::Result<(), String> {
     let path = Path::new(markdown);
-    let plain = path.components().all(|c| {
-        matches!(
-            c,
-            std::path::Component::Normal(_) | std::path::Component::CurDir
-        )
-    }) && path
-        .components()
-        .any(|c| matches!(c, std::path::Component::Normal(_)));
-    if markdown.is_empty() || !plain {
+    if !woodpile_pipeline::layout::is_plain_relative(markdown) {
         return Err(format!(
             "`{markdown}` must be a relative path inside the project (no `..`, not absolute)"
         ));
