@@ -2,8 +2,10 @@
 //! environment (`WOODPILE_PIPELINE`, `WOODPILE_RESULTS`, `WOODPILE_FIGURES`), else a
 //! `woodpile.toml` in the current folder or the nearest one above it (keys `pipeline`,
 //! `results`, `figures`, relative to that file's folder), else `pipeline/`, `results/` and
-//! `figures/` beside the `woodpile.toml` (or in the current folder). So a study in its own
-//! folder, or any folder inside it, needs no flags.
+//! `figures/` beside the `woodpile.toml`, or in the nearest folder holding `pipeline/`, or in
+//! the current folder. So a study in its own folder, or any folder inside it, needs no flags.
+//! The upward search stops at the first folder holding `pipeline/`, and a `woodpile.toml`
+//! owned by another user or in a folder everyone may write is ignored.
 
 use std::path::{Path, PathBuf};
 
@@ -61,34 +63,60 @@ pub(crate) fn resolve(
     })
 }
 
-/// The nearest `woodpile.toml` at or above the current folder: its folder and its table.
+/// The project the current folder is in: the nearest folder at or above it that holds a
+/// trusted `woodpile.toml` (its folder and table) or a `pipeline/` folder (its folder, no
+/// table). The search stops at the first `pipeline/`: a `woodpile.toml` further up (say a
+/// world-writable `/tmp/woodpile.toml`) cannot take over a project that has none of its own.
 fn find_project_file() -> anyhow::Result<Option<(PathBuf, toml::Table)>> {
     let here = std::env::current_dir().context("the current folder")?;
+    // Relative to the current folder when it is the project's own, else absolute.
+    let root_of = |folder: &Path| match folder == here {
+        true => PathBuf::from("."),
+        false => folder.to_path_buf(),
+    };
     for folder in here.ancestors() {
         let path = folder.join(PROJECT_FILE);
-        if !path.is_file() {
-            continue;
+        if path.is_file() && trusted(&path) {
+            return Ok(Some((root_of(folder), read_project_file(&path)?)));
         }
-        let text = woodpile_scene::read_input(&path)
-            .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
-        let table: toml::Table = toml::from_str(&text)
-            .map_err(|e| anyhow!("{}: {}", path.display(), woodpile_scene::syntax_reason(&e, &text)))?;
-        if let Some(key) = table
-            .keys()
-            .find(|k| !["pipeline", "results", "figures"].contains(&k.as_str()))
-        {
-            return Err(anyhow!(
-                "{}: key `{key}`: unknown (woodpile.toml has pipeline, results, figures)",
-                path.display()
-            ));
+        if folder.join("pipeline").is_dir() {
+            return Ok(Some((root_of(folder), toml::Table::new())));
         }
-        // Relative to the current folder when it is the project's own, else absolute.
-        let root = if folder == here {
-            PathBuf::from(".")
-        } else {
-            folder.to_path_buf()
-        };
-        return Ok(Some((root, table)));
     }
     Ok(None)
+}
+
+/// Whether a `woodpile.toml` may direct this run: owned by the user running it, in a folder
+/// that not everyone may write to. Any other is ignored, as if absent.
+fn trusted(path: &Path) -> bool {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let (Ok(file), Ok(dir)) = (std::fs::metadata(path), std::fs::metadata(folder)) else {
+        return false;
+    };
+    let mine = file.uid() == rustix::process::geteuid().as_raw();
+    mine && dir.permissions().mode() & 0o002 == 0
+}
+
+/// The table of the `woodpile.toml` at `path`, its keys checked.
+fn read_project_file(path: &Path) -> anyhow::Result<toml::Table> {
+    let text = woodpile_scene::read_input(&path)
+        .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
+    let table: toml::Table = toml::from_str(&text).map_err(|e| {
+        anyhow!(
+            "{}: {}",
+            path.display(),
+            woodpile_scene::syntax_reason(&e, &text)
+        )
+    })?;
+    if let Some(key) = table
+        .keys()
+        .find(|k| !["pipeline", "results", "figures"].contains(&k.as_str()))
+    {
+        return Err(anyhow!(
+            "{}: key `{key}`: unknown (woodpile.toml has pipeline, results, figures)",
+            path.display()
+        ));
+    }
+    Ok(table)
 }

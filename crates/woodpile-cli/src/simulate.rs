@@ -95,16 +95,25 @@ fn check_outputs(args: &Args) -> anyhow::Result<()> {
                 _ => None,
             };
             if let Some(what) = what {
-                return Err(anyhow!("{flag} {}: {what}; name a new file or a regular one to replace", path.display()));
+                return Err(anyhow!(
+                    "{flag} {}: {what}; name a new file or a regular one to replace",
+                    path.display()
+                ));
             }
         }
         if same_file(path, &args.scene) {
-            return Err(anyhow!("{flag} {}: is the scene being read", path.display()));
+            return Err(anyhow!(
+                "{flag} {}: is the scene being read",
+                path.display()
+            ));
         }
     }
     if let (Some(series), Some(field)) = (&args.series, &args.field) {
         if same_file(series, field) {
-            return Err(anyhow!("--series and --field name the same file, {}: one table would replace the other", field.display()));
+            return Err(anyhow!(
+                "--series and --field name the same file, {}: one table would replace the other",
+                field.display()
+            ));
         }
     }
     Ok(())

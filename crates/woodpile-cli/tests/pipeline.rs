@@ -433,3 +433,34 @@ fn a_new_study_runs_as_written_without_directory_flags() {
         text(&nowhere.stderr)
     );
 }
+
+/// A `woodpile.toml` above a project does not take it over: the search stops at the first
+/// folder holding `pipeline/`, and a `woodpile.toml` in a folder everyone may write (a shared
+/// `/tmp`) is ignored even where no project is found below it.
+#[test]
+fn a_woodpile_toml_above_a_project_does_not_take_it_over() {
+    use std::os::unix::fs::PermissionsExt;
+    let outer = tempfile::tempdir().unwrap();
+    let shared = outer.path().join("shared");
+    std::fs::create_dir_all(shared.join("elsewhere")).unwrap();
+    std::fs::write(
+        shared.join("woodpile.toml"),
+        "pipeline = \"elsewhere\"\nresults = \"stolen\"\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o777)).unwrap();
+    let project = shared.join("project");
+    std::fs::create_dir_all(project.join("pipeline")).unwrap();
+    std::fs::write(project.join("pipeline/small_sweep.toml"), sweep()).unwrap();
+    let inside = project.join("notes");
+    std::fs::create_dir_all(&inside).unwrap();
+    let out = woodpile(&inside, &["status"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(text(&out.stdout).contains("small_sweep"), "{}", text(&out.stdout));
+    // Without a project below it, the world-writable folder's file is still ignored.
+    let lone = shared.join("lone");
+    std::fs::create_dir_all(&lone).unwrap();
+    let out = woodpile(&lone, &["status"]);
+    assert!(!text(&out.stderr).contains("elsewhere"), "{}", text(&out.stderr));
+    assert!(!shared.join("stolen").exists());
+}

@@ -281,10 +281,17 @@ p = 3
 #[test]
 fn outputs_that_are_not_plain_new_files_are_refused() {
     let scene = scene_file("[run]\nt_end = 5.0\n");
-    let dir = scene.parent().unwrap().join(format!("outputs{}", COUNTER.fetch_add(1, Ordering::SeqCst)));
+    let dir = scene
+        .parent()
+        .unwrap()
+        .join(format!("outputs{}", COUNTER.fetch_add(1, Ordering::SeqCst)));
     std::fs::create_dir_all(&dir).unwrap();
     let fifo = dir.join("fifo");
-    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    assert!(Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap()
+        .success());
     let target = dir.join("kept.parquet");
     std::fs::write(&target, "mine").unwrap();
     let link = dir.join("link.parquet");
@@ -307,10 +314,16 @@ fn outputs_that_are_not_plain_new_files_are_refused() {
         let out = command.output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{paths:?}: {stderr}");
-        assert!(stderr.contains(needle) && out.stdout.is_empty(), "{paths:?}: {stderr}");
+        assert!(
+            stderr.contains(needle) && out.stdout.is_empty(),
+            "{paths:?}: {stderr}"
+        );
     }
     assert_eq!(std::fs::read_to_string(&target).unwrap(), "mine");
-    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
     assert!(std::fs::read_to_string(&scene).unwrap().contains("t_end"));
     assert!(!same.exists());
 }
