@@ -31,7 +31,11 @@ const SAME: [&str; 6] = ["R", "T", "E_tr", "E_final", "steps", "method"];
 
 /// Runs `binary` on `scene`: its simulation time (s) and the JSON values that must agree.
 fn simulate(binary: &Path, scene: &Path) -> (f64, Vec<serde_json::Value>) {
-    let out = Command::new(binary).arg("simulate").arg(scene).output().unwrap();
+    let out = Command::new(binary)
+        .arg("simulate")
+        .arg(scene)
+        .output()
+        .unwrap();
     assert!(
         out.status.success(),
         "{} simulate {}: {}",
@@ -100,6 +104,9 @@ fn main() {
     ];
     for (group, name) in groups.iter().enumerate() {
         let (before, after) = (best[0][group] * 1e3, best[1][group] * 1e3);
-        println!("| {name} | {before:.1} | {after:.1} | {:.3} |", after / before);
+        println!(
+            "| {name} | {before:.1} | {after:.1} | {:.3} |",
+            after / before
+        );
     }
 }

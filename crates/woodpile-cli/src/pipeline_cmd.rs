@@ -144,7 +144,8 @@ fn stage_failure(e: PipelineError) -> Failure {
     match e {
         PipelineError::Definition { .. }
         | PipelineError::Syntax { .. }
-        | PipelineError::UnknownStage { .. } => Failure::input(e),
+        | PipelineError::UnknownStage { .. }
+        | PipelineError::Refused { .. } => Failure::input(e),
         _ => Failure::simulation(e),
     }
 }

@@ -456,11 +456,70 @@ fn a_woodpile_toml_above_a_project_does_not_take_it_over() {
     std::fs::create_dir_all(&inside).unwrap();
     let out = woodpile(&inside, &["status"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("small_sweep"), "{}", text(&out.stdout));
+    assert!(
+        text(&out.stdout).contains("small_sweep"),
+        "{}",
+        text(&out.stdout)
+    );
     // Without a project below it, the world-writable folder's file is still ignored.
     let lone = shared.join("lone");
     std::fs::create_dir_all(&lone).unwrap();
     let out = woodpile(&lone, &["status"]);
-    assert!(!text(&out.stderr).contains("elsewhere"), "{}", text(&out.stderr));
+    assert!(
+        !text(&out.stderr).contains("elsewhere"),
+        "{}",
+        text(&out.stderr)
+    );
     assert!(!shared.join("stolen").exists());
+}
+
+/// `results/points` or `results/parts` as a symbolic link to a folder elsewhere is refused by
+/// `run` and by `--shard` (exit 2, naming it), and nothing is written or deleted there.
+#[test]
+fn symlinked_tree_folders_are_refused() {
+    for (folder, args) in [
+        ("points", &["run"][..]),
+        ("parts", &["run", "sweep", "--shard", "0/2"][..]),
+    ] {
+        let dir = project();
+        let elsewhere = tempfile::tempdir().unwrap();
+        std::fs::write(elsewhere.path().join("keep.tmp"), "mine").unwrap();
+        std::fs::create_dir_all(dir.path().join("results")).unwrap();
+        std::os::unix::fs::symlink(elsewhere.path(), dir.path().join("results").join(folder))
+            .unwrap();
+        let out = woodpile(dir.path(), args);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{folder}: {stderr}");
+        assert!(
+            stderr.contains(folder) && stderr.contains("symbolic link"),
+            "{stderr}"
+        );
+        let left: Vec<_> = std::fs::read_dir(elsewhere.path())
+            .unwrap()
+            .flatten()
+            .collect();
+        assert_eq!(left.len(), 1, "{folder}: wrote or deleted outside the tree");
+    }
+}
+
+/// Bad requests about the tree exit 2, as bad input does: a symbolic link as the lock, more
+/// shards than points.
+#[test]
+fn a_symlinked_lock_and_too_many_shards_are_bad_input() {
+    let dir = project();
+    let elsewhere = tempfile::tempdir().unwrap();
+    let target = elsewhere.path().join("file");
+    std::fs::write(&target, "mine").unwrap();
+    std::fs::create_dir_all(dir.path().join("results")).unwrap();
+    std::os::unix::fs::symlink(&target, dir.path().join("results/.woodpile.lock")).unwrap();
+    let out = woodpile(dir.path(), &["run"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert_eq!(std::fs::read_to_string(&target).unwrap(), "mine");
+    let out = woodpile(dir.path(), &["run", "sweep", "--shard", "0/1000"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("key `--shard`") && stderr.contains("at most one shard per point"),
+        "{stderr}"
+    );
 }

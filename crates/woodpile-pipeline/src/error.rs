@@ -50,6 +50,15 @@ pub enum PipelineError {
         #[source]
         source: BoxError,
     },
+    /// A path of the results tree that woodpile will not use as it is (a symbolic link or a
+    /// non-regular file where its lock or its own folders go): bad input, not a failed run.
+    #[error("{path}: {reason}")]
+    Refused {
+        /// The path.
+        path: PathBuf,
+        /// Why, and what to do.
+        reason: String,
+    },
     /// The run finished what it could, but stages failed (or failed in part, or were skipped
     /// because an input failed): each named with its reason.
     #[error("{} failure(s): {}", failures.len(), failures.join("; "))]
@@ -69,6 +78,14 @@ pub enum PipelineError {
 }
 
 impl PipelineError {
+    /// A path of the results tree refused for `reason`.
+    pub fn refused(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
+        PipelineError::Refused {
+            path: path.into(),
+            reason: reason.into(),
+        }
+    }
+
     /// An IO error on `path`, keeping `e` as its source.
     pub fn io(path: impl Into<PathBuf>, e: impl Into<BoxError>) -> Self {
         Self::Io {

@@ -102,3 +102,17 @@ pub fn contained(root: &Path, reference: &str) -> Result<PathBuf, String> {
     }
     Ok(path)
 }
+
+/// Refuses a folder of the results tree (`points/`, `parts/`, a stage's parts) that is a
+/// symbolic link or not a folder: what woodpile writes there, and the stale-temporary sweep's
+/// deletions, would land outside the tree. A folder not yet made is fine. The error is the
+/// reason.
+pub fn check_tree_folder(folder: &Path) -> Result<(), String> {
+    match std::fs::symlink_metadata(folder) {
+        Ok(m) if m.file_type().is_symlink() => Err(
+            "a symbolic link; the results tree's own folders must be real folders inside it (remove it and run again)".into(),
+        ),
+        Ok(m) if !m.is_dir() => Err("not a folder; remove it and run again".into()),
+        _ => Ok(()),
+    }
+}

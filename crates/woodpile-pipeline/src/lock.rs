@@ -34,7 +34,7 @@ pub struct ResultsLock {
 pub fn lock_results(results: &Path, events: &dyn Events) -> Result<ResultsLock> {
     let path = lock_path(results);
     let refuse = |reason: String| {
-        PipelineError::io(
+        PipelineError::refused(
             &path,
             format!(
                 "{reason}; the results tree's lock must be a regular file: remove it and run again"

@@ -63,6 +63,10 @@ pub struct Step {
 /// stage recorded in its table (a fit that did not converge).
 pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Result<Vec<Step>> {
     let results = &options.results;
+    for folder in [points_dir(results), results.join("parts")] {
+        crate::layout::check_tree_folder(&folder)
+            .map_err(|e| PipelineError::refused(&folder, e))?;
+    }
     let store = PointStore::new(points_dir(results));
     let selection = pipeline.selection(&options.targets)?;
     if options.dry_run {

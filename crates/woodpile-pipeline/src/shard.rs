@@ -143,14 +143,16 @@ pub fn run_shard(
     let (stage, sweep) = sweep_of(pipeline, name)?;
     let key = pipeline.key(name).to_string();
     if shard.count > sweep.count() {
-        return Err(PipelineError::stage(
-            name,
-            format!(
+        return Err(PipelineError::Definition {
+            file: stage.file.clone(),
+            key: "--shard".into(),
+            reason: format!(
                 "--shard {shard}: {} shards for a sweep of {} points; use at most one shard per point",
                 shard.count,
                 sweep.count()
             ),
-        ));
+            source: None,
+        });
     }
     let part = part_path(results, name, &key, shard);
     let indices = shard.points(sweep.count());
@@ -164,6 +166,14 @@ pub fn run_shard(
             points: indices.len(),
             already_done: true,
         });
+    }
+    for folder in [
+        points_dir(results),
+        results.join("parts"),
+        parts_dir(results, name),
+    ] {
+        crate::layout::check_tree_folder(&folder)
+            .map_err(|e| PipelineError::refused(&folder, e))?;
     }
     let store = PointStore::new(points_dir(results));
     store.sweep_stale_temps();

@@ -197,7 +197,11 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
         definition(
             file,
             key,
-            &format!("{}: {}", path.display(), woodpile_scene::syntax_reason(&e, &text)),
+            &format!(
+                "{}: {}",
+                path.display(),
+                woodpile_scene::syntax_reason(&e, &text)
+            ),
         )
     })?;
     merge(&mut scene, overrides);

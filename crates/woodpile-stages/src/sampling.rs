@@ -83,7 +83,10 @@ fn drawn<T>(
                 .zip(&values)
                 .map(|(a, v)| format!("{}={v}", a.name))
                 .collect();
-            scenes.push((format!("{label} {}", named.join(" ")), make(sweep, &values)?));
+            scenes.push((
+                format!("{label} {}", named.join(" ")),
+                make(sweep, &values)?,
+            ));
         }
     }
     Ok(scenes)

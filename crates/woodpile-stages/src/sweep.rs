@@ -94,14 +94,13 @@ impl Sweep {
         scene: toml::Table,
         file: &std::path::Path,
     ) -> Result<Sweep> {
-        let template = Template::new(scene, &axes).map_err(|(key, reason)| {
-            PipelineError::Definition {
+        let template =
+            Template::new(scene, &axes).map_err(|(key, reason)| PipelineError::Definition {
                 file: file.to_path_buf(),
                 key,
                 reason,
                 source: None,
-            }
-        })?;
+            })?;
         let sweep = Sweep {
             axes,
             series,

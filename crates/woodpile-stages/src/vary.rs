@@ -32,7 +32,9 @@ use serde_json::json;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{parse_axes, Axis};
-use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck, PointGrid, PointsAt};
+use woodpile_pipeline::kind::{
+    wrong_inputs, Context, Inputs, Kind, KindCheck, PointGrid, PointsAt,
+};
 use woodpile_pipeline::points::{PointStats, Series};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::template::Template;
@@ -62,7 +64,9 @@ impl Vary {
         let set: toml::Table = fields.required("set")?;
         // Every placeholder names an axis and every axis is used, before any input exists.
         Template::new(set.clone(), &axes).map_err(|(key, reason)| {
-            let key = key.strip_prefix("scene").map_or(key.clone(), |k| format!("set{k}"));
+            let key = key
+                .strip_prefix("scene")
+                .map_or(key.clone(), |k| format!("set{k}"));
             fields.error(&key, reason)
         })?;
         let unset: Vec<String> = fields.optional("unset")?.unwrap_or_default();
@@ -80,13 +84,17 @@ impl Vary {
     /// The sweep of `design`'s best scene (in `results`), varied.
     fn sweep_of(&self, stage: &str, design: &str, results: &Path) -> Result<Sweep> {
         let path = woodpile_pipeline::layout::best_path(results, design);
-        let text = woodpile_scene::read_input(&path)
-            .map_err(|reason| PipelineError::stage(stage, format!("{}: {reason}", path.display())))?;
+        let text = woodpile_scene::read_input(&path).map_err(|reason| {
+            PipelineError::stage(stage, format!("{}: {reason}", path.display()))
+        })?;
         let mut scene: toml::Table = toml::from_str(&text)
             .map_err(|e| PipelineError::stage(stage, format!("{}: {e}", path.display())))?;
         for key in &self.unset {
             remove_dotted(&mut scene, key).map_err(|reason| {
-                PipelineError::stage(stage, format!("unset: `{key}` {reason} of `{design}`'s best scene"))
+                PipelineError::stage(
+                    stage,
+                    format!("unset: `{key}` {reason} of `{design}`'s best scene"),
+                )
             })?;
         }
         overlay(&mut scene, &self.set);
@@ -195,7 +203,8 @@ mod tests {
 
     #[test]
     fn set_merges_tables_and_replaces_everything_else() {
-        let mut base = table("chain = { n = 100, boundary = \"fixed\" }\n[[defect]]\nsite = 0\neps = 1.0\n");
+        let mut base =
+            table("chain = { n = 100, boundary = \"fixed\" }\n[[defect]]\nsite = 0\neps = 1.0\n");
         overlay(
             &mut base,
             &table("chain = { precompression = 0.5 }\n[[defect]]\nsite = 3\neps = 2.0\n"),
@@ -208,11 +217,18 @@ mod tests {
 
     #[test]
     fn unset_removes_a_dotted_key_and_names_a_missing_one() {
-        let mut base = table("impulse = { site = -25 }\nrun = { t_end = 150.0, sample_every = 10.0 }\n");
+        let mut base =
+            table("impulse = { site = -25 }\nrun = { t_end = 150.0, sample_every = 10.0 }\n");
         remove_dotted(&mut base, "run.sample_every").unwrap();
         remove_dotted(&mut base, "impulse").unwrap();
         assert_eq!(base, table("run = { t_end = 150.0 }\n"));
-        assert_eq!(remove_dotted(&mut base, "run.tolerance"), Err("names no key"));
-        assert_eq!(remove_dotted(&mut base, "striker.mass"), Err("names no table"));
+        assert_eq!(
+            remove_dotted(&mut base, "run.tolerance"),
+            Err("names no key")
+        );
+        assert_eq!(
+            remove_dotted(&mut base, "striker.mass"),
+            Err("names no table")
+        );
     }
 }

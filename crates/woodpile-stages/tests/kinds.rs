@@ -265,7 +265,8 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
 /// struck by a body instead of given a velocity.
 fn vary_project(vary: &str) -> Project {
     let coarse = single_defect_sweep_to(3.0);
-    let optimum = "kind = \"optimize\"\ninputs = [\"at_end\"]\nover = [\"eps\"]\ntolerance = 1e-7\n";
+    let optimum =
+        "kind = \"optimize\"\ninputs = [\"at_end\"]\nover = [\"eps\"]\ntolerance = 1e-7\n";
     Project::new(&[
         ("sweep", &coarse),
         ("at_end", REDUCE),
@@ -295,11 +296,25 @@ fn vary_simulates_a_best_scene_with_set_laid_over_it() {
     let out = table::read(&p.output("varied")).unwrap();
     let design = table::str_column(&out, "design").unwrap();
     assert!(design.iter().all(|d| d.as_deref() == Some("optimum")));
-    let (f0, t) = (table::f64_column(&out, "F0").unwrap(), table::f64_column(&out, "t").unwrap());
+    let (f0, t) = (
+        table::f64_column(&out, "F0").unwrap(),
+        table::f64_column(&out, "t").unwrap(),
+    );
     let e_tr = table::f64_column(&out, "E_tr").unwrap();
-    let at_end = |f: f64| (0..out.height()).find(|&r| f0[r] == Some(f) && t[r] == Some(12.0)).unwrap();
-    assert_eq!(e_tr[at_end(0.0)], Some(best_e_tr), "F0 = 0 is the best scene itself");
-    assert!((e_tr[at_end(0.5)].unwrap() - best_e_tr).abs() > 1e-3, "a precompression changes it");
+    let at_end = |f: f64| {
+        (0..out.height())
+            .find(|&r| f0[r] == Some(f) && t[r] == Some(12.0))
+            .unwrap()
+    };
+    assert_eq!(
+        e_tr[at_end(0.0)],
+        Some(best_e_tr),
+        "F0 = 0 is the best scene itself"
+    );
+    assert!(
+        (e_tr[at_end(0.5)].unwrap() - best_e_tr).abs() > 1e-3,
+        "a precompression changes it"
+    );
 
     let struck = r#"
 kind = "vary"
@@ -327,11 +342,26 @@ striker = { mass = "$M", velocity = 1.0 }
 /// (at load), and a key to unset that the best scene does not have (when it runs).
 #[test]
 fn vary_refuses_what_it_cannot_vary() {
-    let e = load_error(&[("sweep", SWEEP), ("varied", &PRECOMPRESSED.replace("optimum", "sweep"))]);
-    assert!(e.contains("varied.toml") && e.contains("optimize or design stages"), "{e}");
-    let e = load_error(&[("sweep", SWEEP), ("varied", &PRECOMPRESSED.replace("\"$F0\"", "\"$F1\""))]);
-    assert!(e.contains("set.chain.precompression") && e.contains("`$F1` names no axis"), "{e}");
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("varied", &PRECOMPRESSED.replace("optimum", "sweep")),
+    ]);
+    assert!(
+        e.contains("varied.toml") && e.contains("optimize or design stages"),
+        "{e}"
+    );
+    let e = load_error(&[
+        ("sweep", SWEEP),
+        ("varied", &PRECOMPRESSED.replace("\"$F0\"", "\"$F1\"")),
+    ]);
+    assert!(
+        e.contains("set.chain.precompression") && e.contains("`$F1` names no axis"),
+        "{e}"
+    );
     let p = vary_project(&PRECOMPRESSED.replace("[axes]", "unset = [\"run.sample_evry\"]\n[axes]"));
     let e = p.run(&[]).unwrap_err().to_string();
-    assert!(e.contains("`run.sample_evry` names no key of `optimum`'s best scene"), "{e}");
+    assert!(
+        e.contains("`run.sample_evry` names no key of `optimum`'s best scene"),
+        "{e}"
+    );
 }

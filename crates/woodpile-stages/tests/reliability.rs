@@ -302,8 +302,14 @@ fn a_stage_scene_file_stays_inside_the_project_and_is_never_echoed() {
         format!("kind = \"sweep\"\n[scene]\nfile = \"{file}\"\nrun = {{ t_end = 5.0 }}\n")
     };
     for (file, reason) in [
-        ("/proc/self/environ", "must be a relative path inside the project"),
-        ("../../../../etc/passwd", "must be a relative path inside the project"),
+        (
+            "/proc/self/environ",
+            "must be a relative path inside the project",
+        ),
+        (
+            "../../../../etc/passwd",
+            "must be a relative path inside the project",
+        ),
     ] {
         let e = load_error(&[("sweep", &with_file(file))]);
         assert!(e.contains("scene.file") && e.contains(reason), "{e}");
@@ -316,7 +322,11 @@ fn a_stage_scene_file_stays_inside_the_project_and_is_never_echoed() {
     assert!(e.contains("symbolic link") && !e.contains("hunter2"), "{e}");
 
     let p = Project::new(&[("sweep", &with_file("notes.toml"))]);
-    std::fs::write(p.root().join("notes.toml"), "SECRET_TOKEN=abc123 and more\n").unwrap();
+    std::fs::write(
+        p.root().join("notes.toml"),
+        "SECRET_TOKEN=abc123 and more\n",
+    )
+    .unwrap();
     let e = p.run(&[]).unwrap_err().to_string();
     assert!(e.contains("line 1, column") && !e.contains("abc123"), "{e}");
 }

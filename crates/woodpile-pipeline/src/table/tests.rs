@@ -43,7 +43,10 @@ fn rows_make_typed_columns_and_mixed_kinds_are_an_error() {
 fn a_text_column_is_not_read_as_numbers() {
     let frame = rows_frame(&[Pair(1, None, true)]).unwrap();
     let e = f64_column(&frame, "x").unwrap_err();
-    assert!(e.to_string().contains("column `x` holds str, not numbers"), "{e}");
+    assert!(
+        e.to_string().contains("column `x` holds str, not numbers"),
+        "{e}"
+    );
 }
 
 /// `columns` written as a sealed table in a fresh temporary folder (kept alive by the returned
