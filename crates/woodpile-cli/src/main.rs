@@ -8,12 +8,15 @@
 
 /// `println!` that ends the process quietly when the reader has gone (`woodpile status |
 /// head`): std's `println!` panics on a broken pipe. The exit code is 141, a shell's code for
-/// a process ended by SIGPIPE, so `set -o pipefail` still sees it.
+/// a process ended by SIGPIPE, so `set -o pipefail` still sees it. Control characters (from a
+/// stage file's keys and values) are written escaped: a cloned project cannot draw on the
+/// terminal, or fake a status.
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
+        let text = woodpile_scene::escape_controls(&format!($($arg)*));
         let mut out = std::io::stdout().lock();
-        if let Err(e) = writeln!(out, $($arg)*) {
+        if let Err(e) = writeln!(out, "{text}") {
             if e.kind() == std::io::ErrorKind::BrokenPipe {
                 std::process::exit(141);
             }
@@ -126,7 +129,8 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            eprintln!("error: {}", one_line(&f.error));
+            let line = woodpile_scene::escape_controls(&one_line(&f.error));
+            eprintln!("error: {line}");
             ExitCode::from(f.code)
         }
     }

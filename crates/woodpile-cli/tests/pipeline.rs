@@ -523,3 +523,34 @@ fn a_symlinked_lock_and_too_many_shards_are_bad_input() {
         "{stderr}"
     );
 }
+
+/// Control characters from a stage file (a raw ESC in a value, an escaped one in a key) never
+/// reach the terminal raw: errors, status lines and warnings print them escaped.
+#[test]
+fn control_characters_from_stage_files_are_printed_escaped() {
+    let dir = project();
+    let stage = dir.path().join("pipeline/sweep.toml");
+    let with_value = sweep().replace(
+        "kind = \"sweep\"",
+        "kind = \"sweep\"\ndescription = \"x\u{1b}[2J\u{1b}[Hall stages fresh\"",
+    );
+    std::fs::write(&stage, &with_value).unwrap();
+    let out = woodpile(dir.path(), &["status"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out.stderr));
+    assert!(!out.stdout.contains(&0x1b) && !out.stderr.contains(&0x1b));
+    std::fs::write(
+        &stage,
+        sweep().replace("[axes]", "\"\\u001b[2J\" = 1\n[axes]"),
+    )
+    .unwrap();
+    for args in [&["status"][..], &["run"][..]] {
+        let out = woodpile(dir.path(), args);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(
+            !out.stdout.contains(&0x1b) && !out.stderr.contains(&0x1b),
+            "{stderr:?}"
+        );
+        assert!(stderr.contains("\\u{1b}[2J"), "{stderr:?}");
+    }
+}
