@@ -102,24 +102,72 @@ fn join(prefix: &str, key: &str) -> String {
     }
 }
 
+/// Deepest nesting a scene's value may have: a scene file is four levels deep at most, so this
+/// stops only values that contain themselves (or a `tolist()` that returns a new such object
+/// each time) before the native stack overflows.
+const MAX_DEPTH: usize = 64;
+/// Most values one scene may hold: far above any real chain's lists, below what would fill the
+/// memory (a `tolist()` that grows its own list while it is read).
+const MAX_VALUES: usize = 10_000_000;
+
+/// What a conversion may still spend: values in all (the depth is passed down the calls).
+struct Budget {
+    values: usize,
+}
+
 /// A dict as a TOML table; `prefix` is its dotted key, for errors.
 pub(crate) fn table(dict: &Bound<'_, PyDict>, prefix: &str) -> PyResult<toml::Table> {
+    table_within(dict, prefix, 0, &mut Budget { values: MAX_VALUES })
+}
+
+fn table_within(
+    dict: &Bound<'_, PyDict>,
+    prefix: &str,
+    depth: usize,
+    budget: &mut Budget,
+) -> PyResult<toml::Table> {
     let mut out = toml::Table::new();
-    for (key, value) in dict.iter() {
+    // A snapshot of the items: the dict may be changed by the values' own methods while they
+    // are converted (iterating it live would then panic). A change is then refused.
+    let items = dict.items();
+    for item in items.iter() {
+        let (key, value) = item
+            .extract::<(Bound<'_, PyAny>, Bound<'_, PyAny>)>()
+            .map_err(|e| key_error(prefix, &e.to_string()))?;
         let Ok(key) = key.extract::<String>() else {
-            return Err(key_error(prefix, "keys must be strings"));
+            return Err(key_error(prefix, "keys must be strings of valid text"));
         };
         let path = join(prefix, &key);
-        out.insert(key, value_of(&value, &path)?);
+        out.insert(key, value_within(&value, &path, depth + 1, budget)?);
+    }
+    if dict.len() != items.len() {
+        return Err(key_error(prefix, "the dict changed while it was read"));
     }
     Ok(out)
 }
 
 /// A Python value as a TOML value: bool, int, float, str, dict, list or tuple, and anything
-/// with `tolist()` (NumPy arrays) or `__index__`/`__float__` (NumPy scalars).
-fn value_of(value: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
+/// with `tolist()` (NumPy arrays) or `__index__`/`__float__` (NumPy scalars). Whatever goes
+/// wrong (a method that raises, text that is not valid, a value too deep or too large) is a
+/// `SceneError` naming the key.
+fn value_within(
+    value: &Bound<'_, PyAny>,
+    path: &str,
+    depth: usize,
+    budget: &mut Budget,
+) -> PyResult<toml::Value> {
+    if depth > MAX_DEPTH {
+        return Err(key_error(
+            path,
+            &format!("nested more than {MAX_DEPTH} levels deep (a value that contains itself?)"),
+        ));
+    }
+    budget.values = budget.values.checked_sub(1).ok_or_else(|| {
+        key_error(path, &format!("more than {MAX_VALUES} values in one scene"))
+    })?;
+    let failed = |e: PyErr| key_error(path, &e.to_string());
     if value.is_instance_of::<PyBool>() {
-        return Ok(toml::Value::Boolean(value.extract()?));
+        return Ok(toml::Value::Boolean(value.extract().map_err(failed)?));
     }
     if value.is_instance_of::<PyInt>() {
         return value
@@ -128,37 +176,45 @@ fn value_of(value: &Bound<'_, PyAny>, path: &str) -> PyResult<toml::Value> {
             .map_err(|_| key_error(path, "integer out of range"));
     }
     if value.is_instance_of::<PyFloat>() {
-        return Ok(toml::Value::Float(value.extract()?));
+        return Ok(toml::Value::Float(value.extract().map_err(failed)?));
     }
     if let Ok(s) = value.cast::<PyString>() {
-        return Ok(toml::Value::String(s.extract()?));
+        let text = s
+            .extract()
+            .map_err(|_| key_error(path, "not valid text (a lone surrogate?)"))?;
+        return Ok(toml::Value::String(text));
     }
     if let Ok(dict) = value.cast::<PyDict>() {
-        return Ok(toml::Value::Table(table(dict, path)?));
+        return Ok(toml::Value::Table(table_within(dict, path, depth, budget)?));
     }
     if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
-        let items = value
-            .try_iter()?
-            .enumerate()
-            .map(|(i, item)| value_of(&item?, &format!("{path}[{i}]")))
-            .collect::<PyResult<Vec<_>>>()?;
+        let mut items = Vec::new();
+        for (i, item) in value.try_iter().map_err(failed)?.enumerate() {
+            let item = item.map_err(failed)?;
+            items.push(value_within(&item, &format!("{path}[{i}]"), depth + 1, budget)?);
+        }
         return Ok(toml::Value::Array(items));
     }
-    if value.hasattr("tolist")? {
-        let list = value.call_method0("tolist")?;
+    if value.hasattr("tolist").map_err(failed)? {
+        let list = value.call_method0("tolist").map_err(failed)?;
         if !list.is(value) {
-            return value_of(&list, path);
+            return value_within(&list, path, depth + 1, budget);
         }
     }
-    if value.hasattr("__index__")? {
-        if let Ok(i) = value.extract::<i64>() {
-            return Ok(toml::Value::Integer(i));
-        }
+    if value.hasattr("__index__").map_err(failed)? {
+        return match value.call_method0("__index__") {
+            Ok(i) => i
+                .extract::<i64>()
+                .map(toml::Value::Integer)
+                .map_err(|_| key_error(path, "integer out of range")),
+            Err(e) => Err(key_error(path, &format!("its __index__ failed: {e}"))),
+        };
     }
-    if value.hasattr("__float__")? {
-        if let Ok(x) = value.extract::<f64>() {
-            return Ok(toml::Value::Float(x));
-        }
+    if value.hasattr("__float__").map_err(failed)? {
+        return match value.extract::<f64>() {
+            Ok(x) => Ok(toml::Value::Float(x)),
+            Err(e) => Err(key_error(path, &format!("its __float__ failed: {e}"))),
+        };
     }
     let type_name = value.get_type().name()?;
     Err(key_error(

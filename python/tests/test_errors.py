@@ -85,3 +85,61 @@ def test_a_panic_in_the_core_is_an_exception_not_a_crash():
         _core._panic_in_worker()
     # The interpreter and the module still work.
     assert woodpile.simulate(SCENE).E_tr > 0
+
+
+def _refused(scene, match):
+    """Each entry point raises SceneError naming the key, and the interpreter lives on."""
+    for call in (woodpile.simulate, woodpile.scene_toml):
+        with pytest.raises(woodpile.SceneError, match=match):
+            call(scene)
+
+
+def test_values_that_contain_themselves_are_scene_errors():
+    looped = [1.0]
+    looped.append(looped)
+    _refused({"defect": [{"site": 0, "eps": looped}]}, r"defect\[0\]\.eps.*nested more than")
+    mapping = {"n": 10}
+    mapping["self"] = mapping
+    _refused({"chain": mapping}, "chain.self.*nested more than")
+    deep = 1.0
+    for _ in range(8000):
+        deep = [deep]
+    _refused({"run": {"t_end": deep}}, "run.t_end.*nested more than")
+
+    class Again:
+        def tolist(self):
+            return Again()
+
+    _refused({"run": {"t_end": Again()}}, "run.t_end.*nested more than")
+
+
+def test_hostile_values_are_scene_errors():
+    scene = {"run": {"t_end": 5.0}}
+
+    class Grows:
+        def tolist(self):
+            scene["extra"] = 1
+            return 5.0
+
+    scene["run"]["tolerance"] = Grows()
+    with pytest.raises(woodpile.SceneError, match="changed while it was read"):
+        woodpile.simulate(scene)
+
+    class Endless(list):
+        def __iter__(self):
+            while True:
+                self.append(1.0)
+                yield 1.0
+
+    class Lister:
+        def tolist(self):
+            return Endless()
+
+    _refused({"segment": [{"sites": [0, 3], "mass": Lister()}]}, "more than 10000000 values")
+    _refused({"run": {"method": "rk\ud800"}}, "run.method.*not valid text")
+
+    class BadIndex:
+        def __index__(self):
+            raise RuntimeError("no index here")
+
+    _refused({"run": {"t_end": BadIndex()}}, "run.t_end.*__index__ failed.*no index here")
