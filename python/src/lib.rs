@@ -5,6 +5,7 @@
 //! the pure-Python `woodpile` package around it.
 
 mod interrupt;
+mod pool;
 mod scene_input;
 mod simulate;
 mod sweep;

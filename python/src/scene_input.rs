@@ -162,9 +162,10 @@ fn value_within(
             &format!("nested more than {MAX_DEPTH} levels deep (a value that contains itself?)"),
         ));
     }
-    budget.values = budget.values.checked_sub(1).ok_or_else(|| {
-        key_error(path, &format!("more than {MAX_VALUES} values in one scene"))
-    })?;
+    budget.values = budget
+        .values
+        .checked_sub(1)
+        .ok_or_else(|| key_error(path, &format!("more than {MAX_VALUES} values in one scene")))?;
     let failed = |e: PyErr| key_error(path, &e.to_string());
     if value.is_instance_of::<PyBool>() {
         return Ok(toml::Value::Boolean(value.extract().map_err(failed)?));
@@ -191,7 +192,12 @@ fn value_within(
         let mut items = Vec::new();
         for (i, item) in value.try_iter().map_err(failed)?.enumerate() {
             let item = item.map_err(failed)?;
-            items.push(value_within(&item, &format!("{path}[{i}]"), depth + 1, budget)?);
+            items.push(value_within(
+                &item,
+                &format!("{path}[{i}]"),
+                depth + 1,
+                budget,
+            )?);
         }
         return Ok(toml::Value::Array(items));
     }

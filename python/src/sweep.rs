@@ -67,11 +67,14 @@ pub(crate) fn sweep<'py>(
             .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
     }
     let points: Vec<Result<Point, String>> = interruptible(py, |cancel| {
-        (0..count)
-            .into_par_iter()
-            .map(|i| grid.simulate(i, series, cancel))
-            .collect()
-    })?;
+        crate::pool::run_parallel(|| {
+            (0..count)
+                .into_par_iter()
+                .map(|i| grid.simulate(i, series, cancel))
+                .collect()
+        })
+    })?
+    .map_err(pyo3::exceptions::PyValueError::new_err)?;
     grid.columns(py, &points, series)
 }
 

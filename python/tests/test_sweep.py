@@ -116,3 +116,52 @@ def test_a_sweep_over_a_striker_key_matches_simulate():
     assert table.failure.isna().all()
     heavy = woodpile.simulate(dict(template, striker={"mass": 10.0, "velocity": 1.0}))
     assert (table.iloc[1].R, table.iloc[1].E_tr) == (heavy.R, heavy.E_tr)
+
+
+def _python(code, env=None, timeout=60):
+    """`code` in a fresh interpreter (a fork or a bad environment must not touch this one)."""
+    import os
+    import subprocess
+    import sys
+
+    full_env = dict(os.environ, **(env or {}))
+    return subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout, env=full_env
+    )
+
+
+_SMALL = """
+import woodpile
+scene = {"chain": {"n": 20}, "impulse": {"site": -5}, "defect": [{"site": 0, "eps": "$eps"}],
+         "run": {"t_end": 10.0, "method": "rk4", "dt": 0.05}}
+def small():
+    return woodpile.sweep(scene, {"eps": [0.5, 1.0, 2.0]})
+"""
+
+
+def test_a_sweep_in_a_process_forked_after_a_sweep_runs():
+    """rayon's pool does not survive fork: the child gets a pool of its own instead of waiting
+    for the parent's threads for ever."""
+    code = _SMALL + """
+import os
+parent = small()
+pid = os.fork()
+if pid == 0:
+    child = small()
+    os._exit(0 if child.E_tr.tolist() == parent.E_tr.tolist() else 1)
+_, status = os.waitpid(pid, 0)
+print("child", os.waitstatus_to_exitcode(status))
+"""
+    done = _python(code, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert "child 0" in done.stdout, done.stdout + done.stderr
+
+
+def test_rayon_num_threads_is_validated():
+    """A thread count rayon would choke on is a ValueError at once, and a later valid sweep in
+    a fresh process runs."""
+    done = _python(_SMALL + "small()\n", env={"RAYON_NUM_THREADS": "100000"}, timeout=30)
+    assert done.returncode != 0 and "RAYON_NUM_THREADS" in done.stderr, done.stderr
+    assert "ValueError" in done.stderr and "panic" not in done.stderr.lower(), done.stderr
+    done = _python(_SMALL + "print(len(small()))\n", env={"RAYON_NUM_THREADS": "2"}, timeout=30)
+    assert done.returncode == 0 and done.stdout.strip() == "3", done.stderr

@@ -136,23 +136,12 @@ fn main() -> ExitCode {
     }
 }
 
-/// Most worker threads `RAYON_NUM_THREADS` may ask for.
-const MAX_THREADS: usize = 1024;
-
 /// Starts the worker threads now, so that a bad `RAYON_NUM_THREADS` (not a number, or more
 /// threads than the system gives) is an input error rather than a panic deep inside a run.
 fn start_threads() -> Result<(), String> {
-    let asked = std::env::var("RAYON_NUM_THREADS").ok();
     let mut builder = rayon::ThreadPoolBuilder::new();
-    if let Some(text) = &asked {
-        match text.trim().parse::<usize>() {
-            Ok(n) if n <= MAX_THREADS => builder = builder.num_threads(n),
-            _ => {
-                return Err(format!(
-                    "RAYON_NUM_THREADS=`{text}`: expected a whole number from 0 (all cores) to {MAX_THREADS}"
-                ))
-            }
-        }
+    if let Some(n) = woodpile_scene::threads::asked_threads()? {
+        builder = builder.num_threads(n);
     }
     builder
         .build_global()

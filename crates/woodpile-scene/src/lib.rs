@@ -11,6 +11,7 @@ mod raw;
 pub mod report;
 mod resolve;
 pub mod template;
+pub mod threads;
 
 pub use resolve::{DerivedDefect, Physical, Scene, DEFAULT_RESONATOR_SHARE};
 
