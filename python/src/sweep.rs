@@ -25,6 +25,19 @@ struct Point {
     series: Option<FractionSeries>,
 }
 
+impl Point {
+    /// The point with only what the table reads: a run's final state and its series' scratch
+    /// are a chain's worth of floats each, which thousands of points of a long chain would
+    /// hold at once.
+    fn kept(mut outcome: Outcome, mut series: Option<FractionSeries>) -> Point {
+        outcome.final_state = Vec::new();
+        if let Some(s) = series.as_mut() {
+            s.drop_scratch();
+        }
+        Point { outcome, series }
+    }
+}
+
 /// _sweep(scene, axes, series=False) -> dict
 /// --
 ///
@@ -128,10 +141,7 @@ impl Grid {
                     stop: &stop,
                 };
                 let outcome = simulate(s, &mut watched).map_err(|e| e.to_string())?;
-                Ok(Point {
-                    outcome,
-                    series: Some(watched.inner),
-                })
+                Ok(Point::kept(outcome, Some(watched.inner)))
             } else {
                 let outcome = simulate(
                     s,
@@ -141,10 +151,7 @@ impl Grid {
                     },
                 )
                 .map_err(|e| e.to_string())?;
-                Ok(Point {
-                    outcome,
-                    series: None,
-                })
+                Ok(Point::kept(outcome, None))
             }
         };
         std::panic::catch_unwind(AssertUnwindSafe(run))

@@ -165,3 +165,19 @@ def test_rayon_num_threads_is_validated():
     assert "ValueError" in done.stderr and "panic" not in done.stderr.lower(), done.stderr
     done = _python(_SMALL + "print(len(small()))\n", env={"RAYON_NUM_THREADS": "2"}, timeout=30)
     assert done.returncode == 0 and done.stdout.strip() == "3", done.stderr
+
+
+def test_a_sweep_of_a_long_chain_keeps_no_state_per_point():
+    """Each point keeps its numbers, not its final state or scratch (a chain's worth of floats
+    each): 150 points of a 200,001-site chain fit in 250 MB more address space."""
+    code = _SMALL + """
+import resource
+with open("/proc/self/status") as f:
+    size = next(int(l.split()[1]) for l in f if l.startswith("VmSize:")) * 1024
+resource.setrlimit(resource.RLIMIT_AS, (size + 250 * 2**20, resource.RLIM_INFINITY))
+import numpy as np
+long = dict(scene, chain={"n": 100000}, run={"t_end": 0.5, "method": "rk4", "dt": 0.05})
+print(len(woodpile.sweep(long, {"eps": np.linspace(0.1, 4.0, 150)})))
+"""
+    done = _python(code, env={"RAYON_NUM_THREADS": "2"}, timeout=120)
+    assert done.returncode == 0 and done.stdout.strip() == "150", done.stderr[-2000:]

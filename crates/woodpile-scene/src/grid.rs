@@ -66,16 +66,22 @@ pub const MAX_POINTS: usize = 1_000_000;
 pub const MAX_SWEEP_BYTES: f64 = 4e9;
 
 /// Refuses, before anything runs, a sweep of `points` scenes like `scene` (its largest) that
-/// would hold more than [`MAX_SWEEP_BYTES`]: each point's planned scene (measured at about
-/// 1.4 KB on the paper's chain) and its series (five numbers a sample, in the point and again
-/// in the output table). The error is the reason.
+/// would hold more than [`MAX_SWEEP_BYTES`]. What a sweep holds: for every point, its cache key
+/// and outcome (about 1.4 KB, whatever the chain) and its series (five numbers a sample, in the
+/// point and again in the output table); and, while it runs, one scene and its state per
+/// worker thread (about 200 bytes a site). A point's scene and final state are not kept: a
+/// sweep of a long chain would otherwise hold a chain's worth of floats per point. The error is
+/// the reason, with the estimate.
 pub fn check_sweep_memory(points: usize, scene: &crate::Scene) -> Result<(), String> {
     let s = &scene.scenario;
     let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1;
-    let bytes = points as f64 * (1400.0 + (samples * 5 * 8 * 2) as f64);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let in_flight = (threads * s.model.n_sites()) as f64 * 200.0;
+    let bytes = points as f64 * (1400.0 + (samples * 5 * 8 * 2) as f64) + in_flight;
     if bytes > MAX_SWEEP_BYTES {
         return Err(format!(
-            "{points} points of {samples} samples would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
+            "{points} points of {samples} samples on {} sites would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
+            s.model.n_sites(),
             bytes / 1e9,
             MAX_SWEEP_BYTES / 1e9
         ));

@@ -58,6 +58,12 @@ impl FractionSeries {
         Self::of_kind(model, region, SeriesKind::Kinetic { normalisation })
     }
 
+    /// Frees the per-site scratch the sampling used (a float a site): after the run only the
+    /// samples are needed, and a sweep that keeps many points of a long chain keeps just them.
+    pub fn drop_scratch(&mut self) {
+        self.density = Vec::new();
+    }
+
     fn of_kind(model: &Model, region: Region, kind: SeriesKind) -> Self {
         Self {
             region,

@@ -185,18 +185,22 @@ impl Sweep {
 
     /// Every point's scene and cache key, in grid order.
     pub fn points(&self) -> Result<Vec<(Key, Scene)>> {
-        let all: Vec<usize> = (0..self.count()).collect();
-        self.points_at(&all)
-    }
-
-    /// The scenes and cache keys of the points `indices`.
-    pub fn points_at(&self, indices: &[usize]) -> Result<Vec<(Key, Scene)>> {
-        indices
-            .par_iter()
-            .map(|&i| {
+        (0..self.count())
+            .into_par_iter()
+            .map(|i| {
                 let scene = self.scene_at(i)?;
                 Ok((point_key(&scene, self.series), scene))
             })
+            .collect()
+    }
+
+    /// The cache keys of the points `indices`. Only the keys are kept: a scene holds its
+    /// chain (a few floats a site), so thousands of points of a long chain held at once would
+    /// fill the memory; a point's scene is made again when it is simulated.
+    pub fn keys_at(&self, indices: &[usize]) -> Result<Vec<Key>> {
+        indices
+            .par_iter()
+            .map(|&i| Ok(point_key(&self.scene_at(i)?, self.series)))
             .collect()
     }
 
@@ -219,14 +223,9 @@ impl Sweep {
 
     /// The output rows of the points `indices`: one per sample of each point, or one with the
     /// reason for a point that failed.
-    fn table(
-        &self,
-        indices: &[usize],
-        points: &[(Key, Scene)],
-        results: &[PointResult],
-    ) -> Result<DataFrame> {
+    fn table(&self, indices: &[usize], keys: &[Key], results: &[PointResult]) -> Result<DataFrame> {
         let mut rows = Vec::new();
-        for ((&i, (key, _)), result) in indices.iter().zip(points).zip(results) {
+        for ((&i, key), result) in indices.iter().zip(keys).zip(results) {
             let values = self.values(i);
             let samples = result.as_ref().map_or(1, |p| p.t.len());
             for k in 0..samples {
@@ -327,20 +326,20 @@ impl PointGrid for Sweep {
             store,
             events,
         } = at;
-        let points = self.points_at(indices)?;
+        let keys = self.keys_at(indices)?;
         let mut results: Vec<Option<PointResult>> =
-            points.par_iter().map(|(k, _)| store.load(k)).collect();
+            keys.par_iter().map(|k| store.load(k)).collect();
         // A scene listed twice (an axis value repeated) is simulated once: its first point.
         let mut first_of: HashMap<&Key, usize> = HashMap::new();
-        let todo: Vec<usize> = (0..points.len())
-            .filter(|&i| results[i].is_none() && *first_of.entry(&points[i].0).or_insert(i) == i)
+        let todo: Vec<usize> = (0..keys.len())
+            .filter(|&i| results[i].is_none() && *first_of.entry(&keys[i]).or_insert(i) == i)
             .collect();
-        events.simulating(stage, todo.len(), points.len() - todo.len());
+        events.simulating(stage, todo.len(), keys.len() - todo.len());
         let computed: Vec<(usize, PointResult)> = todo
             .par_iter()
             .map(|&i| {
-                let (key, scene) = &points[i];
-                let result = store.get_or_simulate(key, scene, self.series)?;
+                let scene = self.scene_at(indices[i])?;
+                let result = store.get_or_simulate(&keys[i], &scene, self.series)?;
                 events.point_done();
                 Ok((i, result))
             })
@@ -348,9 +347,9 @@ impl PointGrid for Sweep {
         for (i, result) in computed {
             results[i] = Some(result);
         }
-        for i in 0..points.len() {
+        for i in 0..keys.len() {
             if results[i].is_none() {
-                results[i] = results[first_of[&points[i].0]].clone();
+                results[i] = results[first_of[&keys[i]]].clone();
             }
         }
         let results: Vec<PointResult> = results.into_iter().flatten().collect();
@@ -361,7 +360,7 @@ impl PointGrid for Sweep {
                 stats.failed, stats.points
             ));
         }
-        let frame = self.table(indices, &points, &results)?;
+        let frame = self.table(indices, &keys, &results)?;
         Ok((frame, stats))
     }
 
