@@ -330,3 +330,17 @@ fn a_stage_scene_file_stays_inside_the_project_and_is_never_echoed() {
     let e = p.run(&[]).unwrap_err().to_string();
     assert!(e.contains("line 1, column") && !e.contains("abc123"), "{e}");
 }
+
+/// A defaults file is copied into every stage of its kind, so it is bounded: a large one is
+/// refused at load naming the file, before any stage is parsed.
+#[test]
+fn an_oversized_defaults_file_is_refused() {
+    let p = Project::new(&[("sweep", &single_defect_sweep())]);
+    let mut big = String::from("[render.labels]\n");
+    for i in 0..4000 {
+        big.push_str(&format!("name_{i} = \"label {i}\"\n"));
+    }
+    std::fs::write(p.pipeline().join("defaults.toml"), big).unwrap();
+    let e = Pipeline::load(&p.pipeline(), KINDS).unwrap_err().to_string();
+    assert!(e.contains("defaults.toml") && e.contains("a defaults file may have"), "{e}");
+}
