@@ -36,6 +36,46 @@ pub(crate) struct DiffArgs {
     all: bool,
 }
 
+/// Arguments of the hidden `woodpile probe-table PATH`.
+#[derive(Debug, clap::Args)]
+pub(crate) struct ProbeArgs {
+    /// The parquet file to decode.
+    path: PathBuf,
+}
+
+/// `woodpile probe-table PATH`: decodes the file whole, and nothing else. `diff` runs it in a
+/// child process on files that are not sealed woodpile tables, so that a file that makes the
+/// decoder abort ends the child, not the comparison.
+pub(crate) fn probe_command(args: &ProbeArgs) -> Result<(), Failure> {
+    woodpile_pipeline::table::read_checked(&args.path)
+        .map(|_| ())
+        .map_err(Failure::input)
+}
+
+/// Decodes `path` in a child `woodpile probe-table`: the reason it cannot be read, if any.
+fn probe_in_child(path: &std::path::Path) -> Result<(), String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find woodpile itself: {e}"))?;
+    let out = std::process::Command::new(exe)
+        .arg("probe-table")
+        .arg(path)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .map_err(|e| format!("cannot start a decoder process: {e}"))?;
+    if out.status.success() {
+        return Ok(());
+    }
+    let said = String::from_utf8_lossy(&out.stderr);
+    let line = said.lines().rev().find(|l| l.starts_with("error: "));
+    Err(match (line, out.status.code()) {
+        (Some(line), Some(_)) => {
+            let reason = line.trim_start_matches("error: ");
+            let own = format!("{}: ", path.display());
+            reason.strip_prefix(&own).unwrap_or(reason).to_string()
+        }
+        _ => "the parquet decoder failed on it (it ended the process decoding it)".into(),
+    })
+}
+
 /// Exit 0 when A and B agree, 1 when they differ beyond tolerance.
 pub(crate) fn diff_command(args: &DiffArgs) -> Result<bool, Failure> {
     let mut options = DiffOptions {
@@ -45,6 +85,7 @@ pub(crate) fn diff_command(args: &DiffArgs) -> Result<bool, Failure> {
         },
         ignore: args.ignore.iter().cloned().collect(),
         compare_keys: args.keys,
+        probe: Some(probe_in_child),
         ..Default::default()
     };
     for spec in &args.tolerances {

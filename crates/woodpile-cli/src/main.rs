@@ -60,6 +60,9 @@ enum Command {
     Diff(diff_cmd::DiffArgs),
     /// Make a new study folder that runs as written: `woodpile new study NAME`.
     New(new_study::Args),
+    /// Decode one parquet file and exit (what `diff` runs on foreign files, in a child).
+    #[command(hide = true)]
+    ProbeTable(diff_cmd::ProbeArgs),
 }
 
 /// The package version and the numerics revision every cache key includes (`woodpile 0.1.0 r5`):
@@ -108,6 +111,7 @@ impl Failure {
 }
 
 fn main() -> ExitCode {
+    quiet_decoder_panics();
     let cli = Cli::parse();
     if let Err(reason) = start_threads() {
         eprintln!("error: {reason}");
@@ -120,6 +124,7 @@ fn main() -> ExitCode {
         Command::Merge(args) => pipeline_cmd::merge_command(&args),
         Command::Slurm(args) => pipeline_cmd::slurm_command(&args),
         Command::New(args) => new_study::run(&args),
+        Command::ProbeTable(args) => diff_cmd::probe_command(&args),
         Command::Diff(args) => match diff_cmd::diff_command(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
@@ -146,6 +151,21 @@ fn start_threads() -> Result<(), String> {
     builder
         .build_global()
         .map_err(|e| format!("cannot start the worker threads: {e}"))
+}
+
+/// The parquet decoder's worker threads (`polars-*`) panic on some damaged files; each such
+/// panic is caught and reported as one error line naming the file, so its message and
+/// backtrace are not printed as well. Every other panic is printed as usual.
+fn quiet_decoder_panics() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let decoder = std::thread::current()
+            .name()
+            .is_some_and(|name| name.starts_with("polars"));
+        if !decoder {
+            default(info);
+        }
+    }));
 }
 
 /// The error and its causes on one line, each cause once: an error that already states its

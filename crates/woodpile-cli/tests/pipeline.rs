@@ -575,3 +575,28 @@ fn a_sweep_of_a_long_chain_holds_no_scene_per_point() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(dir.path().join("results/long.parquet").is_file());
 }
+
+/// Foreign parquet files that the decoder cannot take end `diff` with exit 2 naming the file,
+/// never an abort or a printed backtrace: one whose damaged page header makes the decoder ask
+/// for 2^61 bytes (decoded in a child process), and one with a decimal column.
+#[test]
+fn diff_of_foreign_parquet_the_decoder_cannot_take_exits_2() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    for bad in ["foreign_aborts_decoder.parquet", "foreign_decimal.parquet"] {
+        let (a, b) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+        std::fs::copy(data.join(bad), a.path().join("t.parquet")).unwrap();
+        std::fs::copy(data.join("foreign_ok.parquet"), b.path().join("t.parquet")).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
+            .arg("diff")
+            .args([a.path(), b.path()])
+            .output()
+            .unwrap();
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(
+            stderr.contains("t.parquet") && !stderr.contains("panicked"),
+            "{bad}: {stderr}"
+        );
+        assert_eq!(stderr.lines().count(), 1, "{bad}: {stderr}");
+    }
+}

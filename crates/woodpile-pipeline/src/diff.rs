@@ -40,6 +40,11 @@ pub struct DiffOptions {
     pub ignore: BTreeSet<String>,
     /// Compare the key columns ([`KEY_COLUMNS`]) too.
     pub compare_keys: bool,
+    /// Run on every file that is not a sealed woodpile table before it is decoded here: a
+    /// foreign file can make the parquet decoder abort the process (an allocation of 2^61
+    /// bytes from a damaged page header), which no error handling here can catch. The CLI
+    /// decodes such a file in a child process first. The error is the reason.
+    pub probe: Option<fn(&Path) -> std::result::Result<(), String>>,
 }
 
 /// Columns that hold content hashes: they differ whenever the parameters do.
@@ -193,6 +198,13 @@ fn compare_files(
     options: &DiffOptions,
     report: &mut DiffReport,
 ) -> Result<()> {
+    if let Some(probe) = options.probe {
+        for path in [a, b] {
+            if !crate::table::is_sealed(path)? {
+                probe(path).map_err(|reason| PipelineError::io(path, reason))?;
+            }
+        }
+    }
     let (ca, cb) = (read_checked(a)?, read_checked(b)?);
     for (checked, path) in [(&ca, a), (&cb, b)] {
         if checked.manifest.is_none() {

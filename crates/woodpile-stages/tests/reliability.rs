@@ -341,6 +341,11 @@ fn an_oversized_defaults_file_is_refused() {
         big.push_str(&format!("name_{i} = \"label {i}\"\n"));
     }
     std::fs::write(p.pipeline().join("defaults.toml"), big).unwrap();
-    let e = Pipeline::load(&p.pipeline(), KINDS).unwrap_err().to_string();
-    assert!(e.contains("defaults.toml") && e.contains("a defaults file may have"), "{e}");
+    let e = Pipeline::load(&p.pipeline(), KINDS)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("defaults.toml") && e.contains("a defaults file may have"),
+        "{e}"
+    );
 }

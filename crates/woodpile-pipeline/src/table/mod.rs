@@ -75,6 +75,12 @@ fn sealed_bytes(path: &Path) -> Result<(Vec<u8>, Integrity)> {
     Ok((bytes, integrity))
 }
 
+/// Whether the file at `path` is a woodpile table whose bytes match its seal (what woodpile
+/// wrote, and nothing since).
+pub fn is_sealed(path: &Path) -> Result<bool> {
+    Ok(sealed_bytes(path)?.1 == Integrity::Intact)
+}
+
 /// Runs a polars decoder on bytes: some damaged files make it panic rather than return an
 /// error (sealed files never reach it damaged; foreign ones may).
 fn decode<T>(path: &Path, work: impl FnOnce() -> PolarsResult<T>) -> Result<T> {
@@ -82,6 +88,51 @@ fn decode<T>(path: &Path, work: impl FnOnce() -> PolarsResult<T>) -> Result<T> {
         Ok(result) => result.map_err(|e| PipelineError::io(path, e)),
         Err(_) => Err(PipelineError::io(path, "the parquet decoder failed on it")),
     }
+}
+
+/// Most memory a table may take once decoded, as its footer states it.
+pub const MAX_DECODED_BYTES: f64 = 2e9;
+
+/// Whether a table, by its footer, is one woodpile can decode: columns of 32- and 64-bit
+/// numbers, booleans, text or lists of them (the polars build here has no decimal, map, struct
+/// or small integer types, and panics on some), and at most [`MAX_DECODED_BYTES`] once decoded (a small file of run-length encoded
+/// values can claim gigabytes). The error is the reason.
+fn decodable(
+    metadata: &FileMetadataRef,
+    schema: &polars::prelude::ArrowSchema,
+) -> std::result::Result<(), String> {
+    use polars::prelude::ArrowDataType as A;
+    fn readable(dtype: &A) -> bool {
+        match dtype {
+            A::Null | A::Boolean | A::Utf8 | A::LargeUtf8 | A::Utf8View => true,
+            A::List(f) | A::LargeList(f) | A::FixedSizeList(f, _) => readable(f.dtype()),
+            // The integer and float widths this build of polars decodes.
+            A::Int32 | A::Int64 | A::UInt32 | A::UInt64 | A::Float32 | A::Float64 => true,
+            _ => false,
+        }
+    }
+    if let Some((name, field)) = schema.iter().find(|(_, f)| !readable(f.dtype())) {
+        return Err(format!(
+            "column `{name}` is {:?}: woodpile reads columns of numbers, text and lists of them",
+            field.dtype()
+        ));
+    }
+    let stated: usize = metadata
+        .row_groups
+        .iter()
+        .map(|g| g.total_byte_size())
+        .sum();
+    let cells = metadata.num_rows as f64 * schema.len() as f64 * 8.0;
+    let bytes = (stated as f64).max(cells);
+    if bytes > MAX_DECODED_BYTES {
+        return Err(format!(
+            "its footer states {} rows, about {:.1} GB decoded, more than the {:.0} GB woodpile reads",
+            metadata.num_rows,
+            bytes / 1e9,
+            MAX_DECODED_BYTES / 1e9
+        ));
+    }
+    Ok(())
 }
 
 /// Reads the whole table at `path`, after checking its bytes against its manifest's seal.
@@ -94,10 +145,15 @@ pub fn read_checked(path: &Path) -> Result<Checked> {
             integrity,
         });
     }
-    let (metadata, frame) = decode(path, || {
+    // The footer first: what decoding would hold, and whether it is columns woodpile reads.
+    let (metadata, schema) = decode(path, || {
         let mut reader = ParquetReader::new(std::io::Cursor::new(&bytes));
         let metadata = reader.get_metadata()?.clone();
-        reader.finish().map(|frame| (metadata, frame))
+        Ok((metadata, reader.schema()?))
+    })?;
+    decodable(&metadata, &schema).map_err(|reason| PipelineError::io(path, reason))?;
+    let frame = decode(path, || {
+        ParquetReader::new(std::io::Cursor::new(&bytes)).finish()
     })?;
     let manifest = manifest_text(&metadata)
         .map(|t| parse_manifest(path, &t))
