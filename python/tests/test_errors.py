@@ -143,3 +143,10 @@ def test_hostile_values_are_scene_errors():
             raise RuntimeError("no index here")
 
     _refused({"run": {"t_end": BadIndex()}}, "run.t_end.*__index__ failed.*no index here")
+
+
+def test_kernel_files_are_refused_unread():
+    """/proc and /sys files pass as regular files; one read as root (/proc/kmsg) blocks for ever,
+    holding the GIL."""
+    with pytest.raises(woodpile.SceneError, match="a kernel file"):
+        woodpile.simulate("/proc/self/status")

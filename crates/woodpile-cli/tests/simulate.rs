@@ -212,6 +212,9 @@ fn blow_up_exits_3_without_numbers() {
 #[test]
 fn devices_and_oversized_files_are_refused_unread() {
     assert_refused(Path::new("/dev/zero"), &["not a regular file"]);
+    // Kernel files pass as regular ones (`/proc/kmsg` blocks a root reader for ever).
+    assert_refused(Path::new("/proc/self/status"), &["a kernel file"]);
+    assert_refused(Path::new("/proc/self/environ"), &["a kernel file"]);
 
     let mut big = String::from("[chain]\nn = 100\n");
     while big.len() <= 2 << 20 {

@@ -13,7 +13,7 @@ pub fn refusal(path: &Path) -> Option<String> {
     let meta = std::fs::symlink_metadata(path).ok()?;
     let kind = meta.file_type();
     if kind.is_file() {
-        None
+        woodpile_scene::kernel_file(path)
     } else if kind.is_symlink() {
         Some("a symbolic link, which woodpile does not follow in a results tree".into())
     } else if kind.is_dir() {

@@ -65,6 +65,17 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, path)
 }
 
+/// Why `path` is refused as a kernel file: `/proc` and `/sys` hold files that pass as regular
+/// ones but are the kernel's (`/proc/kmsg`, read as root, blocks for ever; others print the
+/// environment). `None` for any other path.
+pub fn kernel_file(path: &Path) -> Option<String> {
+    let real = std::fs::canonicalize(path).ok()?;
+    ["/proc", "/sys"]
+        .iter()
+        .any(|root| real.starts_with(root))
+        .then(|| format!("a kernel file ({}), not an input", real.display()))
+}
+
 /// Reads an input file (scene or stage) as text: only a regular file of at most
 /// [`MAX_FILE_BYTES`], so that `/dev/zero`, a FIFO or a runaway generated file is refused
 /// at once instead of read until memory runs out. The error is the reason, without the path.
@@ -73,6 +84,9 @@ pub fn read_input(path: &Path) -> Result<String, String> {
     let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
     if !meta.is_file() {
         return Err("not a regular file".into());
+    }
+    if let Some(reason) = kernel_file(path) {
+        return Err(reason);
     }
     let too_big =
         |n: u64| format!("{n} bytes, more than the {MAX_FILE_BYTES} an input file may have");
