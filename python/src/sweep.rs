@@ -224,7 +224,9 @@ impl Grid {
             float("E_final", &|p, _| Some(p.outcome.e_final))?;
         }
         float("error_estimate", &|p, _| p.outcome.error_estimate)?;
-        float("dt", &|p, _| p.outcome.plan.dt())?;
+        float("dt", &|p, _| {
+            p.outcome.plan.dt().map(|_| p.outcome.stats.max_step)
+        })?;
         let mut integer = |name: &str, f: &dyn Fn(&Point) -> u64| -> PyResult<()> {
             let v: Vec<i64> = rows
                 .iter()

@@ -330,3 +330,24 @@ fn outputs_that_are_not_plain_new_files_are_refused() {
     assert!(std::fs::read_to_string(&scene).unwrap().contains("t_end"));
     assert!(!same.exists());
 }
+
+/// `dt` is the step taken: each sample interval is cut into equal steps of at most the one
+/// asked for, and `dt_requested` keeps that. dt = 0.08 with samples every 1 takes 13 steps of
+/// 1/13 per interval.
+#[test]
+fn dt_is_the_step_taken() {
+    let (out, _) =
+        simulate("[run]\nmethod = \"rkn6-contact\"\ndt = 0.08\nsample_every = 1.0\nt_end = 20.0\n");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(json_number(&stdout, "dt_requested"), 0.08);
+    assert!(
+        (json_number(&stdout, "dt") - 1.0 / 13.0).abs() < 1e-12,
+        "{stdout}"
+    );
+    assert_eq!(json_number(&stdout, "steps"), 260.0);
+}

@@ -36,7 +36,7 @@ pub type PointResult = std::result::Result<PointData, String>;
 pub struct PointData {
     /// The method that produced the reported run.
     pub method: String,
-    /// Its fixed step, if any.
+    /// Its fixed step as taken (the longest), if any.
     pub dt: Option<f64>,
     /// Steps of the reported run.
     pub steps: u64,
@@ -109,7 +109,8 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
     Ok(PointData {
         method: out.plan.method.name().to_string(),
         dt: match out.plan.control {
-            StepControl::Fixed { dt } => Some(dt),
+            // The step taken (each sample interval cut into equal steps of at most dt).
+            StepControl::Fixed { .. } => Some(out.stats.max_step),
             StepControl::Adaptive { .. } => None,
         },
         steps: out.stats.steps,

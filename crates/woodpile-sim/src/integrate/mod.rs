@@ -179,6 +179,10 @@ pub struct DriveConfig {
 pub struct Stats {
     /// Accepted steps.
     pub steps: u64,
+    /// The longest accepted step. A fixed step `dt` is what each sample interval is cut into
+    /// equal steps of at most: with `sample_every = 1` and `dt = 0.8` every step is 0.5, and
+    /// this says so.
+    pub max_step: f64,
     /// Rejected step attempts (adaptive methods).
     pub rejected: u64,
     /// Right-hand-side evaluations.
@@ -278,6 +282,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                     active.update(model, y, window);
                     t = if i + 1 == n_steps { target } else { t + h_eq };
                     stats.steps += 1;
+                    stats.max_step = stats.max_step.max(h_eq);
                     if stats.steps > cfg.max_steps {
                         return Err(SimError::TooManySteps {
                             t,
@@ -314,6 +319,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
                             active.update(model, y, window);
                             t = if lands { target } else { t + h_try };
                             stats.steps += 1;
+                            stats.max_step = stats.max_step.max(h_try);
                             check_finite_in(y, t, &window.state_ranges(model))?;
                             // A step shortened to land on a sample says nothing about the
                             // step the method could take: keep the larger proposal.
