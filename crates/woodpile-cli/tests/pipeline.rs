@@ -600,3 +600,18 @@ fn diff_of_foreign_parquet_the_decoder_cannot_take_exits_2() {
         assert_eq!(stderr.lines().count(), 1, "{bad}: {stderr}");
     }
 }
+
+/// A stage file whose name starts with `-` is refused at load: as a stage name it would pass
+/// for a flag (`--dry-run.toml` ran as a stage).
+#[test]
+fn flag_like_stage_names_are_refused() {
+    let dir = project();
+    std::fs::write(dir.path().join("pipeline/--dry-run.toml"), sweep()).unwrap();
+    let out = woodpile(dir.path(), &["status"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--dry-run.toml") && stderr.contains("starting with a letter or digit"),
+        "{stderr}"
+    );
+}

@@ -33,6 +33,16 @@ fn quote(path: &Path) -> String {
     format!("'{}'", path.display().to_string().replace('\'', "'\\''"))
 }
 
+/// Most CPUs a task may ask for: more than any node has.
+pub const MAX_CPUS: usize = 1024;
+
+/// `path` as an `#SBATCH --output` value: in double quotes (sbatch splits its lines at spaces
+/// otherwise), with `%` doubled (sbatch reads `%j`, `%A` as the job's numbers). A path with a
+/// double quote or a backslash is refused by [`SlurmJob::validate`].
+fn sbatch_path(path: &Path) -> String {
+    path.display().to_string().replace('%', "%%")
+}
+
 impl SlurmJob<'_> {
     /// Refuses what a script cannot carry safely: a value with a character outside
     /// `[A-Za-z0-9-_:.,+]` (partition, time), or a path with a control character such as a
@@ -51,6 +61,25 @@ impl SlurmJob<'_> {
                     ));
                 }
             }
+        }
+        if self.cpus == 0 || self.cpus > MAX_CPUS {
+            return Err(format!(
+                "--cpus {}: a task takes from 1 to {MAX_CPUS} CPUs",
+                self.cpus
+            ));
+        }
+        if self.stage.starts_with('-') {
+            return Err(format!(
+                "stage `{}`: a name that starts with `-` would be read as a flag",
+                self.stage.escape_debug()
+            ));
+        }
+        let logs = self.logs.display().to_string();
+        if logs.contains(['"', '\\']) {
+            return Err(format!(
+                "--out `{}`: a quote or a backslash cannot go into an #SBATCH --output path",
+                logs.escape_debug()
+            ));
         }
         let paths = [
             ("the woodpile binary", self.binary),
@@ -73,8 +102,8 @@ impl SlurmJob<'_> {
 
     fn header(&self, name: &str, log: &str) -> String {
         let mut h = format!(
-            "#!/bin/bash\n#SBATCH --job-name={name}\n#SBATCH --output={}/{log}\n#SBATCH --cpus-per-task={}\n",
-            self.logs.display(),
+            "#!/bin/bash\n#SBATCH --job-name={name}\n#SBATCH --output=\"{}/{log}\"\n#SBATCH --cpus-per-task={}\n",
+            sbatch_path(self.logs),
             self.cpus
         );
         if let Some(p) = self.partition {
@@ -176,6 +205,44 @@ impl SlurmJob<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A job as the CLI would make it, with `logs` as `--out`.
+    fn job_with(cpus: usize, logs: &Path) -> SlurmJob<'_> {
+        SlurmJob {
+            stage: "f7_coarse",
+            tasks: 2,
+            partition: None,
+            time: None,
+            cpus,
+            binary: Path::new("/opt/wp/woodpile"),
+            workdir: Path::new("/home/me/woodpile"),
+            pipeline: Path::new("pipeline"),
+            results: Path::new("results"),
+            logs,
+        }
+    }
+
+    /// What sbatch would misread is refused or escaped: an absurd CPU count, a `%` in the log
+    /// folder (sbatch's job-number patterns), spaces (its line splitting), quotes.
+    #[test]
+    fn cpus_are_bounded_and_the_output_path_is_quoted_and_escaped() {
+        let logs = Path::new("/home/me/my logs/100%j");
+        assert!(job_with(usize::MAX, logs)
+            .validate()
+            .unwrap_err()
+            .contains("--cpus"));
+        assert!(job_with(0, logs).validate().is_err());
+        let job = job_with(4, logs);
+        job.validate().unwrap();
+        assert!(job
+            .array_script()
+            .contains("#SBATCH --output=\"/home/me/my logs/100%%j/f7_coarse-%A_%a.out\"\n"));
+        let quoted = Path::new("/tmp/a\"b");
+        assert!(job_with(4, quoted)
+            .validate()
+            .unwrap_err()
+            .contains("--out"));
+    }
 
     #[test]
     fn scripts_shard_by_array_index_and_chain_the_merge() {

@@ -166,7 +166,12 @@ fn stage_name(file: &Path) -> Result<String> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let ok = !name.is_empty()
+    // It starts with a letter or digit: a name such as `--dry-run` would be read as a flag
+    // wherever it is passed on (scripts, `woodpile run NAME`).
+    let ok = name
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_lowercase() || c.is_ascii_digit())
         && name
             .chars()
             .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_' || c == '-');
@@ -175,7 +180,7 @@ fn stage_name(file: &Path) -> Result<String> {
     } else {
         Err(PipelineError::Syntax {
             file: file.to_path_buf(),
-            reason: "a stage file's name must be lowercase letters, digits, `_` or `-`".into(),
+            reason: "a stage file's name must be lowercase letters, digits, `_` or `-`, starting with a letter or digit".into(),
             source: None,
         })
     }
