@@ -63,7 +63,8 @@ pub(crate) struct RunArgs {
     #[arg(long, conflicts_with = "shard")]
     shard_from_env: bool,
     /// Run a variant of a stage with a key of its file set, without editing it: `--set
-    /// f4_fractions.at=120.0` runs `f4_fractions--at-120_0`, with its own key and output
+    /// f4_fractions.at=120` runs `f4_fractions--at-120` (a value whose name would lose characters,
+    /// such as `120.0`, is followed by a short hash), with its own key and output
     /// (repeatable; each stage named gets one variant).
     #[arg(long = "set", value_name = "STAGE.KEY=VALUE")]
     sets: Vec<String>,

@@ -411,9 +411,9 @@ fn a_new_study_runs_as_written_without_directory_flags() {
     assert!(svg.contains(r#"width="86.0mm""#) && svg.contains("Eₜᵣ"));
     let inside = woodpile(&study.join("pipeline"), &["status", "--check"]);
     assert_eq!(inside.status.code(), Some(0), "{}", text(&inside.stdout));
-    let variant = woodpile(&study, &["run", "--set", "fractions.at=40.0"]);
+    let variant = woodpile(&study, &["run", "--set", "fractions.at=40"]);
     assert!(variant.status.success(), "{}", text(&variant.stderr));
-    assert!(study.join("results/fractions--at-40_0.parquet").exists());
+    assert!(study.join("results/fractions--at-40.parquet").exists());
     assert_eq!(
         woodpile(&study, &["status", "--check"]).status.code(),
         Some(0)
@@ -614,4 +614,28 @@ fn flag_like_stage_names_are_refused() {
         stderr.contains("--dry-run.toml") && stderr.contains("starting with a letter or digit"),
         "{stderr}"
     );
+}
+
+/// `--set`: a key given twice is refused before anything runs, and a long value makes a short
+/// name (it was a file name too long, after the computation).
+#[test]
+fn set_refuses_a_repeated_key_and_names_long_values_briefly() {
+    let dir = project();
+    let out = woodpile(
+        dir.path(),
+        &[
+            "run",
+            "--set",
+            "sweep.scene.run.t_end=5.0",
+            "--set",
+            "sweep.scene.run.t_end=6.0",
+        ],
+    );
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("given twice"), "{stderr}");
+    assert!(!dir.path().join("results").join("points").exists());
+    let long = format!("sweep.description={}", "x".repeat(3000));
+    let out = woodpile(dir.path(), &["run", "--set", &long]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
 }

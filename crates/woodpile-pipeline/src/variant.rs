@@ -31,34 +31,53 @@ impl Set {
         if stage.is_empty() || key.is_empty() || key.split('.').any(str::is_empty) {
             return Err(FORM.into());
         }
-        let value = value.trim();
-        let parsed = toml::from_str::<toml::Table>(&format!("v = {value}"))
-            .ok()
-            .and_then(|mut t| t.remove("v"))
-            .unwrap_or_else(|| toml::Value::String(value.to_string()));
         Ok(Set {
             stage: stage.to_string(),
             key: key.to_string(),
-            value: parsed,
+            value: value_of(value.trim()),
         })
     }
 
-    /// `key-value` in the characters a stage name allows.
+    /// `key-value` in the characters a stage name allows, readable, and one to one: when the
+    /// readable form loses anything (a `.`, a capital, a space, a float's point, a string that
+    /// reads as a number) or is long, a hash of the exact key and value follows it, so `a.b`
+    /// and `a b` never share a variant (and an output file).
     fn slug(&self) -> String {
-        let value = match &self.value {
-            toml::Value::String(s) => s.clone(),
-            toml::Value::Float(x) => format!("{x:?}"),
-            other => other.to_string(),
+        let (value, exact) = match &self.value {
+            toml::Value::Integer(i) => (i.to_string(), true),
+            toml::Value::String(s) => (s.clone(), value_of(s) == self.value),
+            toml::Value::Float(x) => (format!("{x:?}"), false),
+            other => (other.to_string(), false),
         };
-        format!("{}-{value}", self.key)
+        let raw = format!("{}-{value}", self.key);
+        let readable: String = raw
             .chars()
             .map(|c| match c {
                 'a'..='z' | '0'..='9' | '-' | '_' => c,
                 'A'..='Z' => c.to_ascii_lowercase(),
                 _ => '_',
             })
-            .collect()
+            .take(MAX_SLUG)
+            .collect();
+        if exact && readable == raw && !self.key.contains('-') {
+            return readable;
+        }
+        let exact_text = format!("{}={}", self.key, self.value);
+        let hash = blake3::hash(exact_text.as_bytes()).to_hex();
+        format!("{readable}-{}", &hash[..8])
     }
+}
+
+/// The longest readable part of a variant's name for one set: file names stay far below the
+/// system's 255 bytes (a longer value is told apart by its hash).
+const MAX_SLUG: usize = 60;
+
+/// A `--set` value: TOML (`120.0`, `[1, 2]`, `"auto"`), or else the text as a string.
+fn value_of(text: &str) -> toml::Value {
+    toml::from_str::<toml::Table>(&format!("v = {text}"))
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(text.to_string()))
 }
 
 /// The name of the variant of `stage` that `sets` (those naming it) make.
@@ -82,6 +101,7 @@ pub fn variants(
     let mut names: Vec<&str> = sets.iter().map(|s| s.stage.as_str()).collect();
     names.sort_unstable();
     names.dedup();
+
     names
         .into_iter()
         .map(|name| {
@@ -95,6 +115,23 @@ pub fn variants(
                         .join(", "),
                 }
             })?;
+            // A key set twice would name the variant after both values and run the last.
+            let mine: Vec<&Set> = sets.iter().filter(|s| s.stage == name).collect();
+            if let Some(twice) = mine
+                .iter()
+                .enumerate()
+                .find(|(i, set)| mine[..*i].iter().any(|s| s.key == set.key))
+            {
+                return Err(PipelineError::Definition {
+                    file: stage.file.clone(),
+                    key: twice.1.key.clone(),
+                    reason: format!(
+                        "--set {}.{} given twice; give each key once",
+                        name, twice.1.key
+                    ),
+                    source: None,
+                });
+            }
             let mut table =
                 crate::stage::parse_table(&crate::stage::read_text(&stage.file)?, &stage.file)?;
             for set in sets.iter().filter(|s| s.stage == name) {
@@ -155,12 +192,21 @@ mod tests {
     fn sets_parse_values_as_toml_and_name_their_variant() {
         let set = Set::parse("f4_fractions.at=120.0").unwrap();
         assert_eq!(set.value, toml::Value::Float(120.0));
+        let name = variant_name("f4_fractions", &[set]);
+        assert!(
+            name.starts_with("f4_fractions--at-120_0-") && name.len() == 31,
+            "{name}"
+        );
         assert_eq!(
-            variant_name("f4_fractions", &[set]),
-            "f4_fractions--at-120_0"
+            variant_name("s", &[Set::parse("s.at=40").unwrap()]),
+            "s--at-40"
+        );
+        assert_eq!(
+            variant_name("s", &[Set::parse("s.method=rk4").unwrap()]),
+            "s--method-rk4"
         );
         let tight = Set::parse("s.scene.run.tolerance=1e-7").unwrap();
-        assert_eq!(variant_name("s", &[tight]), "s--scene_run_tolerance-1e-7");
+        assert!(variant_name("s", &[tight]).starts_with("s--scene_run_tolerance-1e-7-"));
         let set = Set::parse("s.scene.run.method=rk4").unwrap();
         assert_eq!(set.value, toml::Value::String("rk4".into()));
         assert!(Set::parse("nokey=1").is_err());
@@ -169,5 +215,19 @@ mod tests {
         assign(&mut table, "scene.run.tolerance", toml::Value::Float(1e-6)).unwrap();
         assert_eq!(table["scene"]["run"]["tolerance"].as_float(), Some(1e-6));
         assert!(assign(&mut table, "scene.run.tolerance.x", toml::Value::Integer(1)).is_err());
+    }
+
+    /// Names are one to one: values that read alike get different names, and a long value a
+    /// short one.
+    #[test]
+    fn variant_names_never_collide_and_stay_short() {
+        let name = |text: &str| variant_name("s", &[Set::parse(text).unwrap()]);
+        assert_ne!(name("s.m=a.b"), name("s.m=a b"));
+        assert_ne!(name("s.m=A"), name("s.m=a"));
+        assert_ne!(name("s.at=40"), name("s.at=\"40\""));
+        assert_ne!(name("s.at=120.0"), name("s.at=120_0"));
+        let long = name(&format!("s.m={}", "x".repeat(5000)));
+        assert!(long.len() < 80, "{}", long.len());
+        assert_ne!(long, name(&format!("s.m={}", "x".repeat(5001))));
     }
 }

@@ -136,7 +136,7 @@ eps = "$eps"
 
     let set = Set::parse("at_end.at=6.0").unwrap();
     let name = woodpile_pipeline::variant::variant_name("at_end", std::slice::from_ref(&set));
-    assert_eq!(name, "at_end--at-6_0");
+    assert!(name.starts_with("at_end--at-6_0-"), "{name}");
     p.run_with(std::slice::from_ref(&set), &[&name]).unwrap();
     let variant = table::read(&output_path(&p.results(), &name)).unwrap();
     assert!(table::f64_column(&variant, "t")
