@@ -26,11 +26,21 @@ pub fn write_checksummed(path: &Path, bytes: &[u8]) -> Result<()> {
     write_impl(path, |file| file.write_all(bytes), false)
 }
 
-/// Writes `path` atomically with `fill`, which receives the temporary file.
+/// Writes `path` atomically with `fill`, which receives the temporary file. Temporaries of
+/// `path` left by writers that are gone (an interrupted `simulate --field` leaves tens of MB)
+/// are removed first.
 pub fn write_with(
     path: &Path,
     fill: impl FnOnce(&mut fs::File) -> std::io::Result<()>,
 ) -> Result<()> {
+    if let (Some(dir), Some(name)) = (path.parent(), path.file_name()) {
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        sweep_stale(dir, Some(&name.to_string_lossy()));
+    }
     write_impl(path, fill, true)
 }
 
@@ -111,16 +121,22 @@ fn host() -> &'static str {
 /// exact form `.{name}~{host}~{pid}~{12 random alphanumerics}.tmp`: a user's own `.x.123.tmp`
 /// in a figures folder is not woodpile's, and is never removed.
 fn temp_owner(name: &str) -> Option<(&str, u32)> {
+    temp_parts(name).map(|(_, host, pid)| (host, pid))
+}
+
+/// The target's file name, the writer's host and its process id of one of [`temp_file`]'s
+/// temporaries.
+fn temp_parts(name: &str) -> Option<(&str, &str, u32)> {
     let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
     let mut parts = rest.rsplitn(4, '~');
-    let (Some(token), Some(pid), Some(host), Some(_name)) =
+    let (Some(token), Some(pid), Some(host), Some(target)) =
         (parts.next(), parts.next(), parts.next(), parts.next())
     else {
         return None;
     };
     let random = token.len() == TEMP_RANDOM && token.chars().all(|c| c.is_ascii_alphanumeric());
     let digits = !pid.is_empty() && pid.chars().all(|c| c.is_ascii_digit());
-    (random && digits && !host.is_empty()).then(|| Some((host, pid.parse().ok()?)))?
+    (random && digits && !host.is_empty()).then(|| Some((target, host, pid.parse().ok()?)))?
 }
 
 /// Random characters in a temporary's name.
@@ -135,15 +151,23 @@ const FOREIGN_TEMP_AGE: std::time::Duration = std::time::Duration::from_secs(24 
 /// for a day. Temporaries of live writers (another shard writing into the same directory) are
 /// left alone. Returns how many were removed.
 pub fn sweep_stale_temps(dir: &Path) -> usize {
+    sweep_stale(dir, None)
+}
+
+/// [`sweep_stale_temps`], of the temporaries of the file named `target` only when given.
+fn sweep_stale(dir: &Path, target: Option<&str>) -> usize {
     let Ok(entries) = fs::read_dir(dir) else {
         return 0;
     };
     let mut removed = 0;
     for entry in entries.flatten() {
         let name = entry.file_name().to_string_lossy().into_owned();
-        let Some((writer_host, pid)) = temp_owner(&name) else {
+        let Some((of, writer_host, pid)) = temp_parts(&name) else {
             continue;
         };
+        if target.is_some_and(|t| t != of) {
+            continue;
+        }
         let gone = if writer_host == host() {
             !process_alive(pid)
         } else {
@@ -215,6 +239,21 @@ mod tests {
         assert_eq!(sweep_stale_temps(dir.path()), 1);
         assert!(!dead.exists() && live.exists() && foreign.exists() && other.exists());
         assert!(users.exists() && short.exists());
+    }
+
+    /// A write sweeps the dead temporaries of its own target, and only those.
+    #[test]
+    fn a_write_removes_its_targets_dead_temporaries() {
+        let dir = tempfile::tempdir().unwrap();
+        let dead = |target: &str| {
+            dir.path()
+                .join(format!(".{target}~{}~0~Ab3dEf6hIj9l.tmp", host()))
+        };
+        std::fs::write(dead("field.parquet"), "left by a killed run").unwrap();
+        std::fs::write(dead("other.parquet"), "not this write's").unwrap();
+        write(&dir.path().join("field.parquet"), b"new").unwrap();
+        assert!(!dead("field.parquet").exists());
+        assert!(dead("other.parquet").exists());
     }
 
     #[test]
