@@ -176,7 +176,7 @@ fn bad_scenes_exit_nonzero_with_a_clear_message() {
             "chain.boundary",
             "fixed",
         ),
-        ("[[defect]\nsite = 0\n", "line 1", "TOML parse error"),
+        ("[[defect]\nsite = 0\n", "line 1", "column 10"),
     ];
     for (text, key, reason) in cases {
         assert_refused(&scene_file(text), &[key, reason]);
@@ -231,12 +231,23 @@ fn endless_runs_and_standing_impulses_exit_2_naming_the_key() {
         ("[run]\nt_end = 1e12\n", "run.t_end"),
         ("[run]\nmethod = \"rk4\"\ndt = 1e-300\n", "run.dt"),
         ("[run]\ntolerance = 1e-30\n", "run.tolerance"),
+        ("[run]\ntolerance = 10.0\n", "run.tolerance"),
+        ("[run]\ntolerance = 1e300\n", "run.tolerance"),
+        ("[impulse]\nvelocity = -1e-308\n", "impulse.velocity"),
+        ("[impulse]\nvelocity = 1e200\n", "impulse.velocity"),
         ("[run]\nsample_every = 1e-12\n", "run.sample_every"),
         ("[[defect]]\nsite = 0\neps = 1e-300\n", "defect[0]"),
         ("[impulse]\nvelocity = 0.0\n", "impulse.velocity"),
     ] {
         assert_refused(&scene_file(scene), &[&format!("key `{key}`")]);
     }
+    // A tiny value is shown as 1e-308, not as a 300-digit decimal.
+    let out = simulate_file(&scene_file("[run]\nt_end = -1e-308\n"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("got -1e-308") && stderr.len() < 200,
+        "{stderr}"
+    );
 }
 
 /// The binary carries two copies of its hot loops, for AVX2 and for the x86-64 baseline, and

@@ -117,15 +117,10 @@ fn host() -> &'static str {
     })
 }
 
-/// The writer (host, process id) of one of [`temp_file`]'s temporaries, recognised by their
+/// The target's file name and the writer (host, process id) of one of [`temp_file`]'s
+/// temporaries, recognised by their
 /// exact form `.{name}~{host}~{pid}~{12 random alphanumerics}.tmp`: a user's own `.x.123.tmp`
 /// in a figures folder is not woodpile's, and is never removed.
-fn temp_owner(name: &str) -> Option<(&str, u32)> {
-    temp_parts(name).map(|(_, host, pid)| (host, pid))
-}
-
-/// The target's file name, the writer's host and its process id of one of [`temp_file`]'s
-/// temporaries.
 fn temp_parts(name: &str) -> Option<(&str, &str, u32)> {
     let rest = name.strip_prefix('.')?.strip_suffix(".tmp")?;
     let mut parts = rest.rsplitn(4, '~');
@@ -266,11 +261,14 @@ mod tests {
         );
         assert_ne!(a.path(), b.path());
         let name = a.path().file_name().unwrap().to_str().unwrap();
-        assert_eq!(temp_owner(name), Some((host(), std::process::id())));
-        assert_eq!(temp_owner("a.parquet"), None);
-        assert_eq!(temp_owner(".a.tmp"), None);
-        assert_eq!(temp_owner(".a~h~x~t.tmp"), None);
-        assert_eq!(temp_owner(".a.parquet.123.tmp"), None);
+        assert_eq!(
+            temp_parts(name),
+            Some(("a.parquet", host(), std::process::id()))
+        );
+        assert_eq!(temp_parts("a.parquet"), None);
+        assert_eq!(temp_parts(".a.tmp"), None);
+        assert_eq!(temp_parts(".a~h~x~t.tmp"), None);
+        assert_eq!(temp_parts(".a.parquet.123.tmp"), None);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use woodpile_sim::model::{Boundary, End};
 use woodpile_sim::ContactLaw;
 
-use super::check::{invalid, non_negative, positive, positive_pattern, required, Invalid};
+use super::check::{invalid, non_negative, positive, positive_pattern, required, shown, Invalid};
 use super::physical::Si;
 use crate::raw;
 
@@ -238,7 +238,7 @@ pub(crate) fn contact_law(
         Some(alpha) if !(1.0..=5.0).contains(&alpha) => {
             return Err(invalid(
                 "chain.exponent",
-                format!("must be a number from 1 to 5, got {alpha}"),
+                format!("must be a number from 1 to 5, got {}", shown(alpha)),
             ))
         }
         Some(alpha) if si.is_some() && alpha != 1.5 => {

@@ -8,11 +8,38 @@ pub(crate) fn invalid(key: impl Into<String>, reason: impl Into<String>) -> Inva
     (key.into(), reason.into())
 }
 
+/// `x` for a message: as written for everyday sizes, in scientific notation when very small or
+/// large (`1e-308`, not a 300-digit decimal).
+pub(crate) fn shown(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// A velocity whose energy, v², is a normal double: neither zero by underflow (1e-308) nor
+/// infinite (1e200), either of which leaves fractions of no energy.
+pub(crate) fn velocity(key: &str, v: f64) -> Result<f64, Invalid> {
+    let v = finite(key, v)?;
+    if (v * v).is_normal() && (v * v) < 1e300 {
+        Ok(v)
+    } else {
+        Err(invalid(
+            key,
+            format!("{} cannot carry an impact: its energy, v², is not a number double precision holds (use |v| from 1e-150 to 1e150)", shown(v)),
+        ))
+    }
+}
+
 pub(crate) fn finite(key: &str, x: f64) -> Result<f64, Invalid> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(invalid(key, format!("must be a finite number, got {x}")))
+        Err(invalid(
+            key,
+            format!("must be a finite number, got {}", shown(x)),
+        ))
     }
 }
 
@@ -20,7 +47,10 @@ pub(crate) fn positive(key: &str, x: f64) -> Result<f64, Invalid> {
     if x.is_finite() && x > 0.0 {
         Ok(x)
     } else {
-        Err(invalid(key, format!("must be finite and > 0, got {x}")))
+        Err(invalid(
+            key,
+            format!("must be finite and > 0, got {}", shown(x)),
+        ))
     }
 }
 
@@ -28,7 +58,10 @@ pub(crate) fn non_negative(key: &str, x: f64) -> Result<f64, Invalid> {
     if x.is_finite() && x >= 0.0 {
         Ok(x)
     } else {
-        Err(invalid(key, format!("must be finite and >= 0, got {x}")))
+        Err(invalid(
+            key,
+            format!("must be finite and >= 0, got {}", shown(x)),
+        ))
     }
 }
 

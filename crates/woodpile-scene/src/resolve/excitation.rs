@@ -6,7 +6,7 @@ use woodpile_sim::model::Boundary;
 use woodpile_sim::rods;
 
 use super::chain::{Layout, Sites};
-use super::check::{finite, invalid, positive, required, Invalid};
+use super::check::{self, invalid, positive, required, Invalid};
 use super::physical::{material_of, Si};
 use crate::raw;
 
@@ -38,7 +38,7 @@ pub(crate) fn impulse(
                 "is 0: no wave enters the chain, so there is no energy to split and the fractions are undefined",
             ));
         }
-        (Some(v), None) => finite("impulse.velocity", v)?,
+        (Some(v), None) => check::velocity("impulse.velocity", v)?,
         (None, _) => 1.0,
     };
     Ok((site, velocity))
@@ -80,7 +80,7 @@ pub(crate) fn striker(
                         "is 0: the striker never reaches the chain",
                     ))
                 }
-                Some(v) => positive("striker.velocity", v)?,
+                Some(v) => check::velocity("striker.velocity", positive("striker.velocity", v)?)?,
                 None => 1.0,
             };
             let mass = positive("striker.mass", required("striker.mass", striker.mass)?)?;

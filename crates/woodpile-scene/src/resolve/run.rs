@@ -14,6 +14,8 @@ use crate::raw;
 const DEFAULT_T_END: f64 = 150.0;
 const DEFAULT_TOLERANCE: f64 = 1e-8;
 const DEFAULT_SAMPLE_EVERY: f64 = 1.0;
+/// The loosest tolerance: a tenth of the fractions' whole range.
+const MAX_TOLERANCE: f64 = 0.1;
 /// Smallest tolerance accepted: the fractions are sums of hundreds of energies, each known to
 /// about 1e-16 relative, so a finer target could never be verified.
 const MIN_TOLERANCE: f64 = 1e-13;
@@ -53,6 +55,12 @@ pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
         })?),
     };
     let tolerance = positive("run.tolerance", run.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
+    if tolerance > MAX_TOLERANCE {
+        return Err(invalid(
+            "run.tolerance",
+            format!("{tolerance:e} is above {MAX_TOLERANCE:e}: fractions lie between 0 and 1, so a looser bound says nothing"),
+        ));
+    }
     if tolerance < MIN_TOLERANCE {
         return Err(invalid(
             "run.tolerance",
