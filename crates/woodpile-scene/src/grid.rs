@@ -76,7 +76,7 @@ pub fn check_sweep_memory(points: usize, scene: &crate::Scene) -> Result<(), Str
     let s = &scene.scenario;
     let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1;
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let in_flight = (threads * s.model.n_sites()) as f64 * 200.0;
+    let in_flight = (threads.min(points) * s.model.n_sites()) as f64 * 200.0;
     let bytes = points as f64 * (1400.0 + (samples * 5 * 8 * 2) as f64) + in_flight;
     if bytes > MAX_SWEEP_BYTES {
         return Err(format!(
