@@ -306,10 +306,12 @@ impl Design {
             }
         }
 
-        // The best design any evaluation found (a robustness sample may beat the searches'),
-        // verified at the tight tolerance: what the best file holds.
+        // The best design any evaluation found inside the space (a robustness sample may beat
+        // the searches', but one whose eps or kappa left its range is not a design of this
+        // space), verified at the tight tolerance: what the best file holds.
         let best = rows
             .iter()
+            .filter(|r| self.space.contains(&r.layout))
             .max_by(|a, b| a.score.total_cmp(&b.score))
             .cloned()
             .unwrap_or(best);

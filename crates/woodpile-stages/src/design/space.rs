@@ -140,33 +140,76 @@ impl Space {
         1 + GENES * self.resonators.1
     }
 
-    /// The layout a genome in [0, 1]^d stands for: a resonator on a site already taken is
-    /// dropped, so every layout is valid and equal layouts come out equal.
+    /// The layout a genome in [0, 1]^d stands for, always inside the space: a resonator whose
+    /// site is taken goes to the next free one (in the order of the sites, wrapping), so a
+    /// design has exactly the count its genome says, and equal genomes give equal layouts.
     pub(super) fn decode(&self, genome: &[f64]) -> Layout {
         let (lo, hi) = self.resonators;
-        let count = lo + pick(genome[0], hi - lo + 1);
+        let choices = self.site_list();
+        let count = (lo + pick(genome[0], hi - lo + 1)).min(choices.len());
+        let mut taken = vec![false; choices.len()];
         let mut resonators: Vec<Resonator> = Vec::with_capacity(count);
         for slot in 0..count {
             let g = &genome[1 + GENES * slot..1 + GENES * (slot + 1)];
-            let site = match &self.sites {
-                Sites::Range(first, last) => first + pick(g[0], (last - first + 1) as usize) as i64,
-                Sites::Among(list) => list[pick(g[0], list.len())],
-                Sites::Fixed(list) => list[slot],
+            let wanted = match &self.sites {
+                Sites::Fixed(_) => slot,
+                _ => pick(g[0], choices.len()),
             };
-            if resonators.iter().any(|r| r.site == site) {
-                continue;
-            }
-            let eps = round_sig(self.eps.at(g[1]));
-            let kappa = round_sig(self.kappa.at(g[2]));
+            let Some(index) = (0..choices.len())
+                .map(|k| (wanted + k) % choices.len())
+                .find(|&i| !taken[i])
+            else {
+                break;
+            };
+            taken[index] = true;
             resonators.push(Resonator {
-                site,
-                eps,
-                kappa,
+                site: choices[index],
+                eps: round_sig(self.eps.at(g[1])),
+                kappa: round_sig(self.kappa.at(g[2])),
                 p: self.p[pick(g[3], self.p.len())],
             });
         }
         resonators.sort_by_key(|r| r.site);
         Layout { resonators }
+    }
+
+    /// The sites resonators may take, in order, each once.
+    fn site_list(&self) -> Vec<i64> {
+        let mut list = match &self.sites {
+            Sites::Range(first, last) => (*first..=*last).collect(),
+            Sites::Among(list) | Sites::Fixed(list) => list.clone(),
+        };
+        if !matches!(self.sites, Sites::Fixed(_)) {
+            list.sort_unstable();
+            list.dedup();
+        }
+        list
+    }
+
+    /// Whether `layout` lies in the space: its count, distinct sites among those allowed, eps,
+    /// kappa and p from their values (to the 10 digits a design keeps), and its total eps
+    /// within the bound.
+    pub fn contains(&self, layout: &Layout) -> bool {
+        let n = layout.resonators.len();
+        let sites = self.site_list();
+        let mut seen: Vec<i64> = layout.resonators.iter().map(|r| r.site).collect();
+        seen.sort_unstable();
+        seen.dedup();
+        let within = |values: &Values, x: f64| match values {
+            Values::Range(r) => x >= round_sig(r.min) && x <= round_sig(r.max),
+            Values::List(list) => list.iter().any(|&v| round_sig(v) == x),
+        };
+        (self.resonators.0..=self.resonators.1).contains(&n)
+            && seen.len() == n
+            && layout.resonators.iter().all(|r| {
+                sites.contains(&r.site)
+                    && within(&self.eps, r.eps)
+                    && within(&self.kappa, r.kappa)
+                    && self.p.contains(&r.p)
+            })
+            && self
+                .max_total_eps
+                .is_none_or(|bound| layout.total_eps() <= bound)
     }
 }
 
@@ -364,6 +407,88 @@ mod tests {
         }
         assert_eq!((s.eps.at(0.0), s.eps.at(1.0)), (0.1, 100.0));
         assert!((s.eps.at(0.5) - 10f64.powf(0.5)).abs() < 1e-12);
+    }
+
+    /// A random space, drawn with `rng`: counts, sites of every form, ranges and lists.
+    fn random_space(rng: &mut SplitMix64) -> Space {
+        let mut int = |lo: i64, hi: i64| lo + (rng.uniform() * (hi - lo + 1) as f64) as i64;
+        let sites = match int(0, 2) {
+            0 => {
+                let first = int(-10, 10);
+                Sites::Range(first, first + int(0, 8))
+            }
+            1 => Sites::Among((0..int(3, 6)).map(|_| int(-20, 20)).collect()),
+            _ => Sites::Fixed(vec![-4, 0, 3, 9][..int(1, 4) as usize].to_vec()),
+        };
+        let distinct = {
+            let mut list = match &sites {
+                Sites::Range(a, b) => (*a..=*b).collect(),
+                Sites::Among(l) | Sites::Fixed(l) => l.clone(),
+            };
+            list.sort_unstable();
+            list.dedup();
+            list.len()
+        };
+        let resonators = match &sites {
+            Sites::Fixed(list) => (list.len(), list.len()),
+            _ => {
+                let lo = int(0, distinct.min(3) as i64) as usize;
+                (lo, (lo + int(0, 4) as usize).max(1))
+            }
+        };
+        let eps = match int(0, 1) {
+            0 => Values::List(vec![0.5, 2.0, 8.0]),
+            _ => Values::Range(Range {
+                min: 0.1,
+                max: 100.0,
+                log: true,
+            }),
+        };
+        Space {
+            resonators,
+            sites,
+            eps,
+            max_total_eps: (int(0, 1) == 0).then_some(50.0),
+            ..space()
+        }
+    }
+
+    /// Every genome of every space decodes inside the space, with the count it asks for: a
+    /// resonator on a taken site moves to a free one instead of being dropped (with three
+    /// resonators on three sites, designs of one or two were evaluated).
+    #[test]
+    fn every_genome_of_every_space_decodes_inside_it() {
+        let mut rng = SplitMix64(2026);
+        for _ in 0..300 {
+            let space = random_space(&mut rng);
+            for _ in 0..50 {
+                let g: Vec<f64> = (0..space.dimension()).map(|_| rng.uniform()).collect();
+                let layout = space.decode(&g);
+                let asked =
+                    space.resonators.0 + pick(g[0], space.resonators.1 - space.resonators.0 + 1);
+                let within_bound = space.max_total_eps.is_none_or(|b| layout.total_eps() <= b);
+                let unbounded = Space {
+                    max_total_eps: None,
+                    ..space.clone()
+                };
+                assert!(unbounded.contains(&layout), "{space:?}\n{layout:?}");
+                assert_eq!(space.contains(&layout), within_bound);
+                assert_eq!(
+                    layout.resonators.len(),
+                    asked.min(unbounded.site_list().len()),
+                    "{space:?}"
+                );
+            }
+        }
+        let three = Space {
+            resonators: (3, 3),
+            sites: Sites::Among(vec![0, 5, 10]),
+            ..space()
+        };
+        for u in [0.0, 0.3, 0.99] {
+            let layout = three.decode(&vec![u; three.dimension()]);
+            assert_eq!(layout.list(|r| r.site), "0, 5, 10");
+        }
     }
 
     /// Fixed sites get one resonator each, whatever the genome; listed sites and listed eps
