@@ -362,3 +362,20 @@ fn dt_is_the_step_taken() {
     );
     assert_eq!(json_number(&stdout, "steps"), 260.0);
 }
+
+/// A named fixed-step method on a kappa ramp, which no energy drift can check, is checked by
+/// a run at half the step: RK4 at dt = 0.5 on an F10-style ramp (E_tr 0.171 where auto gives
+/// 0.280) exits 3 naming the check; at dt = 0.01 it passes with an error estimate.
+#[test]
+fn fixed_steps_on_a_kappa_ramp_are_checked_by_halving() {
+    let ramp = "[chain]\nn = 100\n[impulse]\nsite = -25\n[[defect]]\nsite = 0\neps = 1.0\nkappa = { k1 = 0.0, k2 = 1.0, t0 = 40.0, tau = 1.0 }\n[run]\nt_end = 150.0\nmethod = \"rk4\"\n";
+    let (out, _) = simulate(&format!("{ramp}dt = 0.5\n"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(stderr.contains("kappa depends on time") && out.stdout.is_empty(), "{stderr}");
+    let (out, _) = simulate(&format!("{ramp}dt = 0.01\n"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let estimate = json_number(&stdout, "error_estimate");
+    assert!(estimate > 0.0 && estimate < 1e-6, "{stdout}");
+}

@@ -113,6 +113,17 @@ pub enum SimError {
         /// The allowed bound.
         limit: f64,
     },
+    /// A fixed-step run on a time-dependent model (a kappa ramp), where energy cannot guard
+    /// it, changed by more than the allowed amount when its step was halved.
+    #[error("kappa depends on time, so energy cannot check this fixed-step run: with dt halved to {dt:.3e} the fractions moved by {change:.3e}, more than the allowed {limit:.1e}; take a smaller dt, or method = \"auto\"")]
+    StepCheck {
+        /// The halved step.
+        dt: f64,
+        /// The largest change of R, T or E_tr between the two runs.
+        change: f64,
+        /// The allowed change.
+        limit: f64,
+    },
     /// An adaptive method needed a step below its floor.
     #[error("step size underflow at t = {t:.6}: dt = {dt:.3e}; the tolerance cannot be met")]
     StepUnderflow {
