@@ -100,7 +100,7 @@ fn trusted(path: &Path) -> bool {
 
 /// The table of the `woodpile.toml` at `path`, its keys checked.
 fn read_project_file(path: &Path) -> anyhow::Result<toml::Table> {
-    let text = woodpile_scene::read_input(&path)
+    let text = woodpile_scene::read_input(path)
         .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
     let table: toml::Table = toml::from_str(&text).map_err(|e| {
         anyhow!(

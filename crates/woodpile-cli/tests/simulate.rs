@@ -372,10 +372,17 @@ fn fixed_steps_on_a_kappa_ramp_are_checked_by_halving() {
     let (out, _) = simulate(&format!("{ramp}dt = 0.5\n"));
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{stderr}");
-    assert!(stderr.contains("kappa depends on time") && out.stdout.is_empty(), "{stderr}");
+    assert!(
+        stderr.contains("kappa depends on time") && out.stdout.is_empty(),
+        "{stderr}"
+    );
     let (out, _) = simulate(&format!("{ramp}dt = 0.01\n"));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let estimate = json_number(&stdout, "error_estimate");
     assert!(estimate > 0.0 && estimate < 1e-6, "{stdout}");
 }

@@ -44,8 +44,11 @@ pub struct DiffOptions {
     /// foreign file can make the parquet decoder abort the process (an allocation of 2^61
     /// bytes from a damaged page header), which no error handling here can catch. The CLI
     /// decodes such a file in a child process first. The error is the reason.
-    pub probe: Option<fn(&Path) -> std::result::Result<(), String>>,
+    pub probe: Option<Probe>,
 }
+
+/// A check of a file before it is decoded in this process: the reason it cannot be, if any.
+pub type Probe = fn(&Path) -> std::result::Result<(), String>;
 
 /// Columns that hold content hashes: they differ whenever the parameters do.
 pub const KEY_COLUMNS: &[&str] = &["scene_key"];

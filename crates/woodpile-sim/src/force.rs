@@ -205,7 +205,7 @@ impl Model {
         }
         if hi == n_sites - 1 && boundary.right_wall() {
             let elastic = law.elastic(n_sites, u[n_sites - 1]);
-            if let Some(record) = bond_force.as_deref_mut() {
+            if let Some(record) = bond_force {
                 record[n_sites] = elastic;
             }
             acc_u[n_sites - 1] -= elastic - law.static_force(n_sites);

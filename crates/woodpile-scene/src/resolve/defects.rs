@@ -187,7 +187,7 @@ fn physical(
     );
     let host_mass_ratio = sc.mass_ratio(found.host_kg);
     let own_contact = (rod.diameter.is_some() || rod.material.is_some())
-        .then(|| si.rod.as_ref())
+        .then_some(si.rod.as_ref())
         .flatten()
         .map(|regular| rods::crossed_rods_coefficient(&found.rod, regular) / sc.hertz);
     let derived = DerivedDefect {

@@ -115,7 +115,7 @@ fn step_checked<O: Observer + ?Sized>(
     };
     let half = run_plan(scenario, &plan.with_dt(0.5 * dt), &mut ())?;
     let change = out.fractions.largest_difference(&half.fractions);
-    if !(change <= STEP_CHECK_LIMIT) {
+    if change.is_nan() || change > STEP_CHECK_LIMIT {
         return Err(SimError::StepCheck {
             dt: 0.5 * dt,
             change,
