@@ -16,7 +16,7 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
     write_with(path, |file| file.write_all(bytes))
 }
 
-/// [`write`] without syncing the file to the disk before the rename: atomic for every process
+/// [`write()`] without syncing the file to the disk before the rename: atomic for every process
 /// (a killed writer leaves the old file or the new one), but a power cut may leave the file
 /// empty or partial. Only for files that carry their own checksum, whose reader then finds
 /// the damage and recomputes: the point cache, where a sync per scene kept the sweep's

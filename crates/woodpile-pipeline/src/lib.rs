@@ -1,22 +1,20 @@
-//! The figure pipeline: stages declared in TOML (`pipeline/*.toml`), forming a DAG, each
-//! writing one parquet table under `results/` whose metadata records its cache key and
-//! everything the key was computed from.
+//! The figure pipeline's engine: stages declared in TOML (`pipeline/*.toml`), forming a DAG,
+//! each writing one parquet table under `results/` whose metadata records its cache key and
+//! everything the key was computed from. The engine names no stage kind: it is handed a
+//! [`kind::Registry`] (`woodpile_stages::KINDS` is the paper's).
 //!
-//! The engine, in the crate root:
-//! - [`kind`]: the `Kind` trait every stage kind implements, and `KINDS`, the one list of them.
-//! - [`stage`], [`pipeline`]: parse stage files, check the DAG, compute the keys.
+//! - [`kind`]: the [`kind::Kind`] trait every stage kind implements, and the [`kind::Context`]
+//!   a running stage is given.
+//! - [`stage`], [`pipeline`], [`variant`]: parse stage files (and `--set` variants), check the
+//!   DAG, compute the keys.
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
 //! - [`points`] (with [`grid`], [`template`]): the per-scene cache and the grids behind it.
 //! - [`shard`], [`slurm`]: sweeps split across a cluster and merged.
-//! - [`lock`]: one writer of a results tree at a time.
+//! - [`lock`]: one writer of a results tree at a time; [`layout`]: where everything lives.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
-//! - [`table`], [`manifest`], [`atomic`], [`canonical`]: parquet IO and row tables,
-//!   self-description, atomic writes, blake3 keys of canonical JSON.
-//!
-//! The kinds, in [`kinds`] (re-exported here by name): [`sweep`], [`spacetime`], [`reduce`],
-//! [`optimize`], [`fit`], [`approximate`], [`render`], [`report`], [`workprecision`],
-//! [`stability`], [`design`]. Their numerics (fits, Nelder–Mead, the product approximation)
-//! are `woodpile-analysis`'s.
+//! - [`table`], [`manifest`], [`atomic`], [`canonical`], [`regular`], [`sealed_files`]:
+//!   parquet IO and row tables, self-description, atomic writes, blake3 keys of canonical
+//!   JSON, reading only regular files, the checksums of a stage's other files.
 //!
 //! Nothing here prints: progress goes to an [`events::Events`] implementation.
 #![warn(missing_docs)]

@@ -34,7 +34,7 @@ impl Pipeline {
     }
 
     /// [`Pipeline::load`], plus a variant of a stage for each stage named in `sets`: its file
-    /// with those keys set, named `<stage>--<key>-<value>` ([`Set::variant_name`]), so that it
+    /// with those keys set, named `<stage>--<key>-<value>` ([`crate::variant::variant_name`]), so that it
     /// has its own key and its own output beside the original's.
     pub fn load_with(dir: &Path, kinds: &'static Registry, sets: &[Set]) -> Result<Pipeline> {
         if !dir.is_dir() {

@@ -1,8 +1,6 @@
 //! Linear and logarithmic axes. Data are drawn in "plot space" (the value, or its log10), so
 //! one chart type serves both; the ticks are chosen here and labelled with the data's values.
 
-use crate::chart::tick;
-
 /// How an axis maps values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Scale {
@@ -133,6 +131,27 @@ fn log_ticks(lo: f64, hi: f64, target: usize) -> (Vec<f64>, Vec<f64>) {
         .filter(|m| !major.iter().any(|t| (t - m).abs() < 1e-9))
         .collect();
     (major, minor)
+}
+
+/// A tick label: integers without a decimal point (`10`, not `10.0`), other values with at
+/// most four significant decimals, and never `-0`.
+pub fn tick(v: &f64) -> String {
+    let v = if v.abs() < 1e-12 { 0.0 } else { *v };
+    if (v - v.round()).abs() <= 1e-9 * v.abs().max(1.0) && v.abs() < 1e15 {
+        return format!("{}", v.round() as i64);
+    }
+    let magnitude = v.abs().log10().floor();
+    if !(-4.0..6.0).contains(&magnitude) {
+        return format!("{v:.2e}");
+    }
+    let decimals = (3.0 - magnitude).clamp(0.0, 8.0) as usize;
+    let text = format!("{v:.decimals$}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    if text == "-0" {
+        "0".into()
+    } else {
+        text.into()
+    }
 }
 
 #[cfg(test)]

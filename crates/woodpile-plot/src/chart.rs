@@ -62,27 +62,6 @@ pub(crate) fn text<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
 
-/// A tick label: integers without a decimal point (`10`, not `10.0`), other values with at
-/// most four significant decimals, and never `-0`.
-pub fn tick(v: &f64) -> String {
-    let v = if v.abs() < 1e-12 { 0.0 } else { *v };
-    if (v - v.round()).abs() <= 1e-9 * v.abs().max(1.0) && v.abs() < 1e15 {
-        return format!("{}", v.round() as i64);
-    }
-    let magnitude = v.abs().log10().floor();
-    if !(-4.0..6.0).contains(&magnitude) {
-        return format!("{v:.2e}");
-    }
-    let decimals = (3.0 - magnitude).clamp(0.0, 8.0) as usize;
-    let text = format!("{v:.decimals$}");
-    let text = text.trim_end_matches('0').trim_end_matches('.');
-    if text == "-0" {
-        "0".into()
-    } else {
-        text.into()
-    }
-}
-
 /// Builds a chart on `area` over plot-space ranges, ticked by the scales, with its mesh drawn.
 pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
     area: &'a DrawingArea<DB, Shift>,

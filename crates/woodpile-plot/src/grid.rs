@@ -10,14 +10,14 @@ pub struct Grid {
     pub xs: Vec<f64>,
     /// Distinct y values, increasing.
     pub ys: Vec<f64>,
-    /// `z[j * xs.len() + i]` at (xs[i], ys[j]); `None` where no row gives it.
+    /// `z[j * xs.len() + i]` at `(xs[i], ys[j])`; `None` where no row gives it.
     pub z: Vec<Option<f64>>,
     /// The row with the largest finite z (the first of equals): (x, y, z).
     pub max: Option<(f64, f64, f64)>,
 }
 
 impl Grid {
-    /// The grid of the rows (x[r], y[r], z[r]): a row without x or y is left out.
+    /// The grid of the rows `(x[r], y[r], z[r])`: a row without x or y is left out.
     pub fn from_rows(x: &[Option<f64>], y: &[Option<f64>], z: &[Option<f64>]) -> Grid {
         let (xs, ys) = (distinct(x), distinct(y));
         let mut cells = vec![None; xs.len() * ys.len()];

@@ -5,11 +5,10 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::chart::{chart, pixel, plot_rect, text, Ticked, FONT};
 use crate::colour::{diverging, viridis, Dash, Marker, CATEGORIES};
-use crate::draw::{
-    chart, inside_place, mark_entries, marks, pixel, pixel_curves, plot_rect, text, Shared, FONT,
-};
 use crate::legend::{self, Entry, Glyph};
+use crate::panel::{inside_place, mark_entries, marks, pixel_curves, Ranges, Shared};
 use crate::style::{Corner, Legend, Style};
 use crate::{Colours, HeatPanel};
 
@@ -49,7 +48,7 @@ fn plot_space(centres: &[f64], scale: crate::Scale) -> Vec<f64> {
 }
 
 /// The map's ranges in plot space: its view, or its data.
-pub(crate) fn ranges(h: &HeatPanel) -> crate::draw::Ranges {
+pub(crate) fn ranges(h: &HeatPanel) -> Ranges {
     let (sx, sy) = (h.view.x_scale, h.view.y_scale);
     let ex = drawn_edges(&plot_space(&h.xs, sx));
     let ey = drawn_edges(&plot_space(&h.ys, sy));
@@ -293,7 +292,7 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
     let (z0, z1) = (scale.lo, scale.hi);
     let font = (FONT, style.font(1.0)).into_font().color(&BLACK);
     let width = bar.dim_in_pixel().0 as f64 - style.pt(2.0);
-    let lines = crate::draw::wrap(bar, &h.z_label, width, &font);
+    let lines = crate::chart::wrap(bar, &h.z_label, width, &font);
     let line = style.font(1.0) * 1.25;
     let (top, rest) = bar.split_vertically((lines.len() as f64 * line + style.pt(4.0)) as u32);
     for (k, text) in lines.into_iter().enumerate() {
@@ -305,7 +304,7 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
             ),
             font.clone(),
         ))
-        .map_err(crate::draw::text)?;
+        .map_err(crate::chart::text)?;
     }
     let (major, _) = crate::Scale::Linear.ticks(z0, z1, 6);
     let mut bar_chart = ChartBuilder::on(&rest)
@@ -313,16 +312,13 @@ pub(crate) fn colour_bar<DB: DrawingBackend>(
         .margin_bottom(style.font(2.9) as u32)
         .margin_left(style.pt(2.0) as u32)
         .right_y_label_area_size(style.font(3.6) as u32)
-        .build_cartesian_2d(
-            0.0..1.0,
-            crate::draw::Ticked::new(z0, z1, (major, Vec::new())),
-        )
+        .build_cartesian_2d(0.0..1.0, Ticked::new(z0, z1, (major, Vec::new())))
         .map_err(text)?;
     bar_chart
         .configure_mesh()
         .disable_x_axis()
         .disable_mesh()
-        .y_label_formatter(&crate::chart::tick)
+        .y_label_formatter(&crate::axis::tick)
         .label_style((FONT, style.font(1.0)))
         .set_all_tick_mark_size(style.pt(2.0) as u32)
         .draw()

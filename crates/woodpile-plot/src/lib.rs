@@ -14,14 +14,15 @@ mod grid;
 mod heat;
 mod legend;
 mod markup;
+mod panel;
 mod style;
 
 use std::sync::OnceLock;
 
 use plotters::prelude::*;
 
+pub use axis::tick;
 pub use axis::Scale;
-pub use chart::tick;
 pub use colour::{diverging, hex_colour, viridis, Dash, Marker, SeriesStyle};
 pub use grid::Grid;
 pub use heat::cell_edges;
@@ -81,7 +82,7 @@ pub struct HeatPanel {
     pub xs: Vec<f64>,
     /// Cell centres along y, increasing.
     pub ys: Vec<f64>,
-    /// Values, row-major by y: `z[j * xs.len() + i]` at (xs[i], ys[j]); `None` is drawn grey.
+    /// Values, row-major by y: `z[j * xs.len() + i]` at `(xs[i], ys[j])`; `None` is drawn grey.
     pub z: Vec<Option<f64>>,
     /// A marked point (e.g. the maximum) and its label.
     pub marker: Option<(f64, f64, String)>,

@@ -1,6 +1,6 @@
 //! The scene file of `woodpile simulate` (docs/scene.md): TOML in two stages, ripgrep-style.
 //!
-//! [`raw`] mirrors the file exactly (`deny_unknown_fields`, no defaults applied); [`Scene`] is the
+//! `raw` mirrors the file exactly (`deny_unknown_fields`, no defaults applied); [`Scene`] is the
 //! validated, typed result with the paper's defaults filled in and paper site numbers (-n..n)
 //! translated to the simulator's 0-based indices. Every error names the file, the key and the
 //! reason.

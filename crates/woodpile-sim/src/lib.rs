@@ -13,7 +13,7 @@
 //!   single driver that owns the time loop, sampling and failure detection.
 //! - [`observe`]: sampled time series of the fractions and the space-time velocity field.
 //! - [`run`]: "simulate a scene, return its fractions" as one function.
-//! - [`budget`]: what a run will cost, so an endless one is refused before it starts.
+//! - [`run::budget`]: what a run will cost, so an endless one is refused before it starts.
 //! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
 #![warn(missing_docs)]
 

@@ -31,7 +31,7 @@ pub struct StyleSpec {
     /// `aspect`, if given.
     pub aspect: Option<f64>,
     /// Everything else: `dpi` (300), `font_pt` (8), `legend` ("best"), `panel_letters`,
-    /// `minor_grid`, `share_x`, `share_y` (off); [`StyleSpec::resolve`] sets its size.
+    /// `minor_grid`, `share_x`, `share_y` (off); `StyleSpec::resolve` sets its size.
     pub rest: Style,
 }
 

@@ -1,23 +1,10 @@
 //! The report as Markdown: one table per quote with our number, the paper's, the difference,
-//! the verdict and every convention searched.
+//! the verdict and every convention searched. It renders; [`super::judge`] decides.
 
+use super::judge::{difference, reproduces, verdict};
 use super::measure::{Measured, Scanned};
+use super::number::fmt;
 use super::{Paper, Report};
-
-/// Whether `m` reproduces the paper's number (None for a statement without a range).
-pub(super) fn reproduces(paper: &Paper, m: &Measured) -> Option<bool> {
-    if m.failure.is_some() {
-        return None;
-    }
-    match paper {
-        Paper::Value { value, agree } => Some((m.value - value).abs() <= *agree),
-        Paper::Text {
-            range: Some([lo, hi]),
-            ..
-        } => Some((*lo..=*hi).contains(&m.value)),
-        Paper::Text { range: None, .. } => None,
-    }
-}
 
 /// A measured value as the report shows it: the number, or that it failed.
 fn shown(m: &Measured) -> String {
@@ -25,19 +12,6 @@ fn shown(m: &Measured) -> String {
         Some(_) => "**failed**".into(),
         None => fmt(m.value),
     }
-}
-
-/// Four significant digits, without exponent for the magnitudes a report shows.
-pub(super) fn fmt(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let magnitude = x.abs().log10().floor() as i32;
-    if !(-4..=7).contains(&magnitude) {
-        return format!("{x:.3e}");
-    }
-    let decimals = (3 - magnitude).clamp(0, 8) as usize;
-    format!("{x:.decimals$}")
 }
 
 /// The runs of a scan in words: "t in [30.25, 31.00], t = 35.50, … (7 runs)".
@@ -72,27 +46,6 @@ pub(super) fn paper_text(p: &Paper) -> String {
     match p {
         Paper::Value { value, .. } => fmt(*value),
         Paper::Text { text, .. } => text.clone(),
-    }
-}
-
-pub(super) fn difference(p: &Paper, m: &Measured) -> (Option<f64>, Option<f64>) {
-    if m.failure.is_some() {
-        return (None, None);
-    }
-    match p {
-        Paper::Value { value, .. } => (
-            Some(m.value - value),
-            (*value != 0.0).then(|| (m.value - value) / value.abs()),
-        ),
-        Paper::Text { .. } => (None, None),
-    }
-}
-
-fn verdict(p: &Paper, m: &Measured) -> &'static str {
-    match reproduces(p, m) {
-        Some(true) => "yes",
-        Some(false) => "no",
-        None => "–",
     }
 }
 
@@ -199,18 +152,4 @@ pub(super) fn markdown(
         }
     }
     out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::fmt;
-
-    #[test]
-    fn four_significant_digits() {
-        assert_eq!(fmt(0.21116587), "0.2112");
-        assert_eq!(fmt(3961000.0), "3961000");
-        assert_eq!(fmt(-0.0110), "-0.01100");
-        assert_eq!(fmt(124.0), "124.0");
-        assert_eq!(fmt(1.5e-9), "1.500e-9");
-    }
 }

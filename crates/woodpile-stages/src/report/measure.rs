@@ -10,7 +10,7 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::layout::output_path;
 use woodpile_pipeline::table::{self, f64_column, matching_rows, str_column};
 
-use super::markdown::fmt;
+use super::number::fmt;
 use super::{Paper, Read, Source};
 
 /// What a source measured.

@@ -48,11 +48,14 @@ use woodpile_pipeline::Output;
 
 pub use woodpile_pipeline::table::Match;
 
+mod judge;
 mod markdown;
 mod measure;
+mod number;
 mod parse;
 
-use markdown::{difference, generated_mark, markdown, paper_text, reproduces, runs_text};
+use judge::{difference, reproduces};
+use markdown::{generated_mark, markdown, paper_text, runs_text};
 use measure::{Measured, Reader};
 use parse::{check_markdown_path, parse_quote};
 
