@@ -54,7 +54,7 @@ use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{Context, Kind};
+use woodpile_pipeline::kind::{Context, Kind, PointsAt};
 use woodpile_pipeline::layout::best_path;
 use woodpile_pipeline::points::{PointResult, PointStore};
 use woodpile_pipeline::Output;
@@ -199,6 +199,8 @@ impl Design {
         Ok(design)
     }
 
+    /// The stage: the searches, their refinement, the robustness study around the best design,
+    /// then the best design inside the space verified and written as a scene file.
     pub(crate) fn run(
         &self,
         stage: &str,
@@ -206,16 +208,45 @@ impl Design {
         results: &Path,
         events: &dyn Events,
     ) -> Result<Output> {
-        let d = self.space.dimension();
         let robust: usize = self
             .robustness
             .as_ref()
             .map_or(0, |(samples, spreads)| samples * spreads.len());
         let total = 2 * self.budget + self.refine + 1 + robust;
         events.simulating(stage, total, 0);
-        let mut rows: Vec<Evaluated> = Vec::with_capacity(total);
+        let at = PointsAt {
+            stage,
+            store,
+            events,
+        };
+        let (mut rows, starts) = self.search(at)?;
+        for (label, start, score) in starts {
+            rows.extend(self.refine_from(stage, label, &start, score, store, events)?);
+        }
+        // The best design of the searches; the robustness study is around it.
+        let best = rows
+            .iter()
+            .max_by(|a, b| a.score.total_cmp(&b.score))
+            .cloned()
+            .ok_or_else(|| PipelineError::stage(stage, "no design was evaluated"))?;
+        if !best.score.is_finite() {
+            return Err(PipelineError::stage(stage, "every design failed"));
+        }
+        rows.extend(self.robustness_around(at, &best)?);
+        let (best, verified, best_file) = self.verify_and_write(at, results, &mut rows, best)?;
+        Ok(Output::table(
+            self.frame(&rows)?,
+            self.summary(&rows, &best, &verified, &best_file),
+        ))
+    }
 
-        // Differential evolution, a generation at a time.
+    /// Differential evolution a generation at a time, then random search of the same budget
+    /// (the baseline): their rows, and where each search's refinement starts (the best genome
+    /// of each, with its score).
+    fn search(&self, at: PointsAt<'_>) -> Result<(Vec<Evaluated>, Vec<(Search, Vec<f64>, f64)>)> {
+        let PointsAt { store, events, .. } = at;
+        let d = self.space.dimension();
+        let mut rows = Vec::new();
         let mut de = DifferentialEvolution::new(d, SplitMix64(self.seed ^ 0xde));
         let layouts = de
             .population()
@@ -237,7 +268,6 @@ impl Design {
             rows.extend(evaluated);
         }
 
-        // Random search of the same budget: the baseline.
         let random_genomes = random_points(d, self.budget, &mut SplitMix64(self.seed ^ 0x5eed));
         let layouts = random_genomes
             .iter()
@@ -261,70 +291,73 @@ impl Design {
                 random_rows[i].score,
             ));
         }
-        for (label, start, score) in starts {
-            rows.extend(self.refine_from(stage, label, &start, score, store, events)?);
-        }
+        Ok((rows, starts))
+    }
 
-        // The best design of the searches; the robustness study is around it.
-        let best = rows
-            .iter()
-            .max_by(|a, b| a.score.total_cmp(&b.score))
-            .cloned()
-            .ok_or_else(|| PipelineError::stage(stage, "no design was evaluated"))?;
-        if !best.score.is_finite() {
-            return Err(PipelineError::stage(stage, "every design failed"));
+    /// The robustness study: `best` with every eps and kappa off by up to ±spread, `samples`
+    /// times per spread, each spread's rows in order of the objective (the table then reads
+    /// as the distribution's quantiles).
+    fn robustness_around(&self, at: PointsAt<'_>, best: &Evaluated) -> Result<Vec<Evaluated>> {
+        let mut rows = Vec::new();
+        let Some((samples, spreads)) = &self.robustness else {
+            return Ok(rows);
+        };
+        for (k, &spread) in spreads.iter().enumerate() {
+            let mut rng = SplitMix64(self.seed ^ (0x7000 + k as u64));
+            let layouts = (0..*samples)
+                .map(|_| Layout {
+                    resonators: best
+                        .layout
+                        .resonators
+                        .iter()
+                        .map(|r| {
+                            let mut wobble = |x: f64| {
+                                round_sig(x * (1.0 + spread * (2.0 * rng.uniform() - 1.0)))
+                            };
+                            Resonator {
+                                eps: wobble(r.eps),
+                                kappa: wobble(r.kappa),
+                                ..*r
+                            }
+                        })
+                        .collect(),
+                })
+                .collect();
+            let label = Search::robustness(spread);
+            let mut samples = self.evaluate(label, layouts, None, at.store, at.events)?;
+            samples.sort_by(|a, b| a.score.total_cmp(&b.score));
+            rows.extend(samples);
         }
+        Ok(rows)
+    }
 
-        // Robustness: the best design with every eps and kappa off by up to ±spread.
-        if let Some((samples, spreads)) = &self.robustness {
-            for (k, &spread) in spreads.iter().enumerate() {
-                let mut rng = SplitMix64(self.seed ^ (0x7000 + k as u64));
-                let layouts = (0..*samples)
-                    .map(|_| Layout {
-                        resonators: best
-                            .layout
-                            .resonators
-                            .iter()
-                            .map(|r| {
-                                let mut wobble = |x: f64| {
-                                    round_sig(x * (1.0 + spread * (2.0 * rng.uniform() - 1.0)))
-                                };
-                                Resonator {
-                                    eps: wobble(r.eps),
-                                    kappa: wobble(r.kappa),
-                                    ..*r
-                                }
-                            })
-                            .collect(),
-                    })
-                    .collect();
-                let label = Search::robustness(spread);
-                // In order of E_tr: the table then reads as the distribution's quantiles.
-                let mut samples = self.evaluate(label, layouts, None, store, events)?;
-                samples.sort_by(|a, b| a.score.total_cmp(&b.score));
-                rows.extend(samples);
-            }
-        }
-
-        // The best design any evaluation found inside the space (a robustness sample may beat
-        // the searches', but one whose eps or kappa left its range is not a design of this
-        // space), verified at the tight tolerance: what the best file holds.
+    /// The best design any evaluation found inside the space (a robustness sample may beat the
+    /// searches', but one whose eps or kappa left its range is not a design of this space),
+    /// verified at the tight tolerance and written as `<stage>.best.toml`: the best row, the
+    /// verification's row (also added to `rows`) and the file.
+    fn verify_and_write(
+        &self,
+        at: PointsAt<'_>,
+        results: &Path,
+        rows: &mut Vec<Evaluated>,
+        searched_best: Evaluated,
+    ) -> Result<(Evaluated, Evaluated, std::path::PathBuf)> {
+        let stage = at.stage;
         let best = rows
             .iter()
             .filter(|r| self.space.contains(&r.layout))
             .max_by(|a, b| a.score.total_cmp(&b.score))
             .cloned()
-            .unwrap_or(best);
+            .unwrap_or(searched_best);
         let verified = self
             .evaluate(
                 Search::Verification,
                 vec![best.layout.clone()],
                 Some(self.verify_tolerance),
-                store,
-                events,
+                at.store,
+                at.events,
             )?
             .remove(0);
-        let verified_score = verified.score;
         rows.push(verified.clone());
 
         let best_file = best_path(results, stage);
@@ -333,38 +366,45 @@ impl Design {
         let header = format!(
             "# The best design found by stage `{stage}` (woodpile run {stage}): {} = {} at t_end,\n# verified at tolerance {:e}. Run it with: woodpile simulate {}\n",
             self.objective_name(),
-            self.shown(verified_score),
+            self.shown(verified.score),
             self.verify_tolerance,
             best_file.display()
         );
         woodpile_pipeline::atomic::write(&best_file, (header + &text).as_bytes())?;
+        Ok((best, verified, best_file))
+    }
 
-        let de_best = self.best_of(&rows, Search::DifferentialEvolution);
-        let random_best = self.best_of(&rows, Search::Random);
-        let refined = self.best_of(&rows, Search::Refinement);
-        let refined_random = self.best_of(&rows, Search::RefinementOfRandom);
-        let frame = self.frame(&rows)?;
-        Ok(Output::table(
-            frame,
-            json!({
-                "objective": self.objective_name(),
-                "goal": if self.maximise { "max" } else { "min" },
-                "evaluations": rows.len(),
-                "best": self.shown(verified_score),
-                "best_error_estimate": verified.result.as_ref().ok().and_then(|p| p.error_estimate),
-                "best_sites": verified.layout.list(|r| r.site),
-                "best_eps": verified.layout.list(|r| r.eps),
-                "best_kappa": verified.layout.list(|r| r.kappa),
-                "differential_evolution_best": self.shown(de_best),
-                "random_best": self.shown(random_best),
-                "refined_best": self.shown(refined.max(de_best)),
-                "refined_random_best": self.shown(refined_random.max(random_best)),
-                "best_search": best.search.label(),
-                "baseline_beat_optimiser": refined_random.max(random_best) > refined.max(de_best),
-                "verify_tolerance": self.verify_tolerance,
-                "best_file": best_file.file_name().map(|n| n.to_string_lossy().into_owned()),
-            }),
-        ))
+    /// The manifest's summary: the verified best design, each search's best, and whether the
+    /// baseline beat the optimiser.
+    fn summary(
+        &self,
+        rows: &[Evaluated],
+        best: &Evaluated,
+        verified: &Evaluated,
+        best_file: &Path,
+    ) -> serde_json::Value {
+        let de_best = self.best_of(rows, Search::DifferentialEvolution);
+        let random_best = self.best_of(rows, Search::Random);
+        let refined = self.best_of(rows, Search::Refinement);
+        let refined_random = self.best_of(rows, Search::RefinementOfRandom);
+        json!({
+            "objective": self.objective_name(),
+            "goal": if self.maximise { "max" } else { "min" },
+            "evaluations": rows.len(),
+            "best": self.shown(verified.score),
+            "best_error_estimate": verified.result.as_ref().ok().and_then(|p| p.error_estimate),
+            "best_sites": verified.layout.list(|r| r.site),
+            "best_eps": verified.layout.list(|r| r.eps),
+            "best_kappa": verified.layout.list(|r| r.kappa),
+            "differential_evolution_best": self.shown(de_best),
+            "random_best": self.shown(random_best),
+            "refined_best": self.shown(refined.max(de_best)),
+            "refined_random_best": self.shown(refined_random.max(random_best)),
+            "best_search": best.search.label(),
+            "baseline_beat_optimiser": refined_random.max(random_best) > refined.max(de_best),
+            "verify_tolerance": self.verify_tolerance,
+            "best_file": best_file.file_name().map(|n| n.to_string_lossy().into_owned()),
+        })
     }
 
     /// Nelder–Mead from `start` (score `score`) on the eps and kappa genes of its resonators,
