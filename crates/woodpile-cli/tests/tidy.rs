@@ -199,7 +199,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-plot", "draw.rs:lines_panel", 137),
     ("woodpile-plot", "heat.rs:panel", 130),
     ("woodpile-stages", "render/spec.rs:parse_panel", 124),
-    ("woodpile-sim", "run/mod.rs:verified", 117),
     ("woodpile-bench", "main.rs:main", 117),
     ("woodpile-sim", "integrate/mod.rs:drive", 118),
     ("woodpile-py", "sweep.rs:columns", 103),

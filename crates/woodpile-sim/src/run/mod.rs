@@ -128,122 +128,250 @@ fn step_checked<O: Observer + ?Sized>(
     Ok(out)
 }
 
+/// `auto`: the ladder of steps dt, dt/2, ... each rung of which either accepts its pair of
+/// runs (dt and 2 dt, and a run at 1.5 dt where the scene needs it) or says why not and
+/// halves the step, until [`MAX_HALVINGS`].
 fn verified<O: Observer + ?Sized>(
     scenario: &Scenario,
     plan: Plan,
     observer: &mut O,
 ) -> Result<Outcome, SimError> {
-    let tol = scenario.accuracy.tolerance;
-    // Verification runs only guard against blow-up; the accepted run must also keep energy.
-    let guarded = Plan {
-        drift_limit: BLOW_UP_DRIFT,
-        ..plan
-    };
-    let mut dt = auto_first_step(scenario, &plan);
-    let mut spent = 0;
-    let mut coarse = check_run(scenario, &guarded.with_dt(2.0 * dt), observer, &mut spent)?;
-    // Richardson denominator 2^q - 1 for the method's observed order on Hertzian chains.
-    let order = plan.method.observed_order();
-    let richardson = 2f64.powf(order) - 1.0;
-    let mut estimate = f64::INFINITY;
-    // The change between the two runs before `coarse` (4 dt and 2 dt), once the ladder has
-    // made them: the asymptotic-regime check below.
-    let mut previous_change: Option<f64> = None;
-    let mut why = String::from("no run kept its energy");
-    let Strictness {
-        accept,
-        needs_three_runs,
-        off_ladder_run,
-    } = Strictness::of(&scenario.model, tol);
+    let mut ladder = Ladder::start(scenario, plan, observer)?;
+    let mut why = Refusal::NoRunKeptEnergy;
     for _ in 0..=MAX_HALVINGS {
-        observer.reset();
-        let fine = match run_plan(scenario, &guarded.with_dt(dt), observer) {
+        match ladder.rung()? {
+            Rung::Accept(outcome) => return Ok(*outcome),
+            Rung::Refine(reason) => why = reason,
+        }
+    }
+    Err(SimError::NotConverged {
+        tolerance: ladder.tol,
+        estimate: ladder.estimate,
+        dt: 2.0 * ladder.dt,
+        why: why.to_string(),
+    })
+}
+
+/// What one rung of the ladder decided.
+enum Rung {
+    /// The fine run, with its verified error estimate.
+    Accept(Box<Outcome>),
+    /// Not verified at this step, for this reason: halve it.
+    Refine(Refusal),
+}
+
+/// Why a rung did not accept: the reason a refusal reports for the finest step tried.
+#[derive(Debug, Clone, PartialEq)]
+enum Refusal {
+    /// No rung has run yet.
+    NoRunKeptEnergy,
+    /// The fine run itself blew up or lost its energy.
+    BlewUp(String),
+    /// The run at twice the step blew up: no pair.
+    NoPair,
+    /// The pair's estimate is above what it must meet.
+    Estimate {
+        estimate: f64,
+        accept: f64,
+        tol: f64,
+    },
+    /// The fine run drifts in energy beyond what the tolerance allows.
+    Drift { drift: f64, limit: f64 },
+    /// The estimate would pass, but the changes do not shrink as the method's order says.
+    NotAsymptotic {
+        estimate: f64,
+        before: f64,
+        after: f64,
+    },
+    /// The pair agreed, but a run off the ladder (1.5 dt) does not.
+    OffLadder {
+        estimate: f64,
+        accept: f64,
+        tol: f64,
+    },
+}
+
+impl std::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Refusal::NoRunKeptEnergy => write!(f, "no run kept its energy"),
+            Refusal::BlewUp(ref e) => write!(f, "the run blew up or lost energy ({e})"),
+            Refusal::NoPair => write!(f, "the run at twice the step blew up, so there is no pair to compare"),
+            Refusal::Estimate { estimate, accept, tol } => write!(
+                f,
+                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e})"
+            ),
+            Refusal::Drift { drift, limit } => write!(
+                f,
+                "the energy drifts by {drift:.2e}, more than the {limit:.1e} the tolerance allows"
+            ),
+            Refusal::NotAsymptotic { estimate, before, after } => write!(
+                f,
+                "the error estimate {estimate:.2e} would pass, but the runs are not in their asymptotic regime (the change between runs went from {before:.2e} to {after:.2e} when the step halved, not by the factor the method's order gives), so the estimate cannot be trusted"
+            ),
+            Refusal::OffLadder { estimate, accept, tol } => write!(
+                f,
+                "the pair agreed, but a run at 1.5 times the step differs by an estimated {estimate:.2e}, above the {accept:.1e} it must meet (tolerance {tol:.1e}): the error jumps with the step"
+            ),
+        }
+    }
+}
+
+/// The ladder's state between rungs: the step, the run at twice it, the change between the
+/// two rungs before, what has been spent, and the last estimate.
+struct Ladder<'a, O: Observer + ?Sized> {
+    scenario: &'a Scenario,
+    plan: Plan,
+    /// The plan of verification runs: only guarded against blow-up (the accepted run must
+    /// also keep energy, checked by the rung).
+    guarded: Plan,
+    observer: &'a mut O,
+    tol: f64,
+    /// The method's observed order on Hertzian chains, and the Richardson denominator 2^q − 1.
+    order: f64,
+    richardson: f64,
+    strictness: Strictness,
+    dt: f64,
+    /// The run at 2 dt (None when it blew up).
+    coarse: Option<Outcome>,
+    /// The change between the two runs before `coarse` (4 dt and 2 dt), once made: the
+    /// asymptotic-regime check.
+    previous_change: Option<f64>,
+    spent: u64,
+    estimate: f64,
+}
+
+impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
+    /// The ladder at `auto`'s first step, with the run at twice it made.
+    fn start(scenario: &'a Scenario, plan: Plan, observer: &'a mut O) -> Result<Self, SimError> {
+        let tol = scenario.accuracy.tolerance;
+        let guarded = Plan {
+            drift_limit: BLOW_UP_DRIFT,
+            ..plan
+        };
+        let dt = auto_first_step(scenario, &plan);
+        let mut spent = 0;
+        let coarse = check_run(scenario, &guarded.with_dt(2.0 * dt), observer, &mut spent)?;
+        let order = plan.method.observed_order();
+        Ok(Ladder {
+            scenario,
+            plan,
+            guarded,
+            observer,
+            tol,
+            order,
+            richardson: 2f64.powf(order) - 1.0,
+            strictness: Strictness::of(&scenario.model, tol),
+            dt,
+            coarse,
+            previous_change: None,
+            spent,
+            estimate: f64::INFINITY,
+        })
+    }
+
+    /// One rung: the run at dt against the one at 2 dt. A refusal halves the step for the
+    /// next rung; a scene error (not a blow-up) ends the ladder.
+    fn rung(&mut self) -> Result<Rung, SimError> {
+        let (scenario, tol) = (self.scenario, self.tol);
+        self.observer.reset();
+        let fine = match run_plan(scenario, &self.guarded.with_dt(self.dt), self.observer) {
             Ok(out) => out,
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
             Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
-                why = format!("the run blew up or lost energy ({e})");
-                coarse = None;
-                previous_change = None;
-                dt *= 0.5;
-                continue;
+                self.coarse = None;
+                self.previous_change = None;
+                self.dt *= 0.5;
+                return Ok(Rung::Refine(Refusal::BlewUp(e.to_string())));
             }
             Err(e) => return Err(e),
         };
-        spent += fine.stats.rhs_evals;
-        let change = coarse
+        self.spent += fine.stats.rhs_evals;
+        let change = self
+            .coarse
             .as_ref()
             .map(|c| c.fractions.largest_difference(&fine.fractions));
-        estimate = change.map_or(f64::INFINITY, |c| c / richardson);
+        self.estimate = change.map_or(f64::INFINITY, |c| c / self.richardson);
+        let estimate = self.estimate;
+        let accept = self.strictness.accept;
         let drift_limit = (DRIFT_PER_TOL * tol).max(1e-12);
         let drift_ok = fine.stats.max_energy_drift <= drift_limit;
         let regular = asymptotic(
-            previous_change,
+            self.previous_change,
             change.unwrap_or(f64::INFINITY),
-            (order, f64::from(plan.method.order())),
+            (self.order, f64::from(self.plan.method.order())),
             tol,
         );
-        let enough_runs = previous_change.is_some() || !needs_three_runs;
-        // With a nonlinear resonator, or a wave that has bounced at the chain's ends for a
-        // good part of the run, the pair must also agree with a run off its ladder, at 1.5 dt:
-        // errors that jump erratically with the step can make dt and 2 dt agree while both
-        // miss (docs/methods.md, "The audit").
+        let enough_runs = self.previous_change.is_some() || !self.strictness.needs_three_runs;
+        let pair_passes = estimate <= accept && drift_ok && regular && enough_runs;
+        let off_ladder = match pair_passes && self.needs_off_ladder(&fine) {
+            true => Some(self.off_ladder_estimate(&fine)?),
+            false => None,
+        };
+        if pair_passes && off_ladder.is_none_or(|e| e <= accept) {
+            let estimate = off_ladder.map_or(estimate, |e| e.max(estimate));
+            return Ok(Rung::Accept(Box::new(Outcome {
+                plan: Plan {
+                    drift_limit: self.plan.drift_limit,
+                    ..fine.plan
+                },
+                total_rhs_evals: self.spent,
+                error_estimate: Some(estimate),
+                ..fine
+            })));
+        }
+        let why = if let Some(e) = off_ladder.filter(|&e| e > accept) {
+            Refusal::OffLadder {
+                estimate: e,
+                accept,
+                tol,
+            }
+        } else if change.is_none() {
+            Refusal::NoPair
+        } else if estimate > accept {
+            Refusal::Estimate {
+                estimate,
+                accept,
+                tol,
+            }
+        } else if !drift_ok {
+            Refusal::Drift {
+                drift: fine.stats.max_energy_drift,
+                limit: drift_limit,
+            }
+        } else {
+            Refusal::NotAsymptotic {
+                estimate,
+                before: self.previous_change.unwrap_or(f64::NAN),
+                after: change.unwrap_or(f64::NAN),
+            }
+        };
+        self.previous_change = change;
+        self.coarse = Some(fine);
+        self.dt *= 0.5;
+        Ok(Rung::Refine(why))
+    }
+
+    /// Whether an accepted pair must also agree with a run off its ladder, at 1.5 dt: with a
+    /// nonlinear resonator, or a wave that has bounced at the chain's ends for a good part of
+    /// the run, errors that jump erratically with the step can make dt and 2 dt agree while
+    /// both miss (docs/methods.md, "The audit").
+    fn needs_off_ladder(&self, fine: &Outcome) -> bool {
         let bouncing = fine
             .stats
             .end_reached_at
-            .is_some_and(|t| t < (1.0 - BOUNCING_SHARE) * scenario.t_end);
-        let mut off_ladder = None;
-        if estimate <= accept && drift_ok && regular && enough_runs && (off_ladder_run || bouncing)
-        {
-            let off = check_run(scenario, &guarded.with_dt(1.5 * dt), observer, &mut spent)?;
-            off_ladder = Some(off.map_or(f64::INFINITY, |out| {
-                out.fractions.largest_difference(&fine.fractions) / (1.5f64.powf(order) - 1.0)
-            }));
-        }
-        let off_ladder_ok = off_ladder.is_none_or(|e| e <= accept);
-        if estimate <= accept && drift_ok && regular && enough_runs && off_ladder_ok {
-            let estimate = off_ladder.map_or(estimate, |e| e.max(estimate));
-            return Ok(Outcome {
-                plan: Plan {
-                    drift_limit: plan.drift_limit,
-                    ..fine.plan
-                },
-                total_rhs_evals: spent,
-                error_estimate: Some(estimate),
-                ..fine
-            });
-        }
-        why = if let Some(e) = off_ladder.filter(|&e| e > accept) {
-            format!(
-                "the pair agreed, but a run at 1.5 times the step differs by an estimated {e:.2e}, above the {accept:.1e} it must meet (tolerance {tol:.1e}): the error jumps with the step"
-            )
-        } else if change.is_none() {
-            "the run at twice the step blew up, so there is no pair to compare".to_string()
-        } else if estimate > accept {
-            format!(
-                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e})"
-            )
-        } else if !drift_ok {
-            format!(
-                "the energy drifts by {:.2e}, more than the {drift_limit:.1e} the tolerance allows",
-                fine.stats.max_energy_drift
-            )
-        } else {
-            format!(
-                "the error estimate {estimate:.2e} would pass, but the runs are not in their asymptotic regime (the change between runs went from {:.2e} to {:.2e} when the step halved, not by the factor the method's order gives), so the estimate cannot be trusted",
-                previous_change.unwrap_or(f64::NAN),
-                change.unwrap_or(f64::NAN)
-            )
-        };
-        previous_change = change;
-        coarse = Some(fine);
-        dt *= 0.5;
+            .is_some_and(|t| t < (1.0 - BOUNCING_SHARE) * self.scenario.t_end);
+        self.strictness.off_ladder_run || bouncing
     }
-    Err(SimError::NotConverged {
-        tolerance: tol,
-        estimate,
-        dt: 2.0 * dt,
-        why,
-    })
+
+    /// The error estimate from the run at 1.5 dt against `fine` (infinite if it blew up).
+    fn off_ladder_estimate(&mut self, fine: &Outcome) -> Result<f64, SimError> {
+        let plan = self.guarded.with_dt(1.5 * self.dt);
+        let off = check_run(self.scenario, &plan, self.observer, &mut self.spent)?;
+        Ok(off.map_or(f64::INFINITY, |out| {
+            out.fractions.largest_difference(&fine.fractions) / (1.5f64.powf(self.order) - 1.0)
+        }))
+    }
 }
 
 /// A verification run (the coarse run of a pair, or one off its ladder), shown to the
