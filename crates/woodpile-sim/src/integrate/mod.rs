@@ -238,6 +238,10 @@ impl WatchedEnds {
 
 /// Integrates `y` from t = 0 to `cfg.t_end` with `stepper`, calling `observer` at the samples.
 ///
+/// One loop over the sample intervals: each is covered by the step control's own strategy
+/// ([`Stepping::cover`]: equal fixed steps, or the adaptive method's accepted steps), then the
+/// sample is checked and observed ([`Stepping::sample`]).
+///
 /// Errors: a non-finite state, an energy drift beyond the limit, a step below the floor, or an
 /// exhausted budget stop the run; the state is then meaningless and must not be reported.
 pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
@@ -249,112 +253,190 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
 ) -> Result<Stats, SimError> {
     validate(cfg)?;
     let e0 = total_energy(model, 0.0, y);
-    // Drift is measured (and bounded) only where energy is conserved and a relative drift exists.
-    let tracks_drift = !model.is_time_dependent() && e0 > 0.0;
-    let n_intervals = intervals(cfg.t_end, cfg.sample_every);
-    let mut stats = Stats::default();
-    let mut attempts: u64 = 0;
-    let mut t = 0.0;
-    let mut h = match cfg.control {
+    let h = match cfg.control {
         StepControl::Fixed { dt } => dt,
-        StepControl::Adaptive { .. } => stepper.initial_step(model, t, y, cfg.t_end),
+        StepControl::Adaptive { .. } => stepper.initial_step(model, 0.0, y, cfg.t_end),
     };
-    check_finite(y, t)?;
-    observer.observe(model, t, y);
-    let ends = WatchedEnds::new(model, y, e0);
-    let mut active = ActiveSites::new(model, y, stepper.reach(), cfg.active_window);
-
+    check_finite(y, 0.0)?;
+    observer.observe(model, 0.0, y);
+    let mut run = Stepping {
+        model,
+        cfg,
+        // Drift is measured (and bounded) only where energy is conserved and a relative
+        // drift exists.
+        tracks_drift: !model.is_time_dependent() && e0 > 0.0,
+        e0,
+        ends: WatchedEnds::new(model, y, e0),
+        active: ActiveSites::new(model, y, stepper.reach(), cfg.active_window),
+        stats: Stats::default(),
+        attempts: 0,
+        t: 0.0,
+        h,
+    };
+    let n_intervals = intervals(cfg.t_end, cfg.sample_every);
     for k in 1..=n_intervals {
         let target = if k == n_intervals {
             cfg.t_end
         } else {
             k as f64 * cfg.sample_every
         };
-        match cfg.control {
-            StepControl::Fixed { dt } => {
-                let span = target - t;
-                let n_steps = (span / dt - 1e-9).ceil().max(1.0) as u64;
-                let h_eq = span / n_steps as f64;
-                for i in 0..n_steps {
-                    let window = active.window();
-                    stats.site_steps += window.len() as u64;
-                    stepper.step(model, y, StepSpan { t, h: h_eq, window });
-                    active.update(model, y, window);
-                    t = if i + 1 == n_steps { target } else { t + h_eq };
-                    stats.steps += 1;
-                    stats.max_step = stats.max_step.max(h_eq);
-                    if stats.steps > cfg.max_steps {
-                        return Err(SimError::TooManySteps {
-                            t,
-                            max_steps: cfg.max_steps,
-                        });
-                    }
-                    check_finite_in(y, t, &window.state_ranges(model))?;
+        run.cover(stepper, y, target)?;
+        run.sample(y, observer)?;
+    }
+    run.stats.rhs_evals = stepper.rhs_evals();
+    Ok(run.stats)
+}
+
+/// A run between samples: where it is, its next step, its active window and its statistics.
+struct Stepping<'a> {
+    model: &'a Model,
+    cfg: &'a DriveConfig,
+    tracks_drift: bool,
+    e0: f64,
+    ends: WatchedEnds,
+    active: ActiveSites,
+    stats: Stats,
+    /// Step attempts, rejected ones included (the adaptive budget).
+    attempts: u64,
+    t: f64,
+    /// The next adaptive step (unused by fixed steps).
+    h: f64,
+}
+
+impl Stepping<'_> {
+    /// Advances from `t` to `target` by the step control's strategy.
+    fn cover<S: Stepper + ?Sized>(
+        &mut self,
+        stepper: &mut S,
+        y: &mut [f64],
+        target: f64,
+    ) -> Result<(), SimError> {
+        match self.cfg.control {
+            StepControl::Fixed { dt } => self.fixed_steps(stepper, y, target, dt),
+            StepControl::Adaptive { h_min } => self.adaptive_steps(stepper, y, target, h_min),
+        }
+    }
+
+    /// Equal steps of at most `dt` that end exactly on `target`.
+    fn fixed_steps<S: Stepper + ?Sized>(
+        &mut self,
+        stepper: &mut S,
+        y: &mut [f64],
+        target: f64,
+        dt: f64,
+    ) -> Result<(), SimError> {
+        let span = target - self.t;
+        let n_steps = (span / dt - 1e-9).ceil().max(1.0) as u64;
+        let h_eq = span / n_steps as f64;
+        for i in 0..n_steps {
+            let window = self.active.window();
+            self.stats.site_steps += window.len() as u64;
+            stepper.step(
+                self.model,
+                y,
+                StepSpan {
+                    t: self.t,
+                    h: h_eq,
+                    window,
+                },
+            );
+            self.active.update(self.model, y, window);
+            self.t = if i + 1 == n_steps {
+                target
+            } else {
+                self.t + h_eq
+            };
+            self.stats.steps += 1;
+            self.stats.max_step = self.stats.max_step.max(h_eq);
+            if self.stats.steps > self.cfg.max_steps {
+                return Err(SimError::TooManySteps {
+                    t: self.t,
+                    max_steps: self.cfg.max_steps,
+                });
+            }
+            check_finite_in(y, self.t, &window.state_ranges(self.model))?;
+        }
+        Ok(())
+    }
+
+    /// The adaptive method's steps up to `target`, the last shortened to land on it.
+    fn adaptive_steps<S: Stepper + ?Sized>(
+        &mut self,
+        stepper: &mut S,
+        y: &mut [f64],
+        target: f64,
+        h_min: f64,
+    ) -> Result<(), SimError> {
+        while self.t < target {
+            let remaining = target - self.t;
+            let lands = self.h >= remaining * (1.0 - 1e-12);
+            let h_try = if lands { remaining } else { self.h };
+            self.attempts += 1;
+            if self.attempts > self.cfg.max_steps {
+                return Err(SimError::TooManySteps {
+                    t: self.t,
+                    max_steps: self.cfg.max_steps,
+                });
+            }
+            let window = self.active.window();
+            self.stats.site_steps += window.len() as u64;
+            let span = StepSpan {
+                t: self.t,
+                h: h_try,
+                window,
+            };
+            match stepper.step(self.model, y, span) {
+                StepOutcome::Accepted { h_next } => {
+                    self.active.update(self.model, y, window);
+                    self.t = if lands { target } else { self.t + h_try };
+                    self.stats.steps += 1;
+                    self.stats.max_step = self.stats.max_step.max(h_try);
+                    check_finite_in(y, self.t, &window.state_ranges(self.model))?;
+                    // A step shortened to land on a sample says nothing about the step the
+                    // method could take: keep the larger proposal.
+                    self.h = if lands { h_next.max(self.h) } else { h_next };
+                }
+                StepOutcome::Rejected { h_next } => {
+                    self.stats.rejected += 1;
+                    self.h = h_next;
                 }
             }
-            StepControl::Adaptive { h_min } => {
-                while t < target {
-                    let remaining = target - t;
-                    let lands = h >= remaining * (1.0 - 1e-12);
-                    let h_try = if lands { remaining } else { h };
-                    attempts += 1;
-                    if attempts > cfg.max_steps {
-                        return Err(SimError::TooManySteps {
-                            t,
-                            max_steps: cfg.max_steps,
-                        });
-                    }
-                    let window = active.window();
-                    stats.site_steps += window.len() as u64;
-                    match stepper.step(
-                        model,
-                        y,
-                        StepSpan {
-                            t,
-                            h: h_try,
-                            window,
-                        },
-                    ) {
-                        StepOutcome::Accepted { h_next } => {
-                            active.update(model, y, window);
-                            t = if lands { target } else { t + h_try };
-                            stats.steps += 1;
-                            stats.max_step = stats.max_step.max(h_try);
-                            check_finite_in(y, t, &window.state_ranges(model))?;
-                            // A step shortened to land on a sample says nothing about the
-                            // step the method could take: keep the larger proposal.
-                            h = if lands { h_next.max(h) } else { h_next };
-                        }
-                        StepOutcome::Rejected { h_next } => {
-                            stats.rejected += 1;
-                            h = h_next;
-                        }
-                    }
-                    if !(h >= h_min) {
-                        return Err(SimError::StepUnderflow { t, dt: h });
-                    }
-                }
+            if !(self.h >= h_min) {
+                return Err(SimError::StepUnderflow {
+                    t: self.t,
+                    dt: self.h,
+                });
             }
         }
-        if tracks_drift {
-            let drift = ((total_energy(model, t, y) - e0) / e0).abs();
-            stats.max_energy_drift = stats.max_energy_drift.max(drift);
-            if let Some(limit) = cfg.energy_drift_limit {
+        Ok(())
+    }
+
+    /// At a sample: the energy drift checked, the ends watched, the observer told (and asked
+    /// whether to stop).
+    fn sample<O: Observer + ?Sized>(
+        &mut self,
+        y: &[f64],
+        observer: &mut O,
+    ) -> Result<(), SimError> {
+        let (model, t) = (self.model, self.t);
+        if self.tracks_drift {
+            let drift = ((total_energy(model, t, y) - self.e0) / self.e0).abs();
+            self.stats.max_energy_drift = self.stats.max_energy_drift.max(drift);
+            if let Some(limit) = self.cfg.energy_drift_limit {
                 if !(drift <= limit) {
                     return Err(SimError::EnergyDrift { t, drift, limit });
                 }
             }
         }
-        if stats.end_reached_at.is_none() && ends.reached(y) {
-            stats.end_reached_at = Some(t);
+        if self.stats.end_reached_at.is_none() && self.ends.reached(y) {
+            self.stats.end_reached_at = Some(t);
         }
         observer.observe(model, t, y);
         if observer.cancelled() {
             return Err(SimError::Cancelled { t });
         }
+        Ok(())
     }
-    stats.rhs_evals = stepper.rhs_evals();
-    Ok(stats)
 }
 
 /// Number of sample intervals covering [0, t_end]; the last may be shorter.
