@@ -89,6 +89,38 @@ impl<'a> Fields<'a> {
         }
     }
 
+    /// A key whose value is one of `options` (the names a stage file writes, each with the
+    /// value it stands for), or `default` when absent (`None`: the key is required). The one
+    /// parser of every "one of these words" key, so each refusal reads alike:
+    /// `expected "a", "b" or "c", got "x"`.
+    pub fn choice<T: Copy>(
+        &mut self,
+        key: &str,
+        options: &[(&str, T)],
+        default: Option<T>,
+    ) -> Result<T, PipelineError> {
+        let given = match default {
+            Some(value) => match self.optional::<String>(key)? {
+                Some(text) => text,
+                None => return Ok(value),
+            },
+            None => self.required::<String>(key)?,
+        };
+        if let Some(&(_, value)) = options.iter().find(|(name, _)| *name == given) {
+            return Ok(value);
+        }
+        let names: Vec<String> = options
+            .iter()
+            .map(|(name, _)| format!("\"{name}\""))
+            .collect();
+        let listed = match names.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => String::new(),
+        };
+        Err(self.error(key, format!("expected {listed}, got \"{given}\"")))
+    }
+
     /// An optional `key = [lo, hi]` of finite numbers, the one parser of every range key:
     /// `lo <= hi` for a closed range ([`Ends::MayMeet`]), `lo < hi` for an interval of
     /// positive width ([`Ends::Apart`]).

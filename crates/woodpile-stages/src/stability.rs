@@ -91,27 +91,10 @@ impl Stability {
                 }
             }
         }
-        let vary = match fields.required::<String>("vary")?.as_str() {
-            "eps" => Vary::Eps,
-            "p" => Vary::P,
-            other => {
-                return Err(fields.error(
-                    "vary",
-                    format!("expected \"eps\" or \"p\", got \"{other}\""),
-                ))
-            }
-        };
+        let vary = fields.choice("vary", &[("eps", Vary::Eps), ("p", Vary::P)], None)?;
         let values: Vec<f64> = fields.required("values")?;
-        let steps_are_dt_omega = match fields.required::<String>("step")?.as_str() {
-            "dt_omega" => true,
-            "dt" => false,
-            other => {
-                return Err(fields.error(
-                    "step",
-                    format!("expected \"dt_omega\" or \"dt\", got \"{other}\""),
-                ))
-            }
-        };
+        let steps_are_dt_omega =
+            fields.choice("step", &[("dt_omega", true), ("dt", false)], None)?;
         let steps: Vec<f64> = fields.required("steps")?;
         if values.is_empty() || steps.is_empty() || steps.iter().any(|s| !(*s > 0.0)) {
             return Err(fields.error("steps", "expected non-empty `values` and positive `steps`"));

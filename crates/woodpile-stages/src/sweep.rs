@@ -68,16 +68,11 @@ impl Sweep {
             Some(table) => parse_axes(fields.nested("axes", table))?,
             None => Vec::new(),
         };
-        let series = match fields.optional::<String>("series")?.as_deref() {
-            None | Some("energy") => Series::Energy,
-            Some("kinetic") => Series::Kinetic,
-            Some(other) => {
-                return Err(fields.error(
-                    "series",
-                    format!("expected \"energy\" or \"kinetic\", got \"{other}\""),
-                ))
-            }
-        };
+        let series = fields.choice(
+            "series",
+            &[("energy", Series::Energy), ("kinetic", Series::Kinetic)],
+            Some(Series::Energy),
+        )?;
         let scene: toml::Table = fields.required("scene")?;
         let sweep = Sweep::over(axes, series, scene, fields.file())?;
         let last = sweep.scene_at(sweep.count() - 1)?;

@@ -127,23 +127,9 @@ impl Design {
             return Err(fields.error("budget", format!("at least {POPULATION} evaluations")));
         }
         let refine = positive_int(fields, "refine", Some(0))?;
-        let objective = fields.required::<String>("objective")?;
-        let Some(objective) = Fraction::named(&objective) else {
-            return Err(fields.error(
-                "objective",
-                format!("expected \"E_tr\", \"R\" or \"T\", got \"{objective}\""),
-            ));
-        };
-        let maximise = match fields.optional::<String>("goal")?.as_deref() {
-            None | Some("max") => true,
-            Some("min") => false,
-            Some(other) => {
-                return Err(fields.error(
-                    "goal",
-                    format!("expected \"max\" or \"min\", got \"{other}\""),
-                ))
-            }
-        };
+        let objectives = Fraction::ALL.map(|f| (f.column(), f));
+        let objective = fields.choice("objective", &objectives, None)?;
+        let maximise = fields.choice("goal", &[("max", true), ("min", false)], Some(true))?;
         let verify_tolerance = fields.optional::<f64>("verify_tolerance")?.unwrap_or(1e-8);
         let robustness = match fields.optional::<toml::Table>("robustness")? {
             None => None,

@@ -257,14 +257,11 @@ fn shared_axes(f: &mut Fields<'_>) -> Result<(String, Option<String>, String, St
 }
 
 fn scale_key(f: &mut Fields<'_>, key: &str) -> Result<Scale> {
-    match f.optional::<String>(key)?.as_deref() {
-        None | Some("linear") => Ok(Scale::Linear),
-        Some("log") => Ok(Scale::Log),
-        Some(other) => Err(f.error(
-            key,
-            format!("expected \"linear\" or \"log\", got \"{other}\""),
-        )),
-    }
+    f.choice(
+        key,
+        &[("linear", Scale::Linear), ("log", Scale::Log)],
+        Some(Scale::Linear),
+    )
 }
 
 /// `z_range = [lo, hi] | "robust" | "full"`; by default robust for diverging colours.
