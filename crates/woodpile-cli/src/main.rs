@@ -30,6 +30,7 @@ mod new_study;
 mod pipeline_cmd;
 mod progress;
 mod project;
+mod reports;
 mod simulate;
 
 use std::process::ExitCode;

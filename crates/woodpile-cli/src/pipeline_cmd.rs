@@ -15,6 +15,7 @@ use woodpile_pipeline::{Pipeline, PipelineError};
 use crate::project::Dirs;
 
 use crate::progress::Progress;
+use crate::reports::{RunReport, StageRun, StageStatus};
 use crate::Failure;
 
 /// Where the pipeline lives. Each folder comes from its flag, else its environment variable,
@@ -222,27 +223,24 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let scenes = woodpile_pipeline::points::simulations() - before;
     let seconds = started.elapsed().as_secs_f64();
     if args.json {
-        let stages: Vec<serde_json::Value> = steps
-            .iter()
-            .map(|s| {
-                serde_json::json!({
-                    "stage": s.stage,
-                    "runs": s.runs,
-                    "why": s.why,
-                    "points": s.points.map(|(n, _)| n),
-                    "cached": s.points.map(|(_, c)| c),
+        let report = RunReport {
+            dry_run: args.dry_run,
+            stages: steps
+                .iter()
+                .map(|s| StageRun {
+                    stage: s.stage.clone(),
+                    runs: s.runs,
+                    why: s.why.clone(),
+                    points: s.points.map(|(n, _)| n),
+                    cached: s.points.map(|(_, c)| c),
                 })
-            })
-            .collect();
-        let summary = serde_json::json!({
-            "dry_run": args.dry_run,
-            "stages": stages,
-            "ran": ran,
-            "fresh": steps.len() - ran,
-            "scenes_simulated": if args.dry_run { 0 } else { scenes },
-            "seconds": seconds,
-        });
-        say!("{summary}");
+                .collect(),
+            ran,
+            fresh: steps.len() - ran,
+            scenes_simulated: if args.dry_run { 0 } else { scenes },
+            seconds,
+        };
+        say!("{}", serde_json::to_string(&report).map_err(Failure::simulation)?);
     } else if args.dry_run {
         for step in &steps {
             let points = step
@@ -355,18 +353,16 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
         .collect();
     let not_fresh = states.iter().filter(|(_, st)| *st != State::Fresh).count();
     if args.json {
-        let rows: Vec<serde_json::Value> = states
+        let rows: Vec<StageStatus> = states
             .iter()
-            .map(|(stage, st)| {
-                serde_json::json!({
-                    "stage": stage.name,
-                    "kind": stage.kind,
-                    "state": st.label(),
-                    "why": st.why(),
-                })
+            .map(|(stage, st)| StageStatus {
+                stage: stage.name.clone(),
+                kind: stage.kind,
+                state: st.label(),
+                why: st.why(),
             })
             .collect();
-        say!("{}", serde_json::Value::Array(rows));
+        say!("{}", serde_json::to_string(&rows).map_err(Failure::simulation)?);
     } else {
         say!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
         for (stage, st) in &states {
