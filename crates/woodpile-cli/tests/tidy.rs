@@ -210,7 +210,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-plot", "draw.rs:figure", 93),
     ("woodpile-scene", "resolve/mod.rs:resolve", 91),
     ("woodpile-stages", "workprecision.rs:parse", 90),
-    ("woodpile-stages", "design/mod.rs:parse", 89),
 ];
 
 /// Every function of `code` as (name, lines), found by its `fn` line and the closing brace at
