@@ -240,7 +240,10 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
             scenes_simulated: if args.dry_run { 0 } else { scenes },
             seconds,
         };
-        say!("{}", serde_json::to_string(&report).map_err(Failure::simulation)?);
+        say!(
+            "{}",
+            serde_json::to_string(&report).map_err(Failure::simulation)?
+        );
     } else if args.dry_run {
         for step in &steps {
             let points = step
@@ -362,7 +365,10 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
                 why: st.why(),
             })
             .collect();
-        say!("{}", serde_json::to_string(&rows).map_err(Failure::simulation)?);
+        say!(
+            "{}",
+            serde_json::to_string(&rows).map_err(Failure::simulation)?
+        );
     } else {
         say!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");
         for (stage, st) in &states {

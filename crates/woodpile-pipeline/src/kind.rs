@@ -225,6 +225,9 @@ pub struct Output {
     /// quote that could not be read): recorded in the table, and the run ends non-zero
     /// naming them.
     pub failures: Vec<String>,
+    /// For a grid of scenes: its points' statistics (how many, how many failed), which the
+    /// run's `done` line reports.
+    pub points: Option<PointStats>,
 }
 
 impl Output {
@@ -234,6 +237,15 @@ impl Output {
             frame,
             summary,
             failures: Vec::new(),
+            points: None,
+        }
+    }
+
+    /// The output of a grid of scenes, whose points' statistics are `stats`.
+    pub fn with_points(self, stats: PointStats) -> Output {
+        Output {
+            points: Some(stats),
+            ..self
         }
     }
 }

@@ -391,10 +391,12 @@ fn execute(
         sealed_files::record(&stage.spec.files(&stage.name, results, &options.figures))?;
     let rows = output.frame.height();
     table::write(&output_path(results, &stage.name), output.frame, &manifest)?;
-    let count = |k: &str| output.summary.get(k).and_then(|v| v.as_u64());
-    let line = match (count("points"), count("failed")) {
-        (Some(points), Some(failed)) => format!("{rows} rows, {points} points, {failed} failed"),
-        _ => format!("{rows} rows"),
+    let line = match output.points {
+        Some(stats) => format!(
+            "{rows} rows, {} points, {} failed",
+            stats.points, stats.failed
+        ),
+        None => format!("{rows} rows"),
     };
     Ok((line, output.failures))
 }

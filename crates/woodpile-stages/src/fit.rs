@@ -164,6 +164,7 @@ impl FitStage {
             frame: rows_frame(&out)?,
             summary: json!({"models": rows, "rows_used": keep.len(), "failed": failures.len()}),
             failures,
+            points: None,
         })
     }
 }

@@ -213,7 +213,7 @@ impl Sweep {
             events,
         };
         let (frame, stats) = self.run_points(at, &all)?;
-        Ok(Output::table(frame, self.summary(&stats)?))
+        Ok(Output::table(frame, self.summary(&stats)?).with_points(stats))
     }
 
     /// The output rows of the points `indices`: one per sample of each point, or one with the

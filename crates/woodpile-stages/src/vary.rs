@@ -189,7 +189,8 @@ impl Kind for Vary {
                 "max_error_estimate": stats.max_error_estimate,
                 "max_energy_drift": stats.max_energy_drift,
             }),
-        ))
+        )
+        .with_points(stats))
     }
 }
 

@@ -334,6 +334,7 @@ impl Report {
                 "failed": failures.len(),
                 "markdown": self.markdown,
             }),
+            points: None,
             failures,
         })
     }
