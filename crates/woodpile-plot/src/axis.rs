@@ -179,4 +179,15 @@ mod tests {
         let (major, _) = Scale::Log.ticks(-8.0, 0.0, 6);
         assert_eq!(major, vec![-8.0, -6.0, -4.0, -2.0, 0.0]);
     }
+
+    #[test]
+    fn ticks_print_integers_as_integers_and_never_minus_zero() {
+        assert_eq!(tick(&10.0), "10");
+        assert_eq!(tick(&-0.0), "0");
+        assert_eq!(tick(&-1e-17), "0");
+        assert_eq!(tick(&0.25), "0.25");
+        assert_eq!(tick(&(0.1 + 0.2)), "0.3");
+        assert_eq!(tick(&-2.5), "-2.5");
+        assert_eq!(tick(&1.5e-7), "1.50e-7");
+    }
 }

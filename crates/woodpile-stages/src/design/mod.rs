@@ -108,6 +108,9 @@ struct Evaluated {
     key: String,
 }
 
+/// Where a refinement starts: the search it refines, its genome and its score.
+type Start = (Search, Vec<f64>, f64);
+
 impl Design {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Design> {
         let positive_int = |fields: &mut Fields<'_>, key: &str, default: Option<i64>| {
@@ -229,7 +232,7 @@ impl Design {
     /// Differential evolution a generation at a time, then random search of the same budget
     /// (the baseline): their rows, and where each search's refinement starts (the best genome
     /// of each, with its score).
-    fn search(&self, at: PointsAt<'_>) -> Result<(Vec<Evaluated>, Vec<(Search, Vec<f64>, f64)>)> {
+    fn search(&self, at: PointsAt<'_>) -> Result<(Vec<Evaluated>, Vec<Start>)> {
         let PointsAt { store, events, .. } = at;
         let d = self.space.dimension();
         let mut rows = Vec::new();
