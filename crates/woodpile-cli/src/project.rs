@@ -76,26 +76,43 @@ fn find_project_file() -> anyhow::Result<Option<(PathBuf, toml::Table)>> {
     };
     for folder in here.ancestors() {
         let path = folder.join(PROJECT_FILE);
-        if path.is_file() && trusted(&path) {
-            return Ok(Some((root_of(folder), read_project_file(&path)?)));
+        if path.is_file() {
+            match untrusted(&path) {
+                None => return Ok(Some((root_of(folder), read_project_file(&path)?))),
+                Some(why) => eprintln!(
+                    "warning: ignoring {}: {why}",
+                    woodpile_scene::escape_controls(&path.display().to_string())
+                ),
+            }
         }
-        if folder.join("pipeline").is_dir() {
-            return Ok(Some((root_of(folder), toml::Table::new())));
+        let stages = folder.join("pipeline");
+        if stages.is_dir() {
+            // The current folder's own pipeline/ is the default a bare run has always used;
+            // one further up is adopted only when it could not have been planted there.
+            if folder == here || untrusted(&stages).is_none() {
+                return Ok(Some((root_of(folder), toml::Table::new())));
+            }
+            return Ok(None);
         }
     }
     Ok(None)
 }
 
-/// Whether a `woodpile.toml` may direct this run: owned by the user running it, in a folder
-/// that not everyone may write to. Any other is ignored, as if absent.
-fn trusted(path: &Path) -> bool {
+/// Why a `woodpile.toml` or a `pipeline/` folder may not direct this run: owned by another
+/// user, or in a folder everyone may write to (a shared `/tmp`). `None` when it may.
+fn untrusted(path: &Path) -> Option<&'static str> {
     use std::os::unix::fs::{MetadataExt, PermissionsExt};
     let folder = path.parent().unwrap_or(Path::new("."));
-    let (Ok(file), Ok(dir)) = (std::fs::metadata(path), std::fs::metadata(folder)) else {
-        return false;
+    let (Ok(meta), Ok(dir)) = (std::fs::metadata(path), std::fs::metadata(folder)) else {
+        return Some("it cannot be read");
     };
-    let mine = file.uid() == rustix::process::geteuid().as_raw();
-    mine && dir.permissions().mode() & 0o002 == 0
+    if meta.uid() != rustix::process::geteuid().as_raw() {
+        Some("it belongs to another user")
+    } else if dir.permissions().mode() & 0o002 != 0 {
+        Some("it is in a folder everyone may write to")
+    } else {
+        None
+    }
 }
 
 /// The table of the `woodpile.toml` at `path`, its keys checked.

@@ -461,14 +461,21 @@ fn a_woodpile_toml_above_a_project_does_not_take_it_over() {
         "{}",
         text(&out.stdout)
     );
-    // Without a project below it, the world-writable folder's file is still ignored.
+    // Without a project below it, the world-writable folder's file is still ignored (with a
+    // warning), and so is a pipeline/ planted there.
+    std::fs::create_dir_all(shared.join("pipeline")).unwrap();
+    std::fs::write(shared.join("pipeline/planted.toml"), sweep()).unwrap();
     let lone = shared.join("lone");
     std::fs::create_dir_all(&lone).unwrap();
     let out = woodpile(&lone, &["status"]);
+    let (stdout, stderr) = (text(&out.stdout), text(&out.stderr));
     assert!(
-        !text(&out.stderr).contains("elsewhere"),
-        "{}",
-        text(&out.stderr)
+        stderr.contains("warning: ignoring") && stderr.contains("everyone may write"),
+        "{stderr}"
+    );
+    assert!(
+        !stdout.contains("planted") && !stderr.contains("elsewhere"),
+        "{stdout}{stderr}"
     );
     assert!(!shared.join("stolen").exists());
 }
