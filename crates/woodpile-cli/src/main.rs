@@ -14,7 +14,12 @@
 macro_rules! say {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let text = woodpile_scene::escape_controls(&format!($($arg)*));
+        // Line by line: the text's own line breaks stay (a status table, indented JSON).
+        let text = format!($($arg)*)
+            .split('\n')
+            .map(woodpile_scene::escape_controls)
+            .collect::<Vec<_>>()
+            .join("\n");
         let mut out = std::io::stdout().lock();
         if let Err(e) = writeln!(out, "{text}") {
             if e.kind() == std::io::ErrorKind::BrokenPipe {

@@ -242,7 +242,7 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         };
         say!(
             "{}",
-            serde_json::to_string(&report).map_err(Failure::simulation)?
+            crate::reports::json_text(&report, false).map_err(Failure::simulation)?
         );
     } else if args.dry_run {
         for step in &steps {
@@ -367,7 +367,7 @@ pub(crate) fn status_command(args: &StatusArgs) -> Result<(), Failure> {
             .collect();
         say!(
             "{}",
-            serde_json::to_string(&rows).map_err(Failure::simulation)?
+            crate::reports::json_text(&rows, false).map_err(Failure::simulation)?
         );
     } else {
         say!("{:width$}  {:11}  {:7}  why", "stage", "kind", "state");

@@ -47,3 +47,41 @@ pub(crate) struct StageStatus {
     /// Why it is not fresh (empty when it is).
     pub why: String,
 }
+
+/// `value` as one line of JSON (or indented, with `pretty`) holding no raw control character:
+/// serde_json escapes those below U+0020 but leaves DEL and U+0080–U+009F, which a terminal
+/// obeys; they are written as `\u007f`-style escapes, still valid JSON.
+pub(crate) fn json_text<T: Serialize>(value: &T, pretty: bool) -> serde_json::Result<String> {
+    let text = match pretty {
+        true => serde_json::to_string_pretty(value)?,
+        false => serde_json::to_string(value)?,
+    };
+    Ok(text
+        .chars()
+        .map(|c| match c.is_control() && c > '\u{1f}' {
+            true => format!("\\u{:04x}", c as u32),
+            false => c.to_string(),
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// DEL and the C1 controls (which serde_json leaves raw) come out escaped, and the text
+    /// is still JSON that reads back to the same value.
+    #[test]
+    fn json_text_has_no_raw_control_and_stays_json() {
+        let value = serde_json::json!({"why": "a\u{7f}b\u{85}c\u{9b}2J\u{1b}"});
+        for pretty in [false, true] {
+            let text = json_text(&value, pretty).unwrap();
+            assert!(
+                !text.chars().any(|c| c.is_control() && c != '\n'),
+                "{text:?}"
+            );
+            let back: serde_json::Value = serde_json::from_str(&text).unwrap();
+            assert_eq!(back, value);
+        }
+    }
+}

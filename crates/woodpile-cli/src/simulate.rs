@@ -73,11 +73,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     if let Some(path) = &args.field {
         write_field(path, &args.scene, &scene, &outcome, &field)?;
     }
-    let text = if args.pretty {
-        serde_json::to_string_pretty(&report)
-    } else {
-        serde_json::to_string(&report)
-    };
+    let text = crate::reports::json_text(&report, args.pretty);
     say!("{}", text.map_err(Failure::simulation)?);
     Ok(())
 }

@@ -560,6 +560,15 @@ fn control_characters_from_stage_files_are_printed_escaped() {
         );
         assert!(stderr.contains("\\u{1b}[2J"), "{stderr:?}");
     }
+    // A newline in a key cannot start a line of its own that passes for a status line.
+    std::fs::write(
+        &stage,
+        sweep().replace("[axes]", "\"x\\nfresh     sweep\" = 1\n[axes]"),
+    )
+    .unwrap();
+    let out = woodpile(dir.path(), &["status"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr:?}");
 }
 
 /// A sweep keeps a point's key and series, not its scene: 120 points of a 200,001-site chain

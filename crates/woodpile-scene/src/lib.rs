@@ -122,12 +122,13 @@ pub fn syntax_reason(error: &toml::de::Error, text: &str) -> String {
     }
 }
 
-/// `text` with every control character (ESC, CR, BEL ... but not a plain space) written as
-/// an escape, so that a message quoting a file's key or value cannot move the cursor, recolour
-/// or rewrite the terminal it is printed to.
+/// `text` with every control character (ESC, CR, BEL, a newline ... but not a plain space)
+/// written as an escape, so that a message quoting a file's key or value cannot move the
+/// cursor, recolour, rewrite the terminal it is printed to, or start a line of its own that
+/// passes for another message.
 pub fn escape_controls(text: &str) -> String {
     text.chars()
-        .flat_map(|c| match c.is_control() && c != '\n' {
+        .flat_map(|c| match c.is_control() {
             true => c.escape_default().collect::<Vec<_>>(),
             false => vec![c],
         })
