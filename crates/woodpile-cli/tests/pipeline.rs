@@ -655,3 +655,28 @@ fn set_refuses_a_repeated_key_and_names_long_values_briefly() {
     let out = woodpile(dir.path(), &["run", "--set", &long]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
+
+/// A fan-out folder of the point cache (`results/points/ab`) as a symbolic link is refused
+/// too: no point is written, and no stale temporary deleted, outside the tree.
+#[test]
+fn symlinked_point_fan_out_folders_are_refused() {
+    let dir = project();
+    let elsewhere = tempfile::tempdir().unwrap();
+    std::fs::write(elsewhere.path().join(".x~h~1~Ab3dEf6hIj9l.tmp"), "mine").unwrap();
+    let points = dir.path().join("results/points");
+    std::fs::create_dir_all(&points).unwrap();
+    for byte in 0..=255u8 {
+        std::os::unix::fs::symlink(elsewhere.path(), points.join(format!("{byte:02x}"))).unwrap();
+    }
+    let out = woodpile(dir.path(), &["run"]);
+    let stderr = text(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("symbolic link"),
+        "{stderr}"
+    );
+    let left = std::fs::read_dir(elsewhere.path())
+        .unwrap()
+        .flatten()
+        .count();
+    assert_eq!(left, 1, "wrote or deleted outside the tree");
+}

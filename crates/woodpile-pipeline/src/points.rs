@@ -228,9 +228,15 @@ impl PointStore {
         Ok(result)
     }
 
-    /// Stores `result` under `key`, atomically.
+    /// Stores `result` under `key`, atomically. A fan-out folder that is a symbolic link is
+    /// refused: the write (and the stale-temporary sweep) would land outside the tree.
     pub fn save(&self, key: &Key, result: &PointResult) -> Result<()> {
-        atomic::write_checksummed(&self.path(key), &encode(key, result))
+        let path = self.path(key);
+        if let Some(folder) = path.parent() {
+            crate::layout::check_tree_folder(folder)
+                .map_err(|reason| crate::error::PipelineError::refused(folder, reason))?;
+        }
+        atomic::write_checksummed(&path, &encode(key, result))
     }
 
     /// Removes leftovers of killed writers from the fan-out directory of `key`.
@@ -240,6 +246,7 @@ impl PointStore {
         };
         entries
             .flatten()
+            .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
             .map(|e| atomic::sweep_stale_temps(&e.path()))
             .sum()
     }

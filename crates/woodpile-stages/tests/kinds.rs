@@ -389,3 +389,21 @@ fn a_design_evaluates_only_designs_of_its_space() {
     let best = std::fs::read_to_string(p.results().join("trap.best.toml")).unwrap();
     assert_eq!(best.matches("[[defect]]").count(), 3, "{best}");
 }
+
+/// A design's site range is bounded before anything lists it (`[0, 4000000000]` and the
+/// extremes of i64 allocated without end, even for `woodpile status`).
+#[test]
+fn a_design_site_range_is_bounded() {
+    for range in [
+        "[0, 4000000000]",
+        "[-9223372036854775808, 9223372036854775807]",
+    ] {
+        let file = design(30, 6, 1e-6, 1e-8, "samples = 4, spreads = [0.05]")
+            .replace("sites = [0, 3]", &format!("sites = {range}"));
+        let e = load_error(&[("trap", &file)]);
+        assert!(
+            e.contains("space.sites") && e.contains("at most 10000 sites"),
+            "{e}"
+        );
+    }
+}

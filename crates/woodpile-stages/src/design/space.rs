@@ -282,6 +282,10 @@ pub(super) fn parse_space(mut f: Fields<'_>) -> Result<Space> {
 
 /// `sites`: `[first, last]`, a list of three or more sites, `{ among = [...] }` or
 /// `{ fixed = [...] }` (paper sites, distinct).
+/// The widest `sites = [first, last]` a design may search: far more sites than any trap, and
+/// few enough to list.
+const MAX_RANGE_SITES: usize = 10_000;
+
 fn parse_sites(f: &mut Fields<'_>) -> Result<Sites> {
     const FORMS: &str =
         "expected [first, last], a list of sites, { among = [...] } or { fixed = [...] }";
@@ -301,7 +305,17 @@ fn parse_sites(f: &mut Fields<'_>) -> Result<Sites> {
     };
     match f.required::<toml::Value>("sites")? {
         toml::Value::Array(items) => match items.as_slice() {
-            [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => Ok(Sites::Range(*a, *b)),
+            [toml::Value::Integer(a), toml::Value::Integer(b)] if a <= b => {
+                // The span is counted in i128: [i64::MIN, i64::MAX] must not overflow, and a
+                // range is listed site by site when a genome is decoded.
+                if i128::from(*b) - i128::from(*a) >= MAX_RANGE_SITES as i128 {
+                    return Err(f.error(
+                        "sites",
+                        format!("a range of at most {MAX_RANGE_SITES} sites"),
+                    ));
+                }
+                Ok(Sites::Range(*a, *b))
+            }
             [_, _] => Err(f.error("sites", "expected [first, last] with first <= last (for two separate sites: { among = [a, b] })")),
             _ => Ok(Sites::Among(integers(f, "sites", &items)?)),
         },
