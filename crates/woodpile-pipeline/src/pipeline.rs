@@ -221,6 +221,16 @@ fn stage_files(dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
         if entry.file_type().is_ok_and(|t| t.is_dir()) {
             stage_files(&path, out)?;
         } else if path.extension().is_some_and(|x| x == "toml") {
+            // A stage file that is a link would bring a file from outside the project in as
+            // stage parameters (and into its messages).
+            if entry.file_type().is_ok_and(|t| t.is_symlink()) {
+                return Err(PipelineError::Syntax {
+                    file: path,
+                    reason: "a symbolic link: stage files must be files of the pipeline folder"
+                        .into(),
+                    source: None,
+                });
+            }
             out.push(path);
         }
     }

@@ -107,8 +107,16 @@ impl Defaults {
     /// The defaults in `dir` (none when it has no defaults file), read and parsed once.
     pub fn load(dir: &Path) -> Result<Defaults> {
         let file = dir.join(Defaults::FILE);
-        if !file.exists() {
+        let Ok(meta) = std::fs::symlink_metadata(&file) else {
             return Ok(Defaults::default());
+        };
+        if meta.file_type().is_symlink() {
+            return Err(PipelineError::Syntax {
+                file,
+                reason: "a symbolic link: the defaults must be a file of the pipeline folder"
+                    .into(),
+                source: None,
+            });
         }
         let text = read_text(&file)?;
         if text.len() > Defaults::MAX_BYTES {

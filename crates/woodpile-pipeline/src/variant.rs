@@ -59,7 +59,8 @@ impl Set {
             })
             .take(MAX_SLUG)
             .collect();
-        if exact && readable == raw && !self.key.contains('-') {
+        // A `-` in the key or value could pass for the separator of two sets.
+        if exact && readable == raw && !self.key.contains('-') && !value.contains('-') {
             return readable;
         }
         let exact_text = format!("{}={}", self.key, self.value);
@@ -226,6 +227,11 @@ mod tests {
         assert_ne!(name("s.m=A"), name("s.m=a"));
         assert_ne!(name("s.at=40"), name("s.at=\"40\""));
         assert_ne!(name("s.at=120.0"), name("s.at=120_0"));
+        let two = variant_name(
+            "s",
+            &[Set::parse("s.x=1").unwrap(), Set::parse("s.y=2").unwrap()],
+        );
+        assert_ne!(name("s.x=1--y-2"), two);
         let long = name(&format!("s.m={}", "x".repeat(5000)));
         assert!(long.len() < 80, "{}", long.len());
         assert_ne!(long, name(&format!("s.m={}", "x".repeat(5001))));

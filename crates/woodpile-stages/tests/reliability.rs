@@ -349,3 +349,19 @@ fn an_oversized_defaults_file_is_refused() {
         "{e}"
     );
 }
+
+/// Stage files and the defaults file must be files of the pipeline folder, not links to files
+/// elsewhere (which would enter the stage's parameters and messages).
+#[test]
+fn linked_stage_files_are_refused() {
+    for name in ["linked.toml", "defaults.toml"] {
+        let p = Project::new(&[("sweep", &single_defect_sweep())]);
+        let outside = tempfile::tempdir().unwrap();
+        std::fs::write(outside.path().join("x.toml"), single_defect_sweep()).unwrap();
+        std::os::unix::fs::symlink(outside.path().join("x.toml"), p.pipeline().join(name)).unwrap();
+        let e = Pipeline::load(&p.pipeline(), KINDS)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(name) && e.contains("a symbolic link"), "{e}");
+    }
+}
