@@ -98,3 +98,14 @@ def test_the_command_is_never_taken_from_a_build_folder(monkeypatch, tmp_path):
             _pipeline.find_woodpile()
     monkeypatch.setenv("WOODPILE_BIN", "/opt/woodpile")
     assert _pipeline.find_woodpile() == "/opt/woodpile"
+
+
+def test_read_refuses_a_table_without_a_seal(small_pipeline):
+    """A parquet file woodpile did not write (no seal) is not read as a stage's table."""
+    import pandas as pd
+
+    p = woodpile.Pipeline(small_pipeline)
+    p.results_dir.mkdir(parents=True, exist_ok=True)
+    pd.DataFrame({"x": [1.0]}).to_parquet(p.table_path("small_sweep"))
+    with pytest.raises(ValueError, match="not a woodpile table"):
+        p.read("small_sweep")

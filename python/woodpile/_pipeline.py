@@ -24,6 +24,9 @@ from . import _core
 
 PathLike = Union[str, "os.PathLike[str]"]
 
+# The largest table read, as the engine bounds it.
+_MAX_TABLE_BYTES = 1 << 30
+
 
 def _packaged_binary() -> Path:
     """Where a wheel puts the ``woodpile`` command: inside the package."""
@@ -135,11 +138,16 @@ class Pipeline:
         path = self.table_path(stage)
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no table for stage `{stage}` (run it first)")
+        if path.stat().st_size > _MAX_TABLE_BYTES:
+            raise ValueError(f"{path}: larger than the {_MAX_TABLE_BYTES} bytes a table may have")
         data = path.read_bytes()
-        if _core.table_integrity(data) == "damaged":
+        state = _core.table_integrity(data)
+        if state == "damaged":
             raise ValueError(
                 f"{path}: damaged: its bytes no longer match the seal in its manifest (run the stage again)"
             )
+        if state != "intact":
+            raise ValueError(f"{path}: not a woodpile table (it has no seal)")
         return path, data
 
     def read(self, stage: str) -> pd.DataFrame:

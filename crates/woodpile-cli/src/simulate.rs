@@ -121,8 +121,19 @@ fn same_file(a: &Path, b: &Path) -> bool {
     use std::os::unix::fs::MetadataExt;
     match (std::fs::metadata(a), std::fs::metadata(b)) {
         (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
-        _ => std::path::absolute(a).ok() == std::path::absolute(b).ok(),
+        _ => resolved(a).is_some() && resolved(a) == resolved(b),
     }
+}
+
+/// Where a file that may not exist yet would be: its folder resolved (`a/../o.parquet` is
+/// `o.parquet`), then its name.
+fn resolved(path: &Path) -> Option<std::path::PathBuf> {
+    let name = path.file_name()?;
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    Some(std::fs::canonicalize(folder).ok()?.join(name))
 }
 
 /// The internal site range of `--sites LO,HI` (paper numbering), or the whole chain.

@@ -311,12 +311,15 @@ fn outputs_that_are_not_plain_new_files_are_refused() {
     let link = dir.join("link.parquet");
     std::os::unix::fs::symlink(&target, &link).unwrap();
     let same = dir.join("both.parquet");
-    let cases: [(&[&Path], &str); 6] = [
+    std::fs::create_dir_all(dir.join("sub")).unwrap();
+    let round_about = dir.join("sub/../both.parquet");
+    let cases: [(&[&Path], &str); 7] = [
         (&[&fifo], "not a regular file"),
         (&[&dir], "not a regular file"),
         (&[&link], "a symbolic link"),
         (&[&scene], "is the scene being read"),
         (&[&same, &same], "name the same file"),
+        (&[&round_about, &same], "name the same file"),
         (&[Path::new("/dev/null")], "not a regular file"),
     ];
     for (paths, needle) in cases {

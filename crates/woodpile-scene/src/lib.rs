@@ -65,15 +65,18 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, path)
 }
 
-/// Why `path` is refused as a kernel file: `/proc` and `/sys` hold files that pass as regular
+/// Why `path` is refused as a kernel file: procfs and sysfs hold files that pass as regular
 /// ones but are the kernel's (`/proc/kmsg`, read as root, blocks for ever; others print the
-/// environment). `None` for any other path.
+/// environment). Known by the file system's type wherever it is mounted (`/host/proc` in a
+/// container), and by the usual paths. `None` for any other file.
 pub fn kernel_file(path: &Path) -> Option<String> {
+    const PROC_SUPER_MAGIC: i64 = 0x9fa0;
+    const SYSFS_MAGIC: i64 = 0x6265_6572;
+    let kernel_fs = rustix::fs::statfs(path)
+        .is_ok_and(|fs| [PROC_SUPER_MAGIC, SYSFS_MAGIC].contains(&(fs.f_type as i64)));
     let real = std::fs::canonicalize(path).ok()?;
-    ["/proc", "/sys"]
-        .iter()
-        .any(|root| real.starts_with(root))
-        .then(|| format!("a kernel file ({}), not an input", real.display()))
+    let kernel_path = ["/proc", "/sys"].iter().any(|root| real.starts_with(root));
+    (kernel_fs || kernel_path).then(|| format!("a kernel file ({}), not an input", real.display()))
 }
 
 /// Reads an input file (scene or stage) as text: only a regular file of at most

@@ -87,8 +87,10 @@ impl Vary {
         let text = woodpile_scene::read_input(&path).map_err(|reason| {
             PipelineError::stage(stage, format!("{}: {reason}", path.display()))
         })?;
-        let mut scene: toml::Table = toml::from_str(&text)
-            .map_err(|e| PipelineError::stage(stage, format!("{}: {e}", path.display())))?;
+        let mut scene: toml::Table = toml::from_str(&text).map_err(|e| {
+            let reason = woodpile_scene::syntax_reason(&e, &text);
+            PipelineError::stage(stage, format!("{}: {reason}", path.display()))
+        })?;
         for key in &self.unset {
             remove_dotted(&mut scene, key).map_err(|reason| {
                 PipelineError::stage(
@@ -135,7 +137,8 @@ fn with_design(frame: DataFrame, name: &str, index: usize) -> Result<DataFrame> 
         Column::new(DESIGN_INDEX.into(), vec![index as i64; frame.height()]),
     ];
     columns.extend(frame.columns().iter().cloned());
-    DataFrame::new_infer_height(columns).map_err(|e| PipelineError::stage(name, e.to_string()))
+    DataFrame::new_infer_height(columns)
+        .map_err(|e| PipelineError::stage(name, format!("its design column: {e}")))
 }
 
 impl Kind for Vary {
@@ -167,6 +170,14 @@ impl Kind for Vary {
             let asked = first.method == MethodChoice::Auto || first.accuracy.tolerance_explicit;
             tolerance = tolerance.or(asked.then_some(first.accuracy.tolerance));
             let (frame, part) = sweep.run_points(at, &all)?;
+            if let Some(first) = &stacked {
+                if first.width() != frame.width() + 2 {
+                    return Err(PipelineError::stage(
+                        ctx.name(),
+                        format!("`{design}`'s varied scenes have other columns than the first input's (a striker in one and not the other?): vary inputs whose scenes have the same sections"),
+                    ));
+                }
+            }
             let frame = with_design(frame, design, index)?;
             stats = stats.merge(part);
             stacked = Some(match stacked {
