@@ -75,9 +75,15 @@ pub const MAX_SWEEP_BYTES: f64 = 4e9;
 pub fn check_sweep_memory(points: usize, scene: &crate::Scene) -> Result<(), String> {
     let s = &scene.scenario;
     let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1;
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    // The workers a run starts: RAYON_NUM_THREADS where set, else one per core.
+    let threads = crate::threads::asked_threads()
+        .ok()
+        .flatten()
+        .filter(|&n| n > 0)
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let in_flight = (threads.min(points) * s.model.n_sites()) as f64 * 200.0;
-    let bytes = points as f64 * (1400.0 + (samples * 5 * 8 * 2) as f64) + in_flight;
+    let columns = 5 + usize::from(s.region.has_striker());
+    let bytes = points as f64 * (1400.0 + (samples * columns * 8 * 2) as f64) + in_flight;
     if bytes > MAX_SWEEP_BYTES {
         return Err(format!(
             "{points} points of {samples} samples on {} sites would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
