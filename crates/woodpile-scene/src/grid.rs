@@ -67,7 +67,7 @@ pub const MAX_SWEEP_BYTES: f64 = 4e9;
 
 /// Refuses, before anything runs, a sweep of `points` scenes like `scene` (its largest) that
 /// would hold more than [`MAX_SWEEP_BYTES`]. What a sweep holds: for every point, its cache key
-/// and outcome (about 1.4 KB, whatever the chain) and its series (five numbers a sample, in the
+/// and outcome (about 1.4 KB, whatever the chain) and its series (five numbers a sample, six with a striker, in the
 /// point and again in the output table); and, while it runs, one scene and its state per
 /// worker thread (about 200 bytes a site). A point's scene and final state are not kept: a
 /// sweep of a long chain would otherwise hold a chain's worth of floats per point. The error is
@@ -82,7 +82,7 @@ pub fn check_sweep_memory(points: usize, scene: &crate::Scene) -> Result<(), Str
         .filter(|&n| n > 0)
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let in_flight = (threads.min(points) * s.model.n_sites()) as f64 * 200.0;
-    let columns = 5 + usize::from(s.region.has_striker());
+    let columns = 5 + u64::from(s.region.has_striker());
     let bytes = points as f64 * (1400.0 + (samples * columns * 8 * 2) as f64) + in_flight;
     if bytes > MAX_SWEEP_BYTES {
         return Err(format!(
