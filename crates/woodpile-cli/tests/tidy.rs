@@ -194,7 +194,6 @@ const MAX_FUNCTION_LINES: usize = 80;
 const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-stages", "optimize.rs:run", 213),
     ("woodpile-stages", "report/measure.rs:measure", 173),
-    ("woodpile-pipeline", "diff.rs:compare_files", 177),
     ("woodpile-stages", "stability.rs:run", 138),
     ("woodpile-plot", "draw.rs:lines_panel", 137),
     ("woodpile-plot", "heat.rs:panel", 130),

@@ -194,6 +194,8 @@ fn parquet_files(root: &Path) -> Result<BTreeMap<String, PathBuf>> {
     Ok(out)
 }
 
+/// Compares the tables `a` and `b` (named `name` in the report): their integrity and
+/// manifests, their parameters, their columns, then every shared column value by value.
 fn compare_files(
     name: &str,
     a: &Path,
@@ -226,143 +228,180 @@ fn compare_files(
             report.parameters.push(format!("{name}: {change}"));
         }
     }
-    let (fa, fb) = (ca.frame, cb.frame);
-    report.files += 1;
-    for column in fa.columns() {
-        report.columns.insert(column.name().to_string());
-    }
-    for column in fb.columns() {
-        report.columns.insert(column.name().to_string());
-    }
-    let names = |f: &DataFrame| {
-        f.get_column_names()
-            .iter()
-            .map(|n| n.to_string())
-            .collect::<Vec<_>>()
+    let pair = Pair {
+        name,
+        a: (&ca.frame, a),
+        b: (&cb.frame, b),
     };
-    let (ca, cb) = (names(&fa), names(&fb));
-    for c in ca.iter().filter(|c| !cb.contains(c)) {
-        report
-            .problems
-            .push(format!("{name}: column `{c}` only in {}", a.display()));
-    }
-    for c in cb.iter().filter(|c| !ca.contains(c)) {
-        report
-            .problems
-            .push(format!("{name}: column `{c}` only in {}", b.display()));
-    }
-    if fa.height() != fb.height() {
-        report.problems.push(format!(
-            "{name}: {} rows against {}",
-            fa.height(),
-            fb.height()
-        ));
+    report.files += 1;
+    let Some(shared) = pair.shared_columns(report) else {
         return Ok(());
-    }
-    for column in ca.iter().filter(|c| cb.contains(c)) {
+    };
+    for column in shared {
         let key = KEY_COLUMNS.contains(&column.as_str()) && !options.compare_keys;
-        if key || options.ignore.contains(column) {
-            report.skipped.insert(column.clone());
+        if key || options.ignore.contains(&column) {
+            report.skipped.insert(column);
             continue;
         }
+        pair.compare_column(&column, options, report)?;
+    }
+    Ok(())
+}
+
+/// Two tables being compared, each with the path it came from.
+struct Pair<'a> {
+    name: &'a str,
+    a: (&'a DataFrame, &'a Path),
+    b: (&'a DataFrame, &'a Path),
+}
+
+impl Pair<'_> {
+    /// The columns both tables have, after reporting those only one has; `None` when their
+    /// heights differ (reported too), so that no row is compared with another's.
+    fn shared_columns(&self, report: &mut DiffReport) -> Option<Vec<String>> {
+        let names = |f: &DataFrame| {
+            f.get_column_names()
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+        };
+        let (ca, cb) = (names(self.a.0), names(self.b.0));
+        report.columns.extend(ca.iter().chain(&cb).cloned());
+        for (mine, theirs, path) in [(&ca, &cb, self.a.1), (&cb, &ca, self.b.1)] {
+            for c in mine.iter().filter(|c| !theirs.contains(c)) {
+                report.problems.push(format!(
+                    "{}: column `{c}` only in {}",
+                    self.name,
+                    path.display()
+                ));
+            }
+        }
+        if self.a.0.height() != self.b.0.height() {
+            report.problems.push(format!(
+                "{}: {} rows against {}",
+                self.name,
+                self.a.0.height(),
+                self.b.0.height()
+            ));
+            return None;
+        }
+        Some(ca.into_iter().filter(|c| cb.contains(c)).collect())
+    }
+
+    /// One shared column: its type in both, then its values (numbers within the column's
+    /// tolerance, text exactly); the worst difference goes into the report.
+    fn compare_column(
+        &self,
+        column: &str,
+        options: &DiffOptions,
+        report: &mut DiffReport,
+    ) -> Result<()> {
+        let (fa, fb) = (self.a.0, self.b.0);
         let dtype = |f: &DataFrame| f.column(column).map(|c| c.dtype().clone()).ok();
-        let (ta, tb) = (dtype(&fa), dtype(&fb));
+        let (ta, tb) = (dtype(fa), dtype(fb));
         if ta != tb {
             let show =
                 |t: Option<polars::prelude::DataType>| t.map_or("?".into(), |t| t.to_string());
             report.problems.push(format!(
-                "{name}: column `{column}` is {} in {} but {} in {}",
+                "{}: column `{column}` is {} in {} but {} in {}",
+                self.name,
                 show(ta),
-                a.display(),
+                self.a.1.display(),
                 show(tb),
-                b.display()
+                self.b.1.display()
             ));
         }
-        let tol = options
-            .columns
-            .get(column)
-            .copied()
-            .unwrap_or(options.default);
         let numeric = |f: &DataFrame| {
             f.column(column)
                 .map(|c| c.dtype().is_primitive_numeric())
                 .unwrap_or(false)
         };
-        let mut worst: Option<Difference> = None;
-        let mut consider = |d: Difference, report: &mut DiffReport| {
-            if d.excess > 1.0 {
-                report.beyond += 1;
-            }
-            let larger =
-                |w: &Difference| (d.excess > 1.0, d.abs, d.rel) > (w.excess > 1.0, w.abs, w.rel);
-            if worst.as_ref().is_none_or(larger) {
-                worst = Some(d);
-            }
-        };
-        if numeric(&fa) && numeric(&fb) {
-            let (va, vb) = (f64_column(&fa, column)?, f64_column(&fb, column)?);
+        let mut worst = Worst::default();
+        if numeric(fa) && numeric(fb) {
+            let tol = options
+                .columns
+                .get(column)
+                .copied()
+                .unwrap_or(options.default);
+            let (va, vb) = (f64_column(fa, column)?, f64_column(fb, column)?);
             for (row, (x, y)) in va.iter().zip(&vb).enumerate() {
-                report.values += 1;
-                if let Some(d) = compare_numbers(*x, *y, tol) {
-                    consider(
-                        Difference {
-                            file: name.into(),
-                            column: column.clone(),
-                            row,
-                            ..d
-                        },
-                        report,
-                    );
-                }
+                worst.consider(row, compare_numbers(*x, *y, tol), report);
             }
         } else {
             if options.columns.contains_key(column) {
                 return Err(PipelineError::io(
-                    name,
+                    self.name,
                     format!("column `{column}` holds text, which compares exactly: drop its --tol (or --ignore it)"),
                 ));
             }
-            let as_text = |f: &DataFrame| -> Result<Vec<Option<String>>> {
-                let c = f.column(column).map_err(|e| PipelineError::io(name, e))?;
-                if matches!(c.dtype(), polars::prelude::DataType::List(_)) {
-                    // A list compares as its values' text, row by row.
-                    return Ok((0..c.len())
-                        .map(|i| c.get(i).ok().map(|v| v.to_string()))
-                        .collect());
-                }
-                let c = c
-                    .cast(&polars::prelude::DataType::String)
-                    .map_err(|e| PipelineError::io(name, e))?;
-                str_column(
-                    &DataFrame::new_infer_height(vec![c])
-                        .map_err(|e| PipelineError::io(name, e))?,
-                    column,
-                )
-            };
-            let (va, vb) = (as_text(&fa)?, as_text(&fb)?);
+            let (va, vb) = (self.text(fa, column)?, self.text(fb, column)?);
             for (row, (x, y)) in va.iter().zip(&vb).enumerate() {
-                report.values += 1;
-                if x != y {
-                    let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "null".into());
-                    consider(
-                        Difference {
-                            file: name.into(),
-                            column: column.clone(),
-                            row,
-                            a: show(x),
-                            b: show(y),
-                            abs: f64::INFINITY,
-                            rel: f64::INFINITY,
-                            excess: f64::INFINITY,
-                        },
-                        report,
-                    );
-                }
+                worst.consider(row, compare_text(x, y), report);
             }
         }
-        report.worst.extend(worst);
+        report.worst.extend(worst.0.map(|d| Difference {
+            file: self.name.into(),
+            column: column.to_string(),
+            ..d
+        }));
+        Ok(())
     }
-    Ok(())
+
+    /// A column of `f` as text, row by row (a list as its values' text).
+    fn text(&self, f: &DataFrame, column: &str) -> Result<Vec<Option<String>>> {
+        let c = f
+            .column(column)
+            .map_err(|e| PipelineError::io(self.name, e))?;
+        if matches!(c.dtype(), polars::prelude::DataType::List(_)) {
+            return Ok((0..c.len())
+                .map(|i| c.get(i).ok().map(|v| v.to_string()))
+                .collect());
+        }
+        let c = c
+            .cast(&polars::prelude::DataType::String)
+            .map_err(|e| PipelineError::io(self.name, e))?;
+        str_column(
+            &DataFrame::new_infer_height(vec![c]).map_err(|e| PipelineError::io(self.name, e))?,
+            column,
+        )
+    }
+}
+
+/// The largest difference of a column so far: beyond tolerance first, then by size.
+#[derive(Default)]
+struct Worst(Option<Difference>);
+
+impl Worst {
+    /// Counts the value at `row` (and, when it differs beyond tolerance, one beyond), and
+    /// keeps its difference if it is the worst yet.
+    fn consider(&mut self, row: usize, d: Option<Difference>, report: &mut DiffReport) {
+        report.values += 1;
+        let Some(d) = d else { return };
+        if d.excess > 1.0 {
+            report.beyond += 1;
+        }
+        let larger =
+            |w: &Difference| (d.excess > 1.0, d.abs, d.rel) > (w.excess > 1.0, w.abs, w.rel);
+        if self.0.as_ref().is_none_or(larger) {
+            self.0 = Some(Difference { row, ..d });
+        }
+    }
+}
+
+/// `None` when equal; otherwise the difference of two texts, infinite (file, column and row
+/// left blank).
+fn compare_text(x: &Option<String>, y: &Option<String>) -> Option<Difference> {
+    let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "null".into());
+    (x != y).then(|| Difference {
+        file: String::new(),
+        column: String::new(),
+        row: 0,
+        a: show(x),
+        b: show(y),
+        abs: f64::INFINITY,
+        rel: f64::INFINITY,
+        excess: f64::INFINITY,
+    })
 }
 
 /// `None` when equal; otherwise the difference (file, column and row left blank).
