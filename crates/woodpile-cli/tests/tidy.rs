@@ -207,7 +207,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-scene", "resolve/defects.rs:physical", 96),
     ("woodpile-cli", "pipeline_cmd.rs:run_command", 94),
     ("woodpile-plot", "draw.rs:figure", 93),
-    ("woodpile-scene", "resolve/mod.rs:resolve", 91),
     ("woodpile-stages", "workprecision.rs:parse", 90),
 ];
 

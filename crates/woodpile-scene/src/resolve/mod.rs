@@ -23,6 +23,7 @@ use woodpile_sim::units::Scales;
 
 use crate::raw;
 use check::{invalid, Invalid};
+use physical::Si;
 
 pub use physical::DEFAULT_RESONATOR_SHARE;
 
@@ -99,38 +100,81 @@ pub struct DerivedDefect {
     pub contact_ratio: Option<f64>,
 }
 
+/// The scene a file describes: its chain and sites (with their defects, segments and
+/// excitation), then its run and fractions, then what an SI scene derived.
 pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     let chain_table = file.chain.as_ref();
     let (first, last) = chain::sites(chain_table)?;
     let si = physical::si(file.physical.as_ref(), file.striker.as_ref())?;
-    let boundary = chain::boundary(chain_table)?;
     let layout = chain::Layout {
         first,
         last,
         striker_sites: usize::from(file.striker.is_some()),
     };
-    let mut sites = chain::Sites::regular(&layout);
-    let (resonators, derived) =
-        defects::resonators(&file.defect, &layout, si.as_ref(), &mut sites)?;
-    chain::segments(&file.segment, &layout, si.as_ref(), &mut sites)?;
-    let (impulse_site, impulse_velocity) = match &file.striker {
-        None => excitation::impulse(file.impulse.as_ref(), &layout, si.as_ref())?,
-        Some(striker) => excitation::striker(
-            striker,
-            file.impulse.is_some(),
-            boundary,
-            si.as_ref(),
-            &mut sites,
-        )?,
+    let built = model(&file, &layout, si.as_ref())?;
+    let settings = run::settings(file.run)?;
+    let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
+    let mut region = Region::new(lo as i64, hi as i64, layout.n_sites())
+        .map_err(|e| invalid("fractions.region", e.to_string()))?;
+    if file.striker.is_some() {
+        region = region
+            .with_striker()
+            .map_err(|e| invalid("fractions.region", e.to_string()))?;
+    }
+    let scenario = Scenario {
+        model: built.model,
+        impulse_site: built.impulse.0,
+        impulse_velocity: built.impulse.1,
+        t_end: settings.t_end,
+        region,
+        method: settings.method,
+        accuracy: settings.accuracy,
+        sample_every: settings.sample_every,
+    };
+    run::within_budget(&scenario, settings.sample_every_given)?;
+    let physical = si.map(|si| physical_values(si, built.derived, built.striker, &scenario));
+    Ok(Scene {
+        scenario,
+        first_site: layout.index_zero(),
+        last_site: last,
+        region_paper,
+        physical,
+    })
+}
+
+/// The chain a file builds, with where and how it is struck.
+struct Built {
+    model: Model,
+    /// The struck site (the striker's, with one) and its velocity.
+    impulse: (usize, f64),
+    /// What each SI defect derived.
+    derived: Vec<DerivedDefect>,
+    /// A striker's mass and contact coefficient, over the regular ones.
+    striker: Option<(f64, f64)>,
+}
+
+/// The model of `file`'s chain: sites, defects, segments, the excitation and the contact law,
+/// each section's keys resolved by its own module.
+fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Result<Built, Invalid> {
+    let chain_table = file.chain.as_ref();
+    let boundary = chain::boundary(chain_table)?;
+    let mut sites = chain::Sites::regular(layout);
+    let (resonators, derived) = defects::resonators(&file.defect, layout, si, &mut sites)?;
+    chain::segments(&file.segment, layout, si, &mut sites)?;
+    let impulse = match &file.striker {
+        None => excitation::impulse(file.impulse.as_ref(), layout, si)?,
+        Some(striker) => {
+            excitation::striker(striker, file.impulse.is_some(), boundary, si, &mut sites)?
+        }
     };
     let law = chain::contact_law(
         chain_table,
         boundary,
         file.striker.is_some(),
-        si.as_ref(),
+        si,
         &mut sites,
     )?;
-    let striker_values = file
+    let striker = file
         .striker
         .as_ref()
         .map(|_| (sites.masses[0], sites.contacts[1]));
@@ -142,51 +186,37 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
             .with_contacts(law)
             .map_err(|e| invalid("chain", e.to_string()))?,
     };
-
-    let settings = run::settings(file.run)?;
-    let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
-    let mut region = Region::new(lo as i64, hi as i64, layout.n_sites())
-        .map_err(|e| invalid("fractions.region", e.to_string()))?;
-    if file.striker.is_some() {
-        region = region
-            .with_striker()
-            .map_err(|e| invalid("fractions.region", e.to_string()))?;
-    }
-    let scenario = Scenario {
+    Ok(Built {
         model,
-        impulse_site,
-        impulse_velocity,
-        t_end: settings.t_end,
-        region,
-        method: settings.method,
-        accuracy: settings.accuracy,
-        sample_every: settings.sample_every,
-    };
-    run::within_budget(&scenario, settings.sample_every_given)?;
-    let physical = si.map(|si| {
-        let mut values = si.derived;
-        if let Some((mass, contact)) = striker_values {
-            values.push(("striker_mass".into(), mass));
-            values.push(("striker_contact".into(), contact));
-        }
-        if let Some(law) = scenario
-            .model
-            .contacts()
-            .filter(|l| l.precompression() > 0.0)
-        {
-            values.push(("precompression".into(), law.precompression()));
-        }
-        Physical {
-            scales: si.scales,
-            defects: derived,
-            derived: values,
-        }
-    });
-    Ok(Scene {
-        scenario,
-        first_site: layout.index_zero(),
-        last_site: last,
-        region_paper,
-        physical,
+        impulse,
+        derived,
+        striker,
     })
+}
+
+/// What an SI scene reports under `physical`: its scales, its defects' derived values, and the
+/// striker's and precompression's in the model's units.
+fn physical_values(
+    si: Si,
+    defects: Vec<DerivedDefect>,
+    striker: Option<(f64, f64)>,
+    scenario: &Scenario,
+) -> Physical {
+    let mut values = si.derived;
+    if let Some((mass, contact)) = striker {
+        values.push(("striker_mass".into(), mass));
+        values.push(("striker_contact".into(), contact));
+    }
+    if let Some(law) = scenario
+        .model
+        .contacts()
+        .filter(|l| l.precompression() > 0.0)
+    {
+        values.push(("precompression".into(), law.precompression()));
+    }
+    Physical {
+        scales: si.scales,
+        defects,
+        derived: values,
+    }
 }
