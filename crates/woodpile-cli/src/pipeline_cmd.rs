@@ -173,6 +173,8 @@ fn requested_shard(args: &RunArgs) -> Result<Option<Shard>, Failure> {
     Ok(shard)
 }
 
+/// `woodpile run`: one shard of a sweep, or the selected stages (and `--set` variants) brought
+/// up to date, then what ran told as JSON, a dry run's plan, or a summary line.
 pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
     let sets = args
         .sets
@@ -183,6 +185,9 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         })
         .collect::<Result<Vec<_>, _>>()?;
     let (pipeline, dirs) = load_with(&args.at, &sets)?;
+    if let Some(shard) = requested_shard(args)? {
+        return run_one_shard(&pipeline, &args.stages[0], shard, &dirs);
+    }
     // With --set, the variants are what runs (with their inputs), besides any stage named.
     let mut targets = args.stages.clone();
     for set in &sets {
@@ -191,23 +196,6 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
             targets.push(name);
         }
     }
-    if let Some(shard) = requested_shard(args)? {
-        let progress = Progress::new();
-        let done = run_shard(&pipeline, &args.stages[0], shard, &dirs.results, &progress)
-            .map_err(stage_failure)?;
-        let what = if done.already_done {
-            "already done"
-        } else {
-            "written"
-        };
-        eprintln!(
-            "shard {shard} of `{}` ({} points): {what}: {}",
-            args.stages[0],
-            done.points,
-            done.part.display()
-        );
-        return Ok(());
-    }
     let options = RunOptions {
         targets,
         force: args.force,
@@ -215,57 +203,75 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         results: dirs.results.clone(),
         figures: dirs.figures.clone(),
     };
-    let progress = Progress::new();
     let started = std::time::Instant::now();
     let before = woodpile_pipeline::points::simulations();
-    let steps = run(&pipeline, &options, &progress).map_err(stage_failure)?;
-    let ran = steps.iter().filter(|s| s.runs).count();
-    let scenes = woodpile_pipeline::points::simulations() - before;
-    let seconds = started.elapsed().as_secs_f64();
+    let steps = run(&pipeline, &options, &Progress::new()).map_err(stage_failure)?;
+    let scenes = match args.dry_run {
+        true => 0,
+        false => woodpile_pipeline::points::simulations() - before,
+    };
+    let report = RunReport {
+        dry_run: args.dry_run,
+        stages: steps.iter().map(StageRun::of).collect(),
+        ran: steps.iter().filter(|s| s.runs).count(),
+        fresh: steps.iter().filter(|s| !s.runs).count(),
+        scenes_simulated: scenes,
+        seconds: started.elapsed().as_secs_f64(),
+    };
     if args.json {
-        let report = RunReport {
-            dry_run: args.dry_run,
-            stages: steps
-                .iter()
-                .map(|s| StageRun {
-                    stage: s.stage.clone(),
-                    runs: s.runs,
-                    why: s.why.clone(),
-                    points: s.points.map(|(n, _)| n),
-                    cached: s.points.map(|(_, c)| c),
-                })
-                .collect(),
-            ran,
-            fresh: steps.len() - ran,
-            scenes_simulated: if args.dry_run { 0 } else { scenes },
-            seconds,
-        };
         say!(
             "{}",
             crate::reports::json_text(&report, false).map_err(Failure::simulation)?
         );
     } else if args.dry_run {
-        for step in &steps {
-            let points = step
-                .points
-                .map(|(n, cached)| {
-                    format!(" [{n} scenes: {cached} cached, {} to simulate]", n - cached)
-                })
-                .unwrap_or_default();
-            if step.runs {
-                say!("would run {}: {}{points}", step.stage, step.why);
-            } else {
-                say!("fresh     {}", step.stage);
-            }
-        }
+        say_plan(&report);
     }
     if !args.dry_run {
         eprintln!(
-            "woodpile run: {ran} stage(s) run, {} fresh, {scenes} scene(s) simulated, {seconds:.1} s",
-            steps.len() - ran,
+            "woodpile run: {} stage(s) run, {} fresh, {} scene(s) simulated, {:.1} s",
+            report.ran, report.fresh, report.scenes_simulated, report.seconds
         );
     }
     Ok(())
+}
+
+/// `run STAGE --shard I/N`: that shard's points into its part file.
+fn run_one_shard(
+    pipeline: &Pipeline,
+    stage: &str,
+    shard: Shard,
+    dirs: &Dirs,
+) -> Result<(), Failure> {
+    let done = run_shard(pipeline, stage, shard, &dirs.results, &Progress::new())
+        .map_err(stage_failure)?;
+    let what = if done.already_done {
+        "already done"
+    } else {
+        "written"
+    };
+    eprintln!(
+        "shard {shard} of `{stage}` ({} points): {what}: {}",
+        done.points,
+        done.part.display()
+    );
+    Ok(())
+}
+
+/// A dry run's plan: what would run and why, with the scenes a grid would simulate.
+fn say_plan(report: &RunReport) {
+    for step in &report.stages {
+        let points = match (step.points, step.cached) {
+            (Some(n), Some(cached)) => {
+                format!(" [{n} scenes: {cached} cached, {} to simulate]", n - cached)
+            }
+            _ => String::new(),
+        };
+        if step.runs {
+            say!("would run {}: {}{points}", step.stage, step.why);
+        } else {
+            say!("fresh     {}", step.stage);
+        }
+    }
 }
 
 pub(crate) fn merge_command(args: &MergeArgs) -> Result<(), Failure> {

@@ -35,6 +35,19 @@ pub(crate) struct StageRun {
     pub cached: Option<usize>,
 }
 
+impl StageRun {
+    /// A stage of a run as it is told.
+    pub fn of(step: &woodpile_pipeline::run::Step) -> StageRun {
+        StageRun {
+            stage: step.stage.clone(),
+            runs: step.runs,
+            why: step.why.clone(),
+            points: step.points.map(|(n, _)| n),
+            cached: step.points.map(|(_, c)| c),
+        }
+    }
+}
+
 /// One row of `status --json`.
 #[derive(Debug, Serialize)]
 pub(crate) struct StageStatus {

@@ -205,7 +205,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-stages", "report/markdown.rs:markdown", 99),
     ("woodpile-pipeline", "shard.rs:merge", 99),
     ("woodpile-scene", "resolve/defects.rs:physical", 96),
-    ("woodpile-cli", "pipeline_cmd.rs:run_command", 94),
     ("woodpile-plot", "draw.rs:figure", 93),
     ("woodpile-stages", "workprecision.rs:parse", 90),
 ];
