@@ -206,7 +206,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-pipeline", "shard.rs:merge", 99),
     ("woodpile-scene", "resolve/defects.rs:physical", 96),
     ("woodpile-plot", "draw.rs:figure", 93),
-    ("woodpile-stages", "workprecision.rs:parse", 90),
 ];
 
 /// Every function of `code` as (name, lines), found by its `fn` line and the closing brace at

@@ -66,6 +66,81 @@ pub struct Setting {
     pub accuracy: Accuracy,
 }
 
+/// The `[[scene]]` tables: each a named scene file's content.
+fn parse_scenes(fields: &mut Fields<'_>) -> Result<Vec<(String, Scene)>> {
+    let file = fields.file().to_path_buf();
+    let Some(toml::Value::Array(scene_tables)) = fields.take("scene") else {
+        return Err(fields.error("scene", "expected one or more [[scene]] tables"));
+    };
+    let mut scenes = Vec::new();
+    for (i, entry) in scene_tables.into_iter().enumerate() {
+        let key = format!("scene[{i}]");
+        let toml::Value::Table(mut table) = entry else {
+            return Err(fields.error(&key, "expected a table"));
+        };
+        let name = match table.remove("name") {
+            Some(toml::Value::String(s)) => s,
+            _ => return Err(fields.error(&format!("{key}.name"), "expected a string")),
+        };
+        let scene = woodpile_scene::from_table(table, &file)
+            .map_err(|e| PipelineError::scene(&file, &key, e, ""))?;
+        scenes.push((name, scene));
+    }
+    Ok(scenes)
+}
+
+/// The `i`th `[[method]]` table: its method, and one setting per step (fixed-step methods) or
+/// tolerance (`auto` and adaptive methods) it lists.
+fn parse_method(fields: &Fields<'_>, i: usize, entry: toml::Value) -> Result<Vec<Setting>> {
+    let key = format!("method[{i}]");
+    let toml::Value::Table(table) = entry else {
+        return Err(fields.error(&key, "expected a table"));
+    };
+    let mut f = fields.nested(&key, table);
+    let name: String = f.required("name")?;
+    let choice = match name.as_str() {
+        "auto" => MethodChoice::Auto,
+        other => MethodChoice::Named(
+            Method::from_name(other)
+                .ok_or_else(|| f.error("name", format!("unknown method `{other}`")))?,
+        ),
+    };
+    let adaptive = match choice {
+        MethodChoice::Auto => true,
+        MethodChoice::Named(m) => m.is_adaptive(),
+    };
+    let values: Vec<f64> = if adaptive {
+        f.required("tolerance")?
+    } else {
+        f.required("dt")?
+    };
+    f.finish()?;
+    if values.is_empty() || values.iter().any(|v| !(*v > 0.0)) {
+        let what = if adaptive { "tolerance" } else { "dt" };
+        return Err(fields.error(&format!("{key}.{what}"), "expected positive numbers"));
+    }
+    Ok(values
+        .into_iter()
+        .map(|v| Setting {
+            method: name.clone(),
+            method_index: i,
+            choice,
+            accuracy: match adaptive {
+                true => Accuracy {
+                    tolerance: v,
+                    tolerance_explicit: true,
+                    dt: None,
+                },
+                false => Accuracy {
+                    tolerance: 1e-8,
+                    tolerance_explicit: false,
+                    dt: Some(v),
+                },
+            },
+        })
+        .collect())
+}
+
 impl WorkPrecision {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<WorkPrecision> {
         let repeats = fields.optional::<i64>("repeats")?.unwrap_or(3);
@@ -78,77 +153,13 @@ impl WorkPrecision {
         if !(reference_tolerance > 0.0) {
             return Err(fields.error("reference_tolerance", "must be > 0"));
         }
-        let file = fields.file().to_path_buf();
-        let Some(toml::Value::Array(scene_tables)) = fields.take("scene") else {
-            return Err(fields.error("scene", "expected one or more [[scene]] tables"));
-        };
-        let mut scenes = Vec::new();
-        for (i, entry) in scene_tables.into_iter().enumerate() {
-            let key = format!("scene[{i}]");
-            let toml::Value::Table(mut table) = entry else {
-                return Err(fields.error(&key, "expected a table"));
-            };
-            let name = match table.remove("name") {
-                Some(toml::Value::String(s)) => s,
-                _ => return Err(fields.error(&format!("{key}.name"), "expected a string")),
-            };
-            let scene = woodpile_scene::from_table(table, &file)
-                .map_err(|e| PipelineError::scene(&file, &key, e, ""))?;
-            scenes.push((name, scene));
-        }
+        let scenes = parse_scenes(fields)?;
         let Some(toml::Value::Array(method_tables)) = fields.take("method") else {
             return Err(fields.error("method", "expected one or more [[method]] tables"));
         };
         let mut settings = Vec::new();
         for (i, entry) in method_tables.into_iter().enumerate() {
-            let key = format!("method[{i}]");
-            let toml::Value::Table(table) = entry else {
-                return Err(fields.error(&key, "expected a table"));
-            };
-            let mut f = fields.nested(&key, table);
-            let name: String = f.required("name")?;
-            let choice = match name.as_str() {
-                "auto" => MethodChoice::Auto,
-                other => MethodChoice::Named(
-                    Method::from_name(other)
-                        .ok_or_else(|| f.error("name", format!("unknown method `{other}`")))?,
-                ),
-            };
-            let adaptive = match choice {
-                MethodChoice::Auto => true,
-                MethodChoice::Named(m) => m.is_adaptive(),
-            };
-            let values: Vec<f64> = if adaptive {
-                f.required("tolerance")?
-            } else {
-                f.required("dt")?
-            };
-            f.finish()?;
-            if values.is_empty() || values.iter().any(|v| !(*v > 0.0)) {
-                let what = if adaptive { "tolerance" } else { "dt" };
-                return Err(fields.error(&format!("{key}.{what}"), "expected positive numbers"));
-            }
-            for v in values {
-                let accuracy = if adaptive {
-                    Accuracy {
-                        tolerance: v,
-                        tolerance_explicit: true,
-                        dt: None,
-                    }
-                } else {
-                    Accuracy {
-                        tolerance: 1e-8,
-                        tolerance_explicit: false,
-                        dt: Some(v),
-                    }
-                };
-                settings.push(Setting {
-                    method: name.clone(),
-                    method_index: i,
-                    choice,
-                    accuracy,
-                });
-            }
+            settings.extend(parse_method(fields, i, entry)?);
         }
         Ok(WorkPrecision {
             repeats: repeats as usize,
