@@ -410,16 +410,20 @@ impl Plan {
             active_window,
         };
         // One dynamic call a step picks the stepper; its loops inside are static.
-        let mut run = |stepper: &mut dyn Stepper| drive(model, stepper, y, &cfg, observer);
+        drive(model, &mut *self.stepper(model), y, &cfg, observer)
+    }
+
+    /// The stepper of the plan's method for `model`: the one place a method becomes code.
+    pub fn stepper(&self, model: &Model) -> Box<dyn Stepper> {
         match self.method {
-            Method::Rk4 => run(&mut Rk4Fused::new(model)),
-            Method::Rk4Contact => run(&mut Rk4Fused::with_contact_events(model)),
-            Method::Rkn4Contact => run(&mut Rkn4::with_contact_events(model)),
-            Method::Rkn6Contact => run(&mut Rkn::new(model, DPRKN6, ContactMode::Corrected)),
-            Method::Verlet => run(&mut SymplecticStepper::new(model, VERLET)),
-            Method::Yoshida4 => run(&mut SymplecticStepper::new(model, YOSHIDA4)),
-            Method::Yoshida6 => run(&mut SymplecticStepper::new(model, YOSHIDA6)),
-            Method::Dop853 => run(&mut Dop853::new(model, self.rtol, self.atol)),
+            Method::Rk4 => Box::new(Rk4Fused::new(model)),
+            Method::Rk4Contact => Box::new(Rk4Fused::with_contact_events(model)),
+            Method::Rkn4Contact => Box::new(Rkn4::with_contact_events(model)),
+            Method::Rkn6Contact => Box::new(Rkn::new(model, DPRKN6, ContactMode::Corrected)),
+            Method::Verlet => Box::new(SymplecticStepper::new(model, VERLET)),
+            Method::Yoshida4 => Box::new(SymplecticStepper::new(model, YOSHIDA4)),
+            Method::Yoshida6 => Box::new(SymplecticStepper::new(model, YOSHIDA6)),
+            Method::Dop853 => Box::new(Dop853::new(model, self.rtol, self.atol)),
         }
     }
 }
@@ -428,6 +432,8 @@ impl Plan {
 mod tests {
     use super::*;
 
+    /// Every method's row of facts, its name in scene files, and the stepper a plan builds for
+    /// it, which reports the same name: one table of names, checked for all eight.
     #[test]
     fn every_method_has_its_own_row_of_facts() {
         let names = [
@@ -437,9 +443,20 @@ mod tests {
             "rkn6-contact",
             "verlet",
             "yoshida4",
+            "yoshida6",
+            "dop853",
         ];
+        assert_eq!(Method::ALL.len(), names.len());
+        let model = Model::new(21, crate::Boundary::Fixed, Vec::new()).unwrap();
         for (method, name) in Method::ALL.into_iter().zip(names) {
             assert_eq!(method.name(), name);
+            let accuracy = Accuracy {
+                tolerance: 1e-6,
+                tolerance_explicit: true,
+                dt: (!method.is_adaptive()).then_some(0.1),
+            };
+            let plan = Plan::choose(&model, MethodChoice::Named(method), accuracy).unwrap();
+            assert_eq!(plan.stepper(&model).name(), name, "{method:?}'s stepper");
         }
         for method in Method::ALL {
             assert_eq!(Method::from_name(method.name()), Some(method));
