@@ -119,8 +119,49 @@ impl SpaceTime {
         })
     }
 
+    /// Simulates the stage's scenes and keeps each one's field on the stage's sites.
     pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
-        let (scenes, axes): (Vec<(Vec<AxisValue>, Scene)>, &[Axis]) = match &self.source {
+        let (scenes, axes) = self.scenes(stage, results)?;
+        // The accuracy asked for (a scene's tolerance, or its fixed step's) and the largest
+        // error estimate `auto` reported, for the manifest.
+        let tolerance = scenes.first().and_then(|(_, scene)| {
+            let s = &scene.scenario;
+            let asked = s.method == MethodChoice::Auto || s.accuracy.tolerance_explicit;
+            asked.then_some(s.accuracy.tolerance)
+        });
+        let fields: Vec<SimulatedField> = scenes
+            .into_par_iter()
+            .enumerate()
+            .map(|(i, (values, scene))| {
+                let model = &scene.scenario.model;
+                let mut field = SpaceTimeField::new(model, 1, 1);
+                woodpile_pipeline::points::count_simulation();
+                let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
+                    PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
+                })?;
+                Ok((values, field, scene.first_site, outcome.error_estimate))
+            })
+            .collect::<Result<_>>()?;
+        let max_error_estimate = fields
+            .iter()
+            .filter_map(|f| f.3)
+            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+        let (columns, points) = self.columns(&fields, axes);
+        Ok(Output::table(
+            columns.into_frame()?,
+            json!({
+                "points": points,
+                "sites": self.sites,
+                "tolerance": tolerance,
+                "max_error_estimate": max_error_estimate,
+            }),
+        ))
+    }
+
+    /// The scenes to map, each with its axis values, and the axes: the grid's, or a design
+    /// stage's best scene (whose field is bounded only now that it is known).
+    fn scenes(&self, stage: &str, results: &Path) -> Result<(Vec<Mapped>, &[Axis])> {
+        Ok(match &self.source {
             Source::Grid(sweep) => (
                 (0..sweep.count())
                     .map(|i| Ok((sweep.values(i), sweep.scene_at(i)?)))
@@ -146,31 +187,12 @@ impl SpaceTime {
                 })?;
                 (vec![(Vec::new(), scene)], &[])
             }
-        };
-        // The accuracy asked for (a scene's tolerance, or its fixed step's) and the largest
-        // error estimate `auto` reported, for the manifest.
-        let tolerance = scenes.first().and_then(|(_, scene)| {
-            let s = &scene.scenario;
-            let asked = s.method == MethodChoice::Auto || s.accuracy.tolerance_explicit;
-            asked.then_some(s.accuracy.tolerance)
-        });
-        let fields: Vec<(Vec<AxisValue>, SpaceTimeField, i64, Option<f64>)> = scenes
-            .into_par_iter()
-            .enumerate()
-            .map(|(i, (values, scene))| {
-                let model = &scene.scenario.model;
-                let mut field = SpaceTimeField::new(model, 1, 1);
-                woodpile_pipeline::points::count_simulation();
-                let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
-                    PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
-                })?;
-                Ok((values, field, scene.first_site, outcome.error_estimate))
-            })
-            .collect::<Result<_>>()?;
-        let max_error_estimate = fields
-            .iter()
-            .filter_map(|f| f.3)
-            .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
+        })
+    }
+
+    /// The table's columns from the simulated `fields` (each with its axis values and first
+    /// paper site), kept on the stage's sites, and how many points there were.
+    fn columns(&self, fields: &[SimulatedField], axes: &[Axis]) -> (Columns, usize) {
         let mut point = Vec::new();
         let points = fields.len();
         let mut axis_values: Vec<Vec<AxisValue>> = vec![Vec::new(); axes.len()];
@@ -212,17 +234,16 @@ impl SpaceTime {
             .f64("t", t)
             .i64("site", site)
             .f64("velocity", velocity);
-        Ok(Output::table(
-            columns.into_frame()?,
-            json!({
-                "points": points,
-                "sites": self.sites,
-                "tolerance": tolerance,
-                "max_error_estimate": max_error_estimate,
-            }),
-        ))
+        (columns, points)
     }
 }
+
+/// A scene to map, with its axis values.
+type Mapped = (Vec<AxisValue>, Scene);
+
+/// One simulated scene's field: its axis values, the field, its first paper site and `auto`'s
+/// error estimate.
+type SimulatedField = (Vec<AxisValue>, SpaceTimeField, i64, Option<f64>);
 
 /// `field.sites = [lo, hi]`, if given.
 fn field_sites(f: &mut Fields<'_>) -> Result<Option<[i64; 2]>> {
