@@ -3,7 +3,11 @@
 //! rest, the long-wave speed and the dimer's band edges of a precompressed chain, and a heavy
 //! striker's train of solitary waves.
 
+mod common;
+
 use std::path::Path;
+
+use common::invalid_key;
 
 use woodpile_scene::Scene;
 use woodpile_sim::energy::{total_energy, total_momentum};
@@ -318,10 +322,6 @@ sample_every = 0.05
 /// Each refusal names its key: the scene format's contract for the chain's new keys.
 #[test]
 fn bad_chains_are_refused_naming_the_key() {
-    let key_of = |text: &str| match woodpile_scene::parse(text, Path::new("s.toml")) {
-        Err(woodpile_scene::SceneError::Invalid { key, .. }) => key,
-        other => panic!("expected an invalid key for {text:?}, got {other:?}"),
-    };
     let striker = "[striker]\nmass = 2.0\n";
     let free_left = "[chain]\nboundary = { left = \"free\", right = \"fixed\" }\n";
     let cases = [
@@ -365,7 +365,7 @@ fn bad_chains_are_refused_naming_the_key() {
         ),
     ];
     for (text, key) in cases {
-        assert_eq!(key_of(text), key, "for {text:?}");
+        assert_eq!(invalid_key(text), key, "for {text:?}");
     }
 }
 

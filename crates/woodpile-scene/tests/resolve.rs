@@ -2,16 +2,13 @@
 //! units, and the errors that name the key (endless runs, impossible tolerances, defects).
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
+use common::invalid_key;
+
 use std::path::Path;
 
 use woodpile_scene::{parse, SceneError};
-
-fn invalid_key(text: &str) -> String {
-    match parse(text, Path::new("s.toml")) {
-        Err(SceneError::Invalid { key, .. }) => key,
-        other => panic!("expected an invalid key, got {other:?}"),
-    }
-}
 
 /// The paper's defaults and numbering: site n is index n + N.
 #[test]
