@@ -1,8 +1,9 @@
 //! Opening only regular files: what woodpile reads from a results tree (tables, point files,
 //! shard parts) or writes in place (the lock) must be a regular file, never a symbolic link,
 //! a FIFO (which would block a reader forever), a device (`/dev/zero` reads without end) or a
-//! directory. Files are opened without following a final symbolic link and checked with
-//! `fstat` on the open descriptor, so nothing can be swapped in between the check and the use.
+//! directory, nor a kernel file (procfs, sysfs). Files are opened without following a final
+//! symbolic link and checked with `fstat` and `fstatfs` on the open descriptor, so nothing
+//! can be swapped in between the check and the use.
 
 use std::fs::{File, OpenOptions};
 use std::io::{Error, Read};
@@ -13,7 +14,7 @@ pub fn refusal(path: &Path) -> Option<String> {
     let meta = std::fs::symlink_metadata(path).ok()?;
     let kind = meta.file_type();
     if kind.is_file() {
-        woodpile_scene::kernel_file(path)
+        None
     } else if kind.is_symlink() {
         Some("a symbolic link, which woodpile does not follow in a results tree".into())
     } else if kind.is_dir() {
@@ -43,6 +44,10 @@ pub fn open(path: &Path, options: &mut OpenOptions) -> Result<File, Error> {
         .map_err(|e| refusal(path).map_or(e, Error::other))?;
     if !file.metadata()?.is_file() {
         return Err(Error::other("not a regular file"));
+    }
+    // procfs and sysfs files pass as regular ones (`/proc/kmsg` blocks a root reader).
+    if woodpile_scene::on_kernel_fs(&file) {
+        return Err(Error::other("a kernel file (procfs or sysfs), not a table"));
     }
     Ok(file)
 }
@@ -81,6 +86,8 @@ mod tests {
         let message = |p: &Path, limit| read(p, limit).unwrap_err().to_string();
         assert!(message(&file, 3).contains("more than the 3"));
         assert!(message(dir.path(), 10).contains("directory"));
+        // A kernel file passes as a regular one, and is refused by its file system.
+        assert!(message(Path::new("/proc/self/status"), 1 << 20).contains("kernel file"));
         #[cfg(unix)]
         {
             let link = dir.path().join("link.parquet");

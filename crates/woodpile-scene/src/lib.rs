@@ -70,15 +70,24 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 /// environment). Known by the file system's type wherever it is mounted (`/host/proc` in a
 /// container), and by the usual paths. `None` for any other file.
 pub fn kernel_file(path: &Path) -> Option<String> {
+    let kernel_fs = rustix::fs::statfs(path).is_ok_and(|fs| is_kernel_fs(&fs));
+    let real = std::fs::canonicalize(path).ok()?;
+    let kernel_path = ["/proc", "/sys"].iter().any(|root| real.starts_with(root));
+    (kernel_fs || kernel_path).then(|| format!("a kernel file ({}), not an input", real.display()))
+}
+
+/// Whether the open `file` lies on procfs or sysfs: [`kernel_file`]'s test by file system, one
+/// system call on a descriptor already open, for readers of many files (the point cache).
+pub fn on_kernel_fs(file: &std::fs::File) -> bool {
+    rustix::fs::fstatfs(file).is_ok_and(|fs| is_kernel_fs(&fs))
+}
+
+fn is_kernel_fs(fs: &rustix::fs::StatFs) -> bool {
     const PROC_SUPER_MAGIC: u64 = 0x9fa0;
     const SYSFS_MAGIC: u64 = 0x6265_6572;
     // `f_type`'s integer type differs between platforms: compare its bits.
     #[allow(clippy::unnecessary_cast)]
-    let kernel_fs = rustix::fs::statfs(path)
-        .is_ok_and(|fs| [PROC_SUPER_MAGIC, SYSFS_MAGIC].contains(&(fs.f_type as u64)));
-    let real = std::fs::canonicalize(path).ok()?;
-    let kernel_path = ["/proc", "/sys"].iter().any(|root| real.starts_with(root));
-    (kernel_fs || kernel_path).then(|| format!("a kernel file ({}), not an input", real.display()))
+    [PROC_SUPER_MAGIC, SYSFS_MAGIC].contains(&(fs.f_type as u64))
 }
 
 /// Reads an input file (scene or stage) as text: only a regular file of at most
