@@ -239,8 +239,9 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
     Ok(())
 }
 
-/// `overrides` laid over `base`: tables merge key by key, other values replace.
-fn merge(base: &mut toml::Table, overrides: toml::Table) {
+/// `overrides` laid over `base`: tables merge key by key, other values replace. How a scene
+/// file's overrides, a kind's defaults and a `vary` stage's `[set]` all combine with a table.
+pub fn merge(base: &mut toml::Table, overrides: toml::Table) {
     for (key, value) in overrides {
         match (base.get_mut(&key), value) {
             (Some(toml::Value::Table(inner)), toml::Value::Table(over)) => merge(inner, over),

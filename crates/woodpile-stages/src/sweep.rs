@@ -74,15 +74,12 @@ impl Sweep {
             Some(Series::Energy),
         )?;
         let scene: toml::Table = fields.required("scene")?;
-        let sweep = Sweep::over(axes, series, scene, fields.file())?;
-        let last = sweep.scene_at(sweep.count() - 1)?;
-        woodpile_scene::grid::check_sweep_memory(sweep.count(), &last)
-            .map_err(|reason| fields.error("axes", reason))?;
-        Ok(sweep)
+        Sweep::over(axes, series, scene, fields.file())
     }
 
     /// The sweep of `scene` (a scene table with "$axis" placeholders, from `file`) over
-    /// `axes`, checked at the corners of the grid.
+    /// `axes`, checked at the corners of the grid and for the memory its points will hold
+    /// (its last point's scene is the largest).
     pub fn over(
         axes: Vec<Axis>,
         series: Series,
@@ -107,7 +104,15 @@ impl Sweep {
         // the grid exercise the extremes of every axis. A placeholder cannot add or remove a
         // table, so the first scene says whether every scene has a striker.
         let with_striker = sweep.scene_at(0)?.scenario.region.has_striker();
-        sweep.scene_at(sweep.count() - 1)?;
+        let last = sweep.scene_at(sweep.count() - 1)?;
+        woodpile_scene::grid::check_sweep_memory(sweep.count(), &last).map_err(|reason| {
+            PipelineError::Definition {
+                file: file.to_path_buf(),
+                key: "axes".into(),
+                reason,
+                source: None,
+            }
+        })?;
         Ok(Sweep {
             with_striker,
             ..sweep

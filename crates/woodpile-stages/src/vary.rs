@@ -99,22 +99,10 @@ impl Vary {
                 )
             })?;
         }
-        overlay(&mut scene, &self.set);
+        woodpile_pipeline::stage::merge(&mut scene, self.set.clone());
         Sweep::over(self.axes.clone(), Series::Energy, scene, &self.file).map_err(|e| {
             PipelineError::stage(stage, format!("`{design}`'s best scene, varied: {e}"))
         })
-    }
-}
-
-/// Lays `set` over `base`: tables that both have merge key by key, anything else replaces.
-fn overlay(base: &mut toml::Table, set: &toml::Table) {
-    for (key, value) in set {
-        match (base.get_mut(key), value) {
-            (Some(toml::Value::Table(inner)), toml::Value::Table(over)) => overlay(inner, over),
-            _ => {
-                base.insert(key.clone(), value.clone());
-            }
-        }
     }
 }
 
@@ -217,9 +205,9 @@ mod tests {
     fn set_merges_tables_and_replaces_everything_else() {
         let mut base =
             table("chain = { n = 100, boundary = \"fixed\" }\n[[defect]]\nsite = 0\neps = 1.0\n");
-        overlay(
+        woodpile_pipeline::stage::merge(
             &mut base,
-            &table("chain = { precompression = 0.5 }\n[[defect]]\nsite = 3\neps = 2.0\n"),
+            table("chain = { precompression = 0.5 }\n[[defect]]\nsite = 3\neps = 2.0\n"),
         );
         assert_eq!(
             base,
