@@ -20,7 +20,7 @@ use crate::{SceneError, SimulationError};
 /// --
 ///
 /// The native call behind `woodpile.simulate`: a dict with `report` (the CLI's JSON text),
-/// `series` (t, R, T, E_tr, E arrays, and S with a striker) and, when a field is asked for, `t`, `sites`,
+/// `series` (t, R, T, E_tr, E arrays, S with a striker, D with damping) and, when a field is asked for, `t`, `sites`,
 /// `velocity` and `displacement`.
 #[pyfunction]
 #[pyo3(signature = (scene, fields = false, field_sites = None))]
@@ -79,6 +79,9 @@ pub(crate) fn simulate<'py>(
     columns.set_item("E_tr", series.trapped.into_pyarray(py))?;
     if scene.scenario.region.has_striker() {
         columns.set_item("S", series.striker.into_pyarray(py))?;
+    }
+    if scene.scenario.model.is_dissipative() {
+        columns.set_item("D", series.dissipated.into_pyarray(py))?;
     }
     columns.set_item("E", series.energy.into_pyarray(py))?;
     out.set_item("series", columns)?;

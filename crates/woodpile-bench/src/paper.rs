@@ -183,6 +183,7 @@ fn numba_side(
             transmitted: get("T"),
             trapped: get("E_tr"),
             striker: 0.0,
+            dissipated: 0.0,
             total: reference.total,
         };
         worst = worst.max(numba.largest_difference(reference));

@@ -26,7 +26,8 @@ pub(crate) struct Args {
     #[arg(long)]
     pretty: bool,
     /// Also write R, T, E_tr and E at every `run.sample_every` to this parquet file
-    /// (columns t, R, T, E_tr, E; and S, the striker's share, with a `[striker]`).
+    /// (columns t, R, T, E_tr, E; S, the striker's share, with a `[striker]`; D, the dissipated
+    /// share, with damping).
     #[arg(long, value_name = "OUT.parquet")]
     series: Option<PathBuf>,
     /// Also write every site's displacement and velocity at every sample to this parquet file
@@ -196,6 +197,9 @@ fn write_series(
         .f64("E_tr", some(&series.trapped));
     if scene.scenario.region.has_striker() {
         columns.f64("S", some(&series.striker));
+    }
+    if scene.scenario.model.is_dissipative() {
+        columns.f64("D", some(&series.dissipated));
     }
     columns.f64("E", some(&series.energy));
     let frame = columns.into_frame().map_err(Failure::simulation)?;

@@ -199,8 +199,9 @@ pub fn scene_json(scene: &Scene) -> Value {
         MethodChoice::Named(m) => m.name(),
     };
     let end = |end: End| match end {
-        End::Fixed => "fixed",
-        End::Free => "free",
+        End::Fixed => json!("fixed"),
+        End::Free => json!("free"),
+        End::Soft { spring, damping } => json!({"spring": spring, "damping": damping}),
     };
     let boundary = match model.boundary() {
         Boundary::Fixed => json!("fixed"),
@@ -233,6 +234,14 @@ pub fn scene_json(scene: &Scene) -> Value {
     }
     if s.region.has_striker() {
         canonical["striker"] = json!(true);
+    }
+    if let Some(d) = model.damping() {
+        canonical["damping"] = json!({
+            "contact": d.contact,
+            "law": d.law.name(),
+            "ground": d.ground,
+            "resonators": d.resonator,
+        });
     }
     canonical
 }

@@ -17,6 +17,19 @@ pub(crate) struct SceneFile {
     #[serde(default)]
     pub segment: Vec<Segment>,
     pub striker: Option<Striker>,
+    pub damping: Option<DampingTable>,
+}
+
+/// `[damping]`: contact dashpots and ground damping.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct DampingTable {
+    /// γ of every contact.
+    pub contact: Option<f64>,
+    /// `"linear"` or `"hertzian"`.
+    pub law: Option<String>,
+    /// g, on every site.
+    pub ground: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -118,6 +131,10 @@ pub(crate) struct Defect {
     pub rod: Option<DefectRod>,
     /// Physical scenes with `rod`: the share of the rod's mass carried by the resonator.
     pub resonator_share: Option<f64>,
+    /// The resonator's dashpot c_j (N·s/m in SI scenes).
+    pub damping: Option<f64>,
+    /// The resonator's quality factor Q, instead of `damping`: c_j = μ ω / Q.
+    pub quality_factor: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -12,6 +12,8 @@ use crate::Scene;
 pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
     let f = out.fractions;
     let scenario = &scene.scenario;
+    // A dissipative chain's energy_drift is its ledger's, |E(t) + D(t) − E(0)| / E(0).
+    let dissipative = scenario.model.is_dissipative();
     let mut report = json!({
         "R": f.reflected,
         "T": f.transmitted,
@@ -35,14 +37,17 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         "site_steps_full_chain": scenario.model.n_sites() as u64 * (out.stats.steps + out.stats.rejected),
         "total_rhs_evals": out.total_rhs_evals,
         "energy_drift": if scenario.model.is_time_dependent() { Value::Null } else { json!(out.stats.max_energy_drift) },
-        "energy_conserved": !scenario.model.is_time_dependent(),
-        "normalisation": "E(t_end)",
+        "energy_conserved": !scenario.model.is_time_dependent() && !dissipative,
+        "normalisation": if dissipative { "E(0)" } else { "E(t_end)" },
         "region": scene.region_paper,
         "t_end": scenario.t_end,
         "version": env!("CARGO_PKG_VERSION"),
     });
     if scenario.region.has_striker() {
         report["S"] = json!(f.striker);
+    }
+    if dissipative {
+        report["D"] = json!(f.dissipated);
     }
     if let Some(p) = &scene.physical {
         report["physical"] = json!({

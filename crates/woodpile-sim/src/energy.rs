@@ -82,7 +82,10 @@ pub struct Fractions {
     /// S: the striker's share (its kinetic energy and half its contact's potential); 0
     /// without a striker.
     pub striker: f64,
-    /// The total the shares are normalised by.
+    /// D: the share dissipated so far; 0 for a conservative chain.
+    pub dissipated: f64,
+    /// The total the shares are normalised by: the energy held at that moment, or E(0) for a
+    /// dissipative chain ([`Fractions::of_ledger`]).
     pub total: f64,
 }
 
@@ -105,11 +108,51 @@ impl Fractions {
             transmitted: right / total,
             trapped: inside / total,
             striker: striker / total,
+            dissipated: 0.0,
             total,
         }
     }
 
-    /// The largest difference in R, T, E_tr or S between two runs' fractions: the error
+    /// The shares of a dissipative chain: the density's shares and the energy `dissipated`
+    /// so far, each divided by the initial energy `e_initial`, so that R + T + E_tr + S + D
+    /// = 1 up to the integration error.
+    pub fn of_ledger(density: &[f64], region: Region, dissipated: f64, e_initial: f64) -> Self {
+        let held = Self::from_density(density, region);
+        let scale = held.total / e_initial;
+        Self {
+            reflected: held.reflected * scale,
+            transmitted: held.transmitted * scale,
+            trapped: held.trapped * scale,
+            striker: held.striker * scale,
+            dissipated: dissipated / e_initial,
+            total: e_initial,
+        }
+    }
+
+    /// The fractions of state `y` of `model` at time `t`, from its energy `density` (scratch
+    /// of length `n_sites`): normalised by the energy held, or, for a dissipative chain, by
+    /// `e_initial` with D among them.
+    pub fn of_state(
+        model: &Model,
+        (t, y): (f64, &[f64]),
+        region: Region,
+        e_initial: f64,
+        density: &mut [f64],
+    ) -> Self {
+        energy_density(model, t, y, density);
+        match model.is_dissipative() {
+            true => Self::of_ledger(density, region, model.dissipated(y), e_initial),
+            false => Self::from_density(density, region),
+        }
+    }
+
+    /// R + T + E_tr + S + D: 1 by construction for a conservative chain, and 1 up to the
+    /// integration error for a dissipative one (the ledger).
+    pub fn sum(&self) -> f64 {
+        self.reflected + self.transmitted + self.trapped + self.striker + self.dissipated
+    }
+
+    /// The largest difference in R, T, E_tr, S or D between two runs' fractions: the error
     /// measure of `auto`'s verification and of every accuracy check against a reference.
     pub fn largest_difference(&self, other: &Fractions) -> f64 {
         (self.reflected - other.reflected)
@@ -117,6 +160,7 @@ impl Fractions {
             .max((self.transmitted - other.transmitted).abs())
             .max((self.trapped - other.trapped).abs())
             .max((self.striker - other.striker).abs())
+            .max((self.dissipated - other.dissipated).abs())
     }
 }
 
@@ -148,6 +192,11 @@ pub fn energy_density(model: &Model, t: f64, y: &[f64], density: &mut [f64]) {
     }
     if boundary.right_wall() {
         density[n_sites - 1] += potential(n_sites, u[n_sites - 1]);
+    }
+    if boundary.has_soft_end() {
+        let [left, right] = spring_end_energies(model, u);
+        density[0] += left;
+        density[n_sites - 1] += right;
     }
     for (j, r) in model.resonators().iter().enumerate() {
         let stretch = u[r.site] - q[n_sites + j];
@@ -191,6 +240,9 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
         (false, true) => e += potential(n_sites, u[n_sites - 1]),
         (false, false) => {}
     }
+    if model.boundary().has_soft_end() {
+        e += spring_end_energies(model, u).iter().sum::<f64>();
+    }
     for (j, r) in model.resonators().iter().enumerate() {
         let w = qdot[n_sites + j];
         let stretch = u[r.site] - q[n_sites + j];
@@ -198,6 +250,26 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
             + r.coupling.at(t) * odd_power(stretch, r.p) * stretch / f64::from(r.p + 1);
     }
     e
+}
+
+/// The potential k u²/2 of each soft end's spring (0 for other ends): [left, right]. It
+/// belongs wholly to its end site, as a wall contact's does.
+fn spring_end_energies(model: &Model, u: &[f64]) -> [f64; 2] {
+    let boundary = model.boundary();
+    let spring = |end: crate::model::End, x: f64| end.soft().map_or(0.0, |(k, _)| 0.5 * k * x * x);
+    [
+        spring(boundary.left(), u[0]),
+        spring(boundary.right(), u[u.len() - 1]),
+    ]
+}
+
+/// The energy ledger E(t) + D(t): the energy the chain holds plus what it has dissipated,
+/// equal to E(0) for an exact solution of any scene with a constant coupling.
+pub fn ledger(model: &Model, t: f64, y: &[f64]) -> f64 {
+    match model.is_dissipative() {
+        true => total_energy(model, t, y) + model.dissipated(y),
+        false => total_energy(model, t, y),
+    }
 }
 
 /// Total momentum sum m_n u_n' + sum eps_j v_j' (conserved with free ends).

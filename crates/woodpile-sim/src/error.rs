@@ -159,6 +159,14 @@ pub enum SimError {
         /// Time of the sample at which the run stopped.
         t: f64,
     },
+    /// A method for forces of positions only was asked to run a dissipative chain.
+    #[error("method {method} integrates y'' = f(t, y) and cannot run a chain with damping, whose forces depend on velocities; methods that can: auto, {methods}")]
+    VelocityForces {
+        /// The method asked for.
+        method: &'static str,
+        /// The named methods that can.
+        methods: String,
+    },
     /// A run setting (t_end, dt, tolerance, sample interval) is invalid.
     #[error("invalid run setting: {0}")]
     BadRun(String),

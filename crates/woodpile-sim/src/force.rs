@@ -99,6 +99,9 @@ impl Model {
             None => Self::hertz_chain(self.boundary(), u, acc_u, window, bond_force),
             Some(law) => Self::law_chain(law, self.boundary(), u, acc_u, window, bond_force),
         }
+        if self.boundary().has_soft_end() {
+            self.spring_ends(u, acc_u, window);
+        }
         for (j, r) in self.resonators().iter().enumerate() {
             if r.site < lo || r.site > hi {
                 continue;
@@ -212,12 +215,25 @@ impl Model {
         }
     }
 
+    /// The springs of soft ends (without dashpots: a model with one is dissipative and runs
+    /// [`Model::damped_accelerations_in`]), added to the window's end sites.
+    fn spring_ends(&self, u: &[f64], acc_u: &mut [f64], window: Window) {
+        let last = self.n_sites() - 1;
+        if let (0, Some((spring, _))) = (window.lo, self.boundary().left().soft()) {
+            acc_u[0] -= spring * u[0];
+        }
+        if let (true, Some((spring, _))) = (window.hi == last, self.boundary().right().soft()) {
+            acc_u[last] -= spring * u[last];
+        }
+    }
+
     /// First-order form `y' = (q', q'')` of the equations of motion, for Runge–Kutta methods.
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         self.rhs_in(t, y, dy, Window::full(self));
     }
 
     /// [`Model::rhs`] for the sites of `window`; entries outside it are left untouched.
+    /// A dissipative model's state ends with D, whose rate is the dissipated power.
     pub fn rhs_in(&self, t: f64, y: &[f64], dy: &mut [f64], window: Window) {
         let n_dof = self.n_dof();
         let (q, qdot) = y.split_at(n_dof);
@@ -225,7 +241,12 @@ impl Model {
         for range in window.dof_ranges(self) {
             dq[range.clone()].copy_from_slice(&qdot[range]);
         }
-        self.accelerations_in(t, q, dqdot, window);
+        if self.is_dissipative() {
+            let power = self.damped_accelerations_in(t, (q, qdot), dqdot, window);
+            dqdot[n_dof] = power;
+        } else {
+            self.accelerations_in(t, q, dqdot, window);
+        }
     }
 }
 

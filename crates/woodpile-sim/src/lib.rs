@@ -8,6 +8,7 @@
 //! The pieces, in the order a simulation uses them:
 //! - [`model`]: the chain, its boundary, its resonators and their coupling law (Eqs. 3, 7, 14).
 //! - [`force`]: the right-hand side, accelerations from positions.
+//! - [`damping`]: dashpots, ground damping and the dissipated power (velocity-dependent forces).
 //! - [`energy`]: energy density, total energy, R/T/E_tr fractions (Eq. 5 generalised).
 //! - [`integrate`]: the steppers (RK4, Störmer–Verlet, symplectic compositions, DOP853) and the
 //!   single driver that owns the time loop, sampling and failure detection.
@@ -18,6 +19,7 @@
 #![warn(missing_docs)]
 
 pub mod contact;
+pub mod damping;
 pub mod energy;
 mod error;
 pub mod force;
@@ -32,5 +34,6 @@ pub mod testing;
 pub mod units;
 
 pub use contact::ContactLaw;
+pub use damping::{DashpotLaw, Damping};
 pub use error::{ModelError, OverBudget, SimError, StepSetBy};
 pub use model::{Boundary, Coupling, End, Model, Resonator};

@@ -13,10 +13,11 @@
 //! `n_dof = S + R` and `y.len() = 2 n_dof`. Contacts push, never pull (`[x]_+ = max(x, 0)`).
 
 use crate::contact::ContactLaw;
+use crate::damping::Damping;
 use crate::error::ModelError;
 
 /// What lies beyond the two end sites.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Boundary {
     /// Immovable walls at u_{-1} = u_{S} = 0 (the paper's "zero boundary conditions"): an end
     /// site pushing outwards compresses a Hertzian contact with the wall.
@@ -34,12 +35,32 @@ pub enum Boundary {
 }
 
 /// One end of the chain.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum End {
     /// An immovable wall, touching through a contact.
     Fixed,
     /// Nothing: the end site has a single neighbour.
     Free,
+    /// A soft support (the foam an experiment rests its chain on): a linear spring and a
+    /// dashpot between the end site and a rigid support, acting both ways, force
+    /// −spring u − damping u̇ on the end site. With `damping = 0` the end is conservative.
+    Soft {
+        /// Spring constant (≥ 0).
+        spring: f64,
+        /// Dashpot coefficient (≥ 0).
+        damping: f64,
+    },
+}
+
+impl End {
+    /// The soft end's spring and dashpot, if this end is soft.
+    #[inline(always)]
+    pub fn soft(self) -> Option<(f64, f64)> {
+        match self {
+            End::Soft { spring, damping } => Some((spring, damping)),
+            _ => None,
+        }
+    }
 }
 
 impl Boundary {
@@ -81,6 +102,18 @@ impl Boundary {
     #[inline(always)]
     pub fn right_wall(self) -> bool {
         self.right() == End::Fixed
+    }
+
+    /// Whether either end is soft (a spring, perhaps with a dashpot).
+    pub fn has_soft_end(self) -> bool {
+        self.left().soft().is_some() || self.right().soft().is_some()
+    }
+
+    /// Whether a soft end carries a dashpot.
+    pub fn dissipates(self) -> bool {
+        [self.left(), self.right()]
+            .into_iter()
+            .any(|end| end.soft().is_some_and(|(_, c)| c > 0.0))
     }
 }
 
@@ -193,6 +226,11 @@ pub struct Model {
     /// Contacts beyond the paper's (per-contact coefficients, an exponent, precompression);
     /// `None` for the paper's chain, which keeps its own force loop and bits.
     contacts: Option<Box<ContactLaw>>,
+    /// Dashpots and ground damping ([`crate::damping`]); `None` when nothing dissipates
+    /// (soft ends keep their own dashpots), so a conservative scene pays nothing for them.
+    damping: Option<Box<Damping>>,
+    /// Whether anything dissipates: the state then ends with D ([`Model::state_len`]).
+    dissipative: bool,
 }
 
 impl Model {
@@ -230,6 +268,12 @@ impl Model {
                 positive(&format!("mass of site {site}"), m)?;
             }
         }
+        for (side, end) in [("left", boundary.left()), ("right", boundary.right())] {
+            if let Some((spring, damping)) = end.soft() {
+                non_negative(&format!("{side} end spring"), spring)?;
+                non_negative(&format!("{side} end damping"), damping)?;
+            }
+        }
         let site_masses = site_masses.filter(|m| m.iter().any(|&x| x != 1.0));
         let mut inv_mass: Vec<f64> = match &site_masses {
             Some(m) => m.iter().map(|x| 1.0 / x).collect(),
@@ -243,7 +287,52 @@ impl Model {
             site_masses,
             inv_mass,
             contacts: None,
+            damping: None,
+            dissipative: boundary.dissipates(),
         })
+    }
+
+    /// The same chain with `damping`. A damping with every coefficient zero is dropped, so
+    /// that the scene keeps the conservative path and its bits.
+    pub fn with_damping(mut self, damping: Damping) -> Result<Self, ModelError> {
+        if damping.resonator.len() > self.resonators.len() {
+            return Err(ModelError::Negative {
+                what: format!(
+                    "resonator damping count ({} for {} resonators)",
+                    damping.resonator.len(),
+                    self.resonators.len()
+                ),
+                value: -1.0,
+            });
+        }
+        if damping.dissipates() {
+            self.damping = Some(Box::new(damping));
+            self.dissipative = true;
+        }
+        Ok(self)
+    }
+
+    /// The dashpots and ground damping, when any is non-zero.
+    #[inline(always)]
+    pub fn damping(&self) -> Option<&Damping> {
+        self.damping.as_deref()
+    }
+
+    /// Whether the chain loses energy (a dashpot, ground damping, or a soft end's dashpot).
+    /// Its state then carries D, the energy dissipated so far, after `[q, q']`; forces depend
+    /// on velocities, and only methods for y'' = f(t, y, y') may run it.
+    #[inline(always)]
+    pub fn is_dissipative(&self) -> bool {
+        self.dissipative
+    }
+
+    /// D, the energy dissipated up to state `y` (0 for a conservative chain).
+    #[inline(always)]
+    pub fn dissipated(&self, y: &[f64]) -> f64 {
+        match self.dissipative {
+            true => y[2 * self.n_dof()],
+            false => 0.0,
+        }
     }
 
     /// The same chain with the contact law `law` instead of the paper's: one coefficient per
@@ -279,9 +368,9 @@ impl Model {
         self.n_sites + self.resonators.len()
     }
 
-    /// Length of the flat state vector `[q, q']`.
+    /// Length of the flat state vector `[q, q']`, and D after it when the chain dissipates.
     pub fn state_len(&self) -> usize {
-        2 * self.n_dof()
+        2 * self.n_dof() + usize::from(self.dissipative)
     }
 
     /// The boundary condition.
@@ -547,14 +636,16 @@ impl Window {
     }
 
     /// The parts of a state `[q, q']` of `model` that the window covers, in state order:
-    /// site positions, resonator positions, site velocities, resonator velocities.
-    pub fn state_ranges(&self, model: &Model) -> [std::ops::Range<usize>; 4] {
+    /// site positions, resonator positions, site velocities, resonator velocities, and D
+    /// (empty for a conservative chain).
+    pub fn state_ranges(&self, model: &Model) -> [std::ops::Range<usize>; 5] {
         let (n_sites, n_dof) = (model.n_sites(), model.n_dof());
         [
             self.lo..self.hi + 1,
             n_sites..n_dof,
             n_dof + self.lo..n_dof + self.hi + 1,
             n_dof + n_sites..2 * n_dof,
+            2 * n_dof..model.state_len(),
         ]
     }
 

@@ -45,6 +45,10 @@ pub struct FractionSeries {
     pub striker: Vec<f64>,
     /// The energy split at each sample (total, or kinetic).
     pub energy: Vec<f64>,
+    /// D, the share dissipated so far (all zero for a conservative chain).
+    pub dissipated: Vec<f64>,
+    /// E(0), from the first sample: what a dissipative chain's shares are divided by.
+    e_initial: Option<f64>,
 }
 
 impl FractionSeries {
@@ -75,6 +79,8 @@ impl FractionSeries {
             trapped: Vec::new(),
             striker: Vec::new(),
             energy: Vec::new(),
+            dissipated: Vec::new(),
+            e_initial: None,
         }
     }
 }
@@ -92,13 +98,21 @@ impl Observer for FractionSeries {
             }
         };
         let f = Fractions::from_density(&self.density, self.region);
-        let factor = scale.map_or(1.0, |n| f.total / n);
+        let held = f.total;
+        let e_initial = *self.e_initial.get_or_insert(held);
+        // A dissipative chain's total-energy shares are of E(0), with D beside them.
+        let (factor, dissipated) = match (scale, model.is_dissipative()) {
+            (Some(n), _) => (f.total / n, model.dissipated(y) / n),
+            (None, true) => (held / e_initial, model.dissipated(y) / e_initial),
+            (None, false) => (1.0, 0.0),
+        };
         self.t.push(t);
         self.reflected.push(f.reflected * factor);
         self.transmitted.push(f.transmitted * factor);
         self.trapped.push(f.trapped * factor);
         self.striker.push(f.striker * factor);
-        self.energy.push(f.total);
+        self.energy.push(held);
+        self.dissipated.push(dissipated);
     }
 
     fn reset(&mut self) {
@@ -109,9 +123,11 @@ impl Observer for FractionSeries {
             &mut self.trapped,
             &mut self.striker,
             &mut self.energy,
+            &mut self.dissipated,
         ] {
             v.clear();
         }
+        self.e_initial = None;
     }
 }
 

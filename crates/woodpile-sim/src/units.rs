@@ -61,6 +61,22 @@ impl Scales {
         mass_kg / self.mass_kg
     }
 
+    /// Dimensionless coefficient of a linear dashpot c (N·s/m): c T / M.
+    pub fn dashpot(&self, c: f64) -> f64 {
+        c * self.time_s() / self.mass_kg
+    }
+
+    /// Dimensionless coefficient of a Hertzian dashpot γ (N·s/m^{3/2}), whose force is
+    /// γ √δ δ̇: γ L^{1/2} T / M.
+    pub fn hertzian_dashpot(&self, gamma: f64) -> f64 {
+        gamma * self.length_m().sqrt() * self.time_s() / self.mass_kg
+    }
+
+    /// Dimensionless stiffness of a linear spring k (N/m): k T² / M.
+    pub fn spring(&self, k: f64) -> f64 {
+        k * self.time_s().powi(2) / self.mass_kg
+    }
+
     /// Dimensionless coupling kappa of a spring K (N/m^p) with exponent p.
     pub fn kappa(&self, stiffness: f64, p: u32) -> f64 {
         stiffness * self.length_m().powi(p as i32 + 1)
@@ -79,6 +95,20 @@ mod tests {
         let k = 3.961e6;
         let closed = k / (s.mass_kg.powf(0.2) * s.hertz.powf(0.8) * s.velocity.powf(0.4));
         assert!((s.kappa(k, 1) / closed - 1.0).abs() < 1e-12);
+    }
+
+    /// A linear spring is a p = 1 coupling, and a dashpot's force over a spring's is a rate
+    /// times a time: the conversions agree with kappa and with each other.
+    #[test]
+    fn springs_and_dashpots_rescale_consistently() {
+        let s = Scales::new(0.866e-3, 2.47e9, 1.98).unwrap();
+        assert!((s.spring(3.0e5) / s.kappa(3.0e5, 1) - 1.0).abs() < 1e-12);
+        // c u̇ against k u at u̇ = u / T_phys: the ratio c / (k T_phys) is unit-free.
+        let (c, k, t_phys) = (40.0, 3.0e5, 1e-4);
+        let dimensionless = s.dashpot(c) / (s.spring(k) * (t_phys / s.time_s()));
+        assert!((dimensionless - c / (k * t_phys)).abs() < 1e-12);
+        // The Hertzian dashpot at an overlap of one length scale is the linear one.
+        assert!((s.hertzian_dashpot(c) / s.length_m().sqrt() - s.dashpot(c)).abs() < 1e-12 * s.dashpot(c));
     }
 
     /// The rescaling makes the Hertz law unit-free: a L^{1/2} T^2 / M = 1.

@@ -4,7 +4,9 @@
 use woodpile_sim::model::{Boundary, End};
 use woodpile_sim::ContactLaw;
 
-use super::check::{invalid, non_negative, positive, positive_pattern, required, shown, Invalid};
+use super::check::{
+    invalid, non_negative, number, positive, positive_pattern, required, shown, Invalid,
+};
 use super::physical::Si;
 use crate::raw;
 
@@ -50,6 +52,32 @@ impl Layout {
     }
 }
 
+/// A soft end `{ spring = k, damping = c }`: a linear spring and a dashpot on a rigid support
+/// (both default to 0; an SI scene gives N/m and N·s/m).
+fn soft_end(key: &str, table: &toml::Table, si: Option<&Si>) -> Result<End, Invalid> {
+    if let Some(other) = table.keys().find(|k| !["spring", "damping"].contains(&k.as_str())) {
+        return Err(invalid(
+            format!("{key}.{other}"),
+            "unknown key; a soft end has spring and damping",
+        ));
+    }
+    let get = |name: &str| -> Result<f64, Invalid> {
+        let full = format!("{key}.{name}");
+        match table.get(name) {
+            None => Ok(0.0),
+            Some(v) => non_negative(&full, number(&full, v)?),
+        }
+    };
+    let (spring, damping) = (get("spring")?, get("damping")?);
+    Ok(match si {
+        None => End::Soft { spring, damping },
+        Some(si) => End::Soft {
+            spring: si.scales.spring(spring),
+            damping: si.scales.dashpot(damping),
+        },
+    })
+}
+
 /// The first and last paper sites: `chain.n` (sites -n..n) or `chain.sites = [first, last]`.
 pub(crate) fn sites(chain: Option<&raw::Chain>) -> Result<(i64, i64), Invalid> {
     let (n, sites) = chain.map_or((None, None), |c| (c.n, c.sites.as_deref()));
@@ -84,18 +112,25 @@ pub(crate) fn sites(chain: Option<&raw::Chain>) -> Result<(i64, i64), Invalid> {
     }
 }
 
-/// `chain.boundary`: `"fixed"` (the default), `"free"`, or `{ left = .., right = .. }`.
-pub(crate) fn boundary(chain: Option<&raw::Chain>) -> Result<Boundary, Invalid> {
-    let end = |key: &str, value: &toml::Value| match value.as_str() {
-        Some("fixed") => Ok(End::Fixed),
-        Some("free") => Ok(End::Free),
+/// `chain.boundary`: `"fixed"` (the default), `"free"`, or `{ left = .., right = .. }`, each
+/// end `"fixed"`, `"free"` or soft, `{ spring = k, damping = c }` (N/m and N·s/m in an SI
+/// scene, converted with its scales).
+pub(crate) fn boundary(chain: Option<&raw::Chain>, si: Option<&Si>) -> Result<Boundary, Invalid> {
+    let end = |key: &str, value: &toml::Value| match value {
+        toml::Value::String(s) if s == "fixed" => Ok(End::Fixed),
+        toml::Value::String(s) if s == "free" => Ok(End::Free),
+        toml::Value::Table(soft) => soft_end(key, soft, si),
         _ => Err(invalid(
             key,
-            format!("must be \"fixed\" or \"free\", got {value}"),
+            format!("must be \"fixed\", \"free\" or {{ spring = .., damping = .. }}, got {value}"),
         )),
     };
     match chain.and_then(|c| c.boundary.as_ref()) {
         None => Ok(Boundary::Fixed),
+        Some(toml::Value::Table(ends)) if ends.contains_key("spring") || ends.contains_key("damping") => Err(invalid(
+            "chain.boundary",
+            "a soft end belongs to one side: boundary = { left = \"free\", right = { spring = .., damping = .. } }",
+        )),
         Some(toml::Value::Table(ends)) => {
             if let Some(other) = ends
                 .keys()

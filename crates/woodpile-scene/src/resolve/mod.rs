@@ -11,6 +11,7 @@
 
 mod chain;
 mod check;
+mod damping;
 mod defects;
 mod excitation;
 mod physical;
@@ -132,7 +133,11 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         sample_every: settings.sample_every,
     };
     run::within_budget(&scenario, settings.sample_every_given)?;
-    let physical = si.map(|si| physical_values(si, built.derived, built.striker, &scenario));
+    let physical = si.map(|si| {
+        let mut values = physical_values(si, built.derived, built.striker, &scenario);
+        values.derived.extend(built.damping_values);
+        values
+    });
     Ok(Scene {
         scenario,
         first_site: layout.index_zero(),
@@ -151,13 +156,30 @@ struct Built {
     derived: Vec<DerivedDefect>,
     /// A striker's mass and contact coefficient, over the regular ones.
     striker: Option<(f64, f64)>,
+    /// An SI scene's dashpots and soft ends in the model's units, by name.
+    damping_values: Vec<(String, f64)>,
+}
+
+/// An SI scene's soft ends, converted, for the JSON's `physical` block.
+fn soft_end_values(boundary: woodpile_sim::Boundary, si: bool) -> Vec<(String, f64)> {
+    let ends = [("left", boundary.left()), ("right", boundary.right())];
+    ends.into_iter()
+        .filter(|_| si)
+        .filter_map(|(side, end)| end.soft().map(|soft| (side, soft)))
+        .flat_map(|(side, (spring, damping))| {
+            [
+                (format!("boundary_{side}_spring"), spring),
+                (format!("boundary_{side}_damping"), damping),
+            ]
+        })
+        .collect()
 }
 
 /// The model of `file`'s chain: sites, defects, segments, the excitation and the contact law,
 /// each section's keys resolved by its own module.
 fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Result<Built, Invalid> {
     let chain_table = file.chain.as_ref();
-    let boundary = chain::boundary(chain_table)?;
+    let boundary = chain::boundary(chain_table, si)?;
     let mut sites = chain::Sites::regular(layout);
     let (resonators, derived) = defects::resonators(&file.defect, layout, si, &mut sites)?;
     chain::segments(&file.segment, layout, si, &mut sites)?;
@@ -178,19 +200,28 @@ fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Resu
         .striker
         .as_ref()
         .map(|_| (sites.masses[0], sites.contacts[1]));
+    let dissipation = damping::damping(file, &resonators, &sites.masses, si)?;
     let model = Model::with_masses(layout.n_sites(), boundary, resonators, Some(sites.masses))
         .map_err(|e| invalid("defect", e.to_string()))?;
-    let model = match law {
+    let mut model = match law {
         None => model,
         Some(law) => model
             .with_contacts(law)
             .map_err(|e| invalid("chain", e.to_string()))?,
     };
+    let mut damping_values = soft_end_values(boundary, si.is_some());
+    if let Some((damping, listed)) = dissipation {
+        model = model
+            .with_damping(damping)
+            .map_err(|e| invalid("damping", e.to_string()))?;
+        damping_values.extend(listed);
+    }
     Ok(Built {
         model,
         impulse,
         derived,
         striker,
+        damping_values,
     })
 }
 

@@ -66,6 +66,12 @@ impl Cubic {
         c[0] + x * (c[1] + x * (c[2] + x * c[3]))
     }
 
+    /// d/dx of the cubic.
+    fn slope(&self, x: f64) -> f64 {
+        let c = &self.0;
+        c[1] + x * (2.0 * c[2] + x * 3.0 * c[3])
+    }
+
     /// Critical points strictly inside (0, 1), sorted.
     fn critical_points(&self) -> ([f64; 2], usize) {
         let (a, b, c) = (3.0 * self.0[3], 2.0 * self.0[2], self.0[1]);
@@ -192,6 +198,128 @@ pub(crate) fn path_integrals_of(path: &BondPath, h: f64, force: impl Fn(f64) -> 
         }
     }
     (impulse * h, moment * h * h)
+}
+
+/// [`path_integrals_of`] for a contact with a dashpot: `force(c, ċ)` gives the bond's total
+/// force (clipped at zero) and its dashpot power at overlap c > 0 closing at rate ċ. Returns
+/// the impulse, the moment and the energy dissipated along the path.
+///
+/// The force may jump where the contact closes (a linear dashpot's γ ċ) and has a kink where
+/// the clip starts (the dashpot pulling harder than the spring pushes, as the contact opens):
+/// each positive piece is split at those clip points too, found by bisection between a
+/// grid of [`CLIP_SCAN`] points, so that the rule integrates a smooth function on every part.
+pub(crate) fn damped_path_integrals(
+    path: &BondPath,
+    h: f64,
+    force: impl Fn(f64, f64) -> (f64, f64),
+) -> (f64, f64, f64) {
+    let cubic = Cubic::hermite(path, h);
+    let at = |x: f64| {
+        let c = cubic.at(x);
+        let rate = cubic.slope(x) / h;
+        (c, rate)
+    };
+    // The unclipped force's sign decides the clip: total > 0 where it pushes.
+    let pushes = |x: f64| {
+        let (c, rate) = at(x);
+        c > 0.0 && force(c, rate).0 > 0.0
+    };
+    let (mut impulse, mut moment, mut lost) = (0.0, 0.0, 0.0);
+    for (a, b) in positive_pieces(&cubic) {
+        // Samples just inside both ends and at the grid's midpoints; each change of "pushes"
+        // between neighbours is a clip point.
+        let inside = 1e-12 * (b - a);
+        let samples: Vec<f64> = std::iter::once(a + inside)
+            .chain((0..CLIP_SCAN).map(|k| a + (b - a) * (k as f64 + 0.5) / CLIP_SCAN as f64))
+            .chain(std::iter::once(b - inside))
+            .collect();
+        let mut cuts = vec![a];
+        for pair in samples.windows(2) {
+            if pushes(pair[0]) != pushes(pair[1]) {
+                cuts.push(bisect(&pushes, pair[0], pair[1]));
+            }
+        }
+        cuts.push(b);
+        for part in cuts.windows(2) {
+            let (p, q) = (part[0], part[1]);
+            if !(q > p) {
+                continue;
+            }
+            for (x, w) in gauss16() {
+                let smooth = x * x * (3.0 - 2.0 * x);
+                let xi = p + (q - p) * smooth;
+                let jacobian = 6.0 * x * (1.0 - x) * (q - p);
+                let (c, rate) = at(xi);
+                if !(c > 0.0) {
+                    continue;
+                }
+                let (f, power) = force(c, rate);
+                impulse += w * jacobian * f;
+                moment += w * jacobian * (1.0 - xi) * f;
+                lost += w * jacobian * power;
+            }
+        }
+    }
+    (impulse * h, moment * h * h, lost * h)
+}
+
+/// The first moment, as a fraction of the step in (0, 1), at which a damped contact's force
+/// switches along its path: the contact closes (its force jumps to γ ċ with a linear dashpot,
+/// and rises as √c with a Hertzian one) or its clip starts (a kink). `force(c, ċ)` is as for
+/// [`damped_path_integrals`]. Found on a grid of [`CLIP_SCAN`] points, then by bisection.
+pub(crate) fn first_switch(
+    path: &BondPath,
+    h: f64,
+    force: impl Fn(f64, f64) -> (f64, f64),
+) -> Option<f64> {
+    let cubic = Cubic::hermite(path, h);
+    let pushes = |x: f64| {
+        let c = cubic.at(x);
+        c > 0.0 && force(c, cubic.slope(x) / h).0 > 0.0
+    };
+    let grid = |k: usize| k as f64 / CLIP_SCAN as f64;
+    (1..=CLIP_SCAN)
+        .map(|k| (grid(k - 1), grid(k)))
+        .find(|&(a, b)| pushes(a) != pushes(b))
+        .map(|(a, b)| bisect(&pushes, a, b))
+}
+
+/// Sub-intervals a positive piece is scanned in for the start of a dashpot's clip.
+const CLIP_SCAN: usize = 32;
+
+/// The point in [a, b] where `holds` changes, by bisection to the last bit.
+fn bisect(holds: &impl Fn(f64) -> bool, mut a: f64, mut b: f64) -> f64 {
+    let at_a = holds(a);
+    for _ in 0..64 {
+        let mid = 0.5 * (a + b);
+        if mid <= a || mid >= b {
+            break;
+        }
+        if holds(mid) == at_a {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// The pieces of [0, 1] on which the cubic is positive, split at its roots.
+fn positive_pieces(cubic: &Cubic) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let (knots, n_knots) = cubic.monotone_knots();
+    let mut points = vec![];
+    for piece in knots[..n_knots].windows(2) {
+        let (a, b) = (piece[0], piece[1]);
+        points.push(a);
+        if (cubic.at(a) > 0.0) != (cubic.at(b) > 0.0) {
+            points.push(cubic.root_between(a, b));
+        }
+    }
+    points.push(1.0);
+    let spans: Vec<(f64, f64)> = points.windows(2).map(|w| (w[0], w[1])).collect();
+    spans
+        .into_iter()
+        .filter(move |&(a, b)| b > a && cubic.at(0.5 * (a + b)) > 0.0)
 }
 
 /// RK4's own quadrature of a bond force from its four stage values:

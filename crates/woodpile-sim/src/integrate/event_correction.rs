@@ -6,8 +6,12 @@
 //! A method supplies only its quadrature: what its stage weights make of a bond's `S` stage
 //! forces, as an impulse `h Σ b_i F_i` and a position change `h² Σ b̄_i F_i`.
 
-use super::contact_event::{first_crossing, path_integrals, path_integrals_of, BondPath};
+use super::contact_event::{
+    damped_path_integrals, first_crossing, first_switch, path_integrals, path_integrals_of,
+    BondPath,
+};
 use crate::contact::ContactLaw;
+use crate::damping::BondRecord;
 use crate::model::{Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
@@ -19,6 +23,28 @@ pub(crate) type Quadrature<const S: usize> = fn([f64; S], f64) -> (f64, f64);
 /// quiet chain behind the wave, with forces below 1e-16; skipping them changes no fraction by
 /// more than 1e-16 and saves most of the correction's cost.
 const NEGLIGIBLE_FORCE: f64 = 1e-14;
+
+/// A bond's correction: (left site or None for a wall, right site or None, impulse, position).
+type Correction = (Option<usize>, Option<usize>, f64, f64);
+
+/// Extra passes of a dissipative chain's corrections ([`ContactEvents::refine`]).
+const REFINE_PASSES: usize = 2;
+
+/// Adds each correction to the end state: the bond pushes its left member back and its right
+/// member on.
+fn apply(model: &Model, corrections: &[Correction], (new_q, new_v): (&mut [f64], &mut [f64])) {
+    let inv_mass = model.inv_mass();
+    for &(left, right, impulse, moment) in corrections {
+        if let Some(i) = left {
+            new_v[i] -= impulse * inv_mass[i];
+            new_q[i] -= moment * inv_mass[i];
+        }
+        if let Some(i) = right {
+            new_v[i] += impulse * inv_mass[i];
+            new_q[i] += moment * inv_mass[i];
+        }
+    }
+}
 
 /// Whether a bond's contact changed state during a step: its stage forces and end overlap do
 /// not all agree on "touching". Bonds that stay open (the whole quiet chain) or stay closed
@@ -46,13 +72,26 @@ fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
     }
 }
 
-fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, f64) {
+/// A bond's impulse and moment along its path, and the energy its dashpot dissipates there
+/// (0 for a conservative chain).
+fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, f64, f64) {
+    if model.is_dissipative() {
+        // The path is of the total overlap; the force law takes the relative displacement.
+        let delta = model.contacts().map_or(0.0, |law| law.static_overlap(bond));
+        return damped_path_integrals(path, h, |c, rate| {
+            let (force, power) = model.contact_force(bond, c - delta, rate);
+            (force.total, power)
+        });
+    }
     match model.contacts() {
-        None => path_integrals(path, h),
+        None => {
+            let (impulse, moment) = path_integrals(path, h);
+            (impulse, moment, 0.0)
+        }
         Some(law) => {
             let a = law.coefficient(bond);
             let (impulse, moment) = path_integrals_of(path, h, |d| law.power(d));
-            (a * impulse, a * moment)
+            (a * impulse, a * moment, 0.0)
         }
     }
 }
@@ -64,13 +103,19 @@ fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, 
 pub(crate) struct ContactEvents<const S: usize> {
     /// The bond forces of each stage, written by [`Model::accelerations_recording`].
     stage_force: [Vec<f64>; S],
+    /// The bonds' dashpot power of each stage (empty for a conservative chain).
+    stage_power: [Vec<f64>; S],
     quadrature: Quadrature<S>,
-    /// (left site or None for a wall, right site or None, impulse, position) corrections.
-    pending: Vec<(Option<usize>, Option<usize>, f64, f64)>,
+    /// The corrections of the last step.
+    pending: Vec<Correction>,
+    /// A dissipative chain's corrected bonds and the energy each dissipated along its path.
+    corrected: Vec<(usize, f64)>,
     /// Bonds corrected so far.
     events: u64,
     /// Scratch: the bonds that changed contact in this step, as (bond, left site, right site).
     changed: Vec<(usize, Option<usize>, Option<usize>)>,
+    /// Bonds the next step corrects whatever its scan finds ([`ContactEvents::correct_next`]).
+    carried: Vec<(usize, Option<usize>, Option<usize>)>,
 }
 
 impl<const S: usize> ContactEvents<S> {
@@ -83,12 +128,19 @@ impl<const S: usize> ContactEvents<S> {
             None => vec![0.0; model.n_sites() + 1],
             Some(law) => (0..law.n_bonds()).map(|b| law.static_force(b)).collect(),
         };
+        let powers = match model.is_dissipative() {
+            true => model.n_sites() + 1,
+            false => 0,
+        };
         Self {
             stage_force: std::array::from_fn(|_| at_rest.clone()),
+            stage_power: std::array::from_fn(|_| vec![0.0; powers]),
             quadrature,
             pending: Vec::new(),
             events: 0,
             changed: Vec::new(),
+            carried: Vec::new(),
+            corrected: Vec::new(),
         }
     }
 
@@ -122,35 +174,84 @@ impl<const S: usize> ContactEvents<S> {
     ) {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
+        for bond in self.carried.drain(..) {
+            if !self.changed.contains(&bond) {
+                self.changed.push(bond);
+            }
+        }
         let (q, v) = start.split_at(n);
         let (new_q, new_v) = end.split_at_mut(n);
         let quadrature = self.quadrature;
         let mut pending = std::mem::take(&mut self.pending);
         pending.clear();
+        let mut dissipated = 0.0;
+        let mut corrected = std::mem::take(&mut self.corrected);
+        corrected.clear();
         for &(bond, left, right) in &self.changed {
             let stage = self.stage_forces(bond);
             let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
             if negligible(stage, end_force(model, bond, &path)) {
                 continue;
             }
-            let (impulse, moment) = bond_integrals(model, bond, &path, h);
+            let (impulse, moment, lost) = bond_integrals(model, bond, &path, h);
             let (q0, q1) = quadrature(stage, h);
             pending.push((left, right, impulse - q0, moment - q1));
-        }
-        // The bond pushes its left member back and its right member on.
-        let inv_mass = model.inv_mass();
-        for &(left, right, impulse, moment) in &pending {
-            if let Some(i) = left {
-                new_v[i] -= impulse * inv_mass[i];
-                new_q[i] -= moment * inv_mass[i];
-            }
-            if let Some(i) = right {
-                new_v[i] += impulse * inv_mass[i];
-                new_q[i] += moment * inv_mass[i];
+            if model.is_dissipative() {
+                let powers = std::array::from_fn(|s| self.stage_power[s][bond]);
+                dissipated += lost - quadrature(powers, h).0;
+                corrected.push((bond, lost));
             }
         }
+        if model.is_dissipative() {
+            // D follows the velocities, at index n_dof of them.
+            new_v[n] += dissipated;
+        }
+        apply(model, &pending, (new_q, new_v));
+        if model.is_dissipative() {
+            self.refine(model, (start, end), h, (&mut pending, &mut corrected));
+        }
+        self.corrected = corrected;
         self.events += pending.len() as u64;
         self.pending = pending;
+    }
+
+    /// A dissipative chain's corrections again, [`REFINE_PASSES`] times, each from the end
+    /// state the last one corrected. A bond's path is drawn through the step's end, and the
+    /// uncorrected end is off by what the stages made of the bond's force. For a force that
+    /// only kinks, that is small; a dashpot's force rises like √s (Hertzian) or carries
+    /// c^{3/2} beside a jump, and the end is then too far off for the path to be right to the
+    /// method's order. Each pass brings the path closer by about a power of the step.
+    fn refine(
+        &mut self,
+        model: &Model,
+        (start, end): (&[f64], &mut [f64]),
+        h: f64,
+        (pending, corrected): (&mut [Correction], &mut [(usize, f64)]),
+    ) {
+        let n = model.n_dof();
+        let (q, v) = start.split_at(n);
+        for _ in 0..REFINE_PASSES {
+            let (new_q, new_v) = end.split_at_mut(n);
+            let mut deltas = Vec::with_capacity(pending.len());
+            let mut dissipated = 0.0;
+            for (applied, (bond, lost_before)) in pending.iter_mut().zip(corrected.iter_mut()) {
+                let (left, right, impulse_before, moment_before) = *applied;
+                let path = bond_path(model, *bond, (q, v), (new_q, new_v), (left, right));
+                let (impulse, moment, lost) = bond_integrals(model, *bond, &path, h);
+                let (q0, q1) = (self.quadrature)(self.stage_forces(*bond), h);
+                *applied = (left, right, impulse - q0, moment - q1);
+                deltas.push((
+                    left,
+                    right,
+                    impulse - q0 - impulse_before,
+                    moment - q1 - moment_before,
+                ));
+                dissipated += lost - *lost_before;
+                *lost_before = lost;
+            }
+            new_v[n] += dissipated;
+            apply(model, &deltas, (new_q, new_v));
+        }
     }
 
     /// The earliest moment, as a fraction of the step in (`after`, 1), at which a contact of
@@ -179,6 +280,45 @@ impl<const S: usize> ContactEvents<S> {
             }
         }
         first
+    }
+
+    /// The earliest moment, as a fraction of the step in (0, 1), at which the force of a
+    /// damped contact of `window` switches along its path ([`first_switch`]: it closes, or its
+    /// clip starts), not counting [`negligible`] ones: where `rk4-contact` ends a step on a
+    /// dissipative chain, so that no step carries a jump or a kink of a force in its stages.
+    pub(crate) fn first_switch(
+        &mut self,
+        model: &Model,
+        (start, end): (&[f64], &[f64]),
+        h: f64,
+        window: Window,
+    ) -> Option<(f64, (usize, Option<usize>, Option<usize>))> {
+        let n = model.n_dof();
+        self.scan(model, &end[..n], window);
+        let (q, v) = start.split_at(n);
+        let (new_q, new_v) = end.split_at(n);
+        let mut first = None;
+        for &(bond, left, right) in &self.changed {
+            let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
+            if negligible(self.stage_forces(bond), end_force(model, bond, &path)) {
+                continue;
+            }
+            let delta = model.contacts().map_or(0.0, |law| law.static_overlap(bond));
+            let switch = first_switch(&path, h, |c, rate| {
+                let (force, power) = model.contact_force(bond, c - delta, rate);
+                (force.total, power)
+            });
+            if let Some(x) = switch.filter(|&x| first.is_none_or(|(f, _)| x < f)) {
+                first = Some((x, (bond, left, right)));
+            }
+        }
+        first
+    }
+
+    /// Makes the next step correct `bond` (as [`ContactEvents::first_switch`] gives it) whether
+    /// or not the scan finds it changed: a step that begins just after the bond's force switched.
+    pub(crate) fn correct_next(&mut self, bond: (usize, Option<usize>, Option<usize>)) {
+        self.carried.push(bond);
     }
 
     fn stage_forces(&self, bond: usize) -> [f64; S] {
@@ -350,7 +490,7 @@ impl<const S: usize> FixedStepScratch<S> {
         let n = model.n_dof();
         Self {
             q_stage: vec![0.0; n],
-            y_new: vec![0.0; 2 * n],
+            y_new: vec![0.0; model.state_len()],
             evals: 0,
             contact: quadrature.map(|q| ContactEvents::new(model, q)),
             names,
@@ -363,19 +503,33 @@ impl<const S: usize> FixedStepScratch<S> {
     }
 }
 
-/// Stage `stage`'s accelerations `acc` at positions `q`, recording every bond force into
-/// `contact` when a contact-event method keeps them.
+/// The velocities a Nyström method passes to [`stage_accelerations`]: none, since its forces
+/// depend on positions only. [`super::Plan::choose`] never gives such a method a dissipative
+/// model, the one kind that would read them.
+pub(crate) const NYSTROM_VELOCITIES: &[f64] = &[];
+
+/// Stage `stage`'s accelerations `acc` at positions `q` (and velocities `v`, which only a
+/// dissipative model reads), recording every bond force into `contact` when a contact-event
+/// method keeps them. Returns the stage's dissipated power (0 for a conservative chain).
 pub(crate) fn stage_accelerations<const S: usize>(
     model: &Model,
     contact: Option<&mut ContactEvents<S>>,
-    (q, acc): (&[f64], &mut [f64]),
+    (q, v, acc): (&[f64], &[f64], &mut [f64]),
     (t, stage): (f64, usize),
     window: Window,
-) {
+) -> f64 {
+    if model.is_dissipative() {
+        let record = contact.map(|c| BondRecord {
+            force: &mut c.stage_force[stage],
+            power: &mut c.stage_power[stage],
+        });
+        return model.damped_recording(t, (q, v), acc, window, record);
+    }
     match contact {
         None => model.accelerations_in(t, q, acc, window),
         Some(c) => model.accelerations_recording(t, q, acc, window, &mut c.stage_force[stage]),
     }
+    0.0
 }
 
 /// Ends a step of a method that can correct contact events: corrects `y_new` (the new state,
@@ -401,6 +555,9 @@ pub(crate) fn copy_window(model: &Model, (y, y_new): (&mut [f64], &[f64]), windo
     for r in window.dof_ranges(model) {
         q[r.clone()].copy_from_slice(&new_q[r.clone()]);
         v[r.clone()].copy_from_slice(&new_v[r]);
+    }
+    if model.is_dissipative() {
+        v[n] = new_v[n];
     }
 }
 

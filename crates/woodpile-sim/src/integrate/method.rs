@@ -75,6 +75,16 @@ impl Method {
         self.facts().adaptive
     }
 
+    /// Whether the method may run a dissipative chain, whose forces depend on velocities.
+    pub fn takes_velocity_forces(self) -> bool {
+        self.facts().velocity_forces
+    }
+
+    /// The named methods that may run a dissipative chain.
+    pub fn with_velocity_forces() -> impl Iterator<Item = Method> {
+        Method::ALL.into_iter().filter(|m| m.takes_velocity_forces())
+    }
+
     /// Largest dt * omega for which the method is stable on the linear oscillator
     /// x'' = -omega^2 x (its stability interval on the imaginary axis for RK; HLW Section I.5 for
     /// compositions), used to keep fixed steps safe for stiff resonators.
@@ -88,6 +98,10 @@ struct Facts {
     name: &'static str,
     order: u32,
     adaptive: bool,
+    /// Whether the method integrates y'' = f(t, y, y') (a Runge–Kutta method in first-order
+    /// form), so that it may run a dissipative chain; the Nyström and symplectic methods
+    /// assume forces of positions only.
+    velocity_forces: bool,
     stability_limit: f64,
     error: ErrorModel,
 }
@@ -111,6 +125,7 @@ const FACTS: [Facts; 8] = [
         name: "rk4",
         order: 4,
         adaptive: false,
+        velocity_forces: true,
         stability_limit: 2.0 * std::f64::consts::SQRT_2,
         error: ErrorModel {
             coef: 1.5e-3,
@@ -121,6 +136,7 @@ const FACTS: [Facts; 8] = [
         name: "rk4-contact",
         order: 4,
         adaptive: false,
+        velocity_forces: true,
         stability_limit: 2.0 * std::f64::consts::SQRT_2,
         error: ErrorModel {
             coef: 1.56e-2,
@@ -131,6 +147,7 @@ const FACTS: [Facts; 8] = [
         name: "rkn4-contact",
         order: 4,
         adaptive: false,
+        velocity_forces: false,
         // The spectral radius of one step on the oscillator exceeds 1 past 2.5867 (computed).
         stability_limit: 2.586,
         // A third of rk4-contact's: its R and T errors on the standard scene are 3 to 4 times
@@ -144,6 +161,7 @@ const FACTS: [Facts; 8] = [
         name: "rkn6-contact",
         order: 6,
         adaptive: false,
+        velocity_forces: false,
         // DPRKN6 is not dissipative: on x'' = -ω² x one step grows the amplitude by 1.7e-8 at
         // ωh = 0.5 and 4e-6 at 1 (computed), so its bound is the growth it may accumulate, not
         // an edge.
@@ -163,6 +181,7 @@ const FACTS: [Facts; 8] = [
         name: "verlet",
         order: 2,
         adaptive: false,
+        velocity_forces: false,
         stability_limit: 2.0,
         error: ErrorModel {
             coef: 1.5e-2,
@@ -173,6 +192,7 @@ const FACTS: [Facts; 8] = [
         name: "yoshida4",
         order: 4,
         adaptive: false,
+        velocity_forces: false,
         stability_limit: 1.57,
         error: ErrorModel {
             coef: 1.0e-2,
@@ -183,6 +203,7 @@ const FACTS: [Facts; 8] = [
         name: "yoshida6",
         order: 6,
         adaptive: false,
+        velocity_forces: false,
         stability_limit: 1.0,
         error: ErrorModel {
             coef: 3.0e-3,
@@ -193,6 +214,7 @@ const FACTS: [Facts; 8] = [
         name: "dop853",
         order: 8,
         adaptive: true,
+        velocity_forces: true,
         stability_limit: 3.5,
         error: ErrorModel {
             coef: 1.0,
@@ -257,6 +279,12 @@ pub const DRIFT_PER_TOL: f64 = 100.0;
 /// `rk4-contact` did at tolerances 1e-5 to 1e-7, with no scene missing its tolerance.
 pub const AUTO_METHOD: Method = Method::Rkn6Contact;
 
+/// The method `auto` verifies on a dissipative chain, whose dashpots make the forces depend
+/// on velocities, which the Nyström methods cannot take: RK4 with exact contact events, each
+/// event bond's force (spring, dashpot and clip) integrated along its path
+/// (docs/methods.md, "Dissipation").
+pub const DISSIPATIVE_AUTO_METHOD: Method = Method::Rk4Contact;
+
 /// Largest omega * dt `auto` and tolerance-driven fixed steps accept for the fastest linear
 /// resonator: keeps its phase accurate, not merely stable.
 const MAX_OMEGA_DT: f64 = 0.5;
@@ -284,8 +312,18 @@ impl Plan {
         }
         let method = match choice {
             MethodChoice::Named(m) => m,
+            MethodChoice::Auto if model.is_dissipative() => DISSIPATIVE_AUTO_METHOD,
             MethodChoice::Auto => AUTO_METHOD,
         };
+        if model.is_dissipative() && !method.takes_velocity_forces() {
+            return Err(SimError::VelocityForces {
+                method: method.name(),
+                methods: Method::with_velocity_forces()
+                    .map(Method::name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            });
+        }
         let tolerance_drift = (DRIFT_PER_TOL * tol).max(1e-12);
         if method.is_adaptive() {
             let rtol = (tol * DOP853_RTOL_PER_TOL).max(1e-14);
@@ -354,7 +392,8 @@ impl Plan {
     pub fn resolving_dt(model: &Model, energy: f64) -> f64 {
         let omega = model
             .max_resonator_omega(energy)
-            .max(model.max_contact_omega(energy));
+            .max(model.max_contact_omega(energy))
+            .max(model.max_dissipation_rate(energy));
         if omega > 0.0 {
             MAX_OMEGA_DT / omega
         } else {

@@ -59,6 +59,86 @@ impl Stepper for Rk4Fused {
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        if !locates_switches(model, &self.scratch) {
+            self.stages(model, y, span);
+            finish_step(self.scratch.contact.as_mut(), model, (y, &mut self.scratch.y_new), span.h, span.window);
+            return StepOutcome::Accepted { h_next: span.h };
+        }
+        // A contact dashpot's force switches inside a step: it jumps to γ ċ as a contact
+        // closes (linear law), and has a kink where its clip starts. RK4's later stages would
+        // carry those into every stage state, which the bond's own correction cannot undo
+        // (order 2 instead of 3). So the step ends where the first force switches, and goes on
+        // from there.
+        let mut rest = span;
+        for split in 0..=MAX_LOCATED {
+            self.stages(model, y, rest);
+            let s = &mut self.scratch;
+            let contact = s.contact.as_mut().expect("a located step keeps contact events");
+            let switch = match split < MAX_LOCATED {
+                true => contact.first_switch(model, (y, &s.y_new), rest.h, rest.window),
+                false => None,
+            };
+            // Switches within MIN_LOCATED of a step's ends (in the whole step's measure) are
+            // left to the correction. A located step ends LATE after its switch, so that its
+            // last stage alone sees the new force; the next step is corrected on that bond,
+            // whose force is not smooth just behind its start.
+            let away = |x: f64| {
+                x * rest.h > MIN_LOCATED * span.h && (1.0 - x) * rest.h > MIN_LOCATED * span.h
+            };
+            match switch.filter(|&(x, _)| away(x)) {
+                None => break,
+                Some((x, bond)) => {
+                    let first = StepSpan {
+                        h: x * rest.h + LATE * span.h,
+                        ..rest
+                    };
+                    self.stages(model, y, first);
+                    let s = &mut self.scratch;
+                    finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), first.h, first.window);
+                    if let Some(contact) = s.contact.as_mut() {
+                        contact.correct_next(bond);
+                    }
+                    rest = StepSpan {
+                        t: rest.t + first.h,
+                        h: rest.h - first.h,
+                        ..rest
+                    };
+                }
+            }
+        }
+        let s = &mut self.scratch;
+        finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), rest.h, rest.window);
+        StepOutcome::Accepted { h_next: span.h }
+    }
+
+    fn reach(&self) -> usize {
+        4
+    }
+
+    fn rhs_evals(&self) -> u64 {
+        self.scratch.evals
+    }
+}
+
+/// Most force switches one step is split at; one beyond them is corrected as any event.
+const MAX_LOCATED: usize = 8;
+
+/// A switch this close to either end of a step (as a fraction of it) is left to the correction.
+const MIN_LOCATED: f64 = 1e-6;
+
+/// How far after a switch a located step ends, as a fraction of the whole step.
+const LATE: f64 = 1e-8;
+
+/// Whether `rk4-contact` ends its steps at force switches: on a chain whose contacts carry a
+/// dashpot.
+fn locates_switches(model: &Model, scratch: &FixedStepScratch<4>) -> bool {
+    scratch.contact.is_some() && model.damping().is_some_and(|d| d.contact > 0.0)
+}
+
+impl Rk4Fused {
+    /// RK4's four stages from `y` over `span`, the new state (uncorrected) left in the
+    /// scratch's `y_new`.
+    fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan) {
         let StepSpan { t, h, window } = span;
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
@@ -68,15 +148,19 @@ impl Stepper for Rk4Fused {
         // Stage 1 is the state itself: its accelerations are taken at q directly, and the
         // first pass below writes y + (h b_1) k_1 and stage 2 from (q, v) instead of copying
         // (q, v) into four buffers first. Same operations on the same operands, same bits.
-        stage_accelerations(
+        let mut power = stage_accelerations(
             model,
             s.contact.as_mut(),
-            (q, &mut self.a_stage),
+            (q, v, &mut self.a_stage),
             (t, 0),
             window,
         );
+        // D, the dissipated energy (a dissipative chain only), is the state's last entry: RK4
+        // integrates its rate, the power, with the same weights and in the same order.
+        let mut dissipated = model.dissipated(y);
         for stage in 0..4 {
             let hb = h * B[stage];
+            dissipated += hb * power;
             let next = A_NEXT.get(stage).map(|&a| h * a);
             for r in ranges.clone() {
                 let len = r.len();
@@ -114,25 +198,18 @@ impl Stepper for Rk4Fused {
                 }
             }
             if stage < 3 {
-                stage_accelerations(
+                power = stage_accelerations(
                     model,
                     s.contact.as_mut(),
-                    (&s.q_stage, &mut self.a_stage),
+                    (&s.q_stage, &self.v_stage, &mut self.a_stage),
                     (t + C[stage + 1] * h, stage + 1),
                     window,
                 );
             }
         }
+        if model.is_dissipative() {
+            s.y_new[2 * n] = dissipated;
+        }
         s.evals += 4;
-        finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), h, window);
-        StepOutcome::Accepted { h_next: h }
-    }
-
-    fn reach(&self) -> usize {
-        4
-    }
-
-    fn rhs_evals(&self) -> u64 {
-        self.scratch.evals
     }
 }

@@ -20,7 +20,7 @@
 //! closes, so that no step contains a kink, and the next step starts there.
 
 use super::event_correction::{
-    copy_window, finish_step, stage_accelerations, ContactEvents, Quadrature,
+    copy_window, finish_step, stage_accelerations, ContactEvents, Quadrature, NYSTROM_VELOCITIES,
 };
 use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
@@ -240,7 +240,7 @@ impl<const S: usize> Rkn<S> {
             stage_accelerations(
                 model,
                 self.contact.as_mut(),
-                (qs, &mut self.a[i]),
+                (qs, NYSTROM_VELOCITIES, &mut self.a[i]),
                 (t + tab.c[i] * h, i),
                 window,
             );

@@ -22,7 +22,9 @@
 //! where the tableau stepper takes 6.7 ms (1.18x; best of 15, `cargo run --release -p
 //! woodpile-bench --example nystrom4`).
 
-use super::event_correction::{finish_step, stage_accelerations, FixedStepScratch, Quadrature};
+use super::event_correction::{
+    finish_step, stage_accelerations, FixedStepScratch, Quadrature, NYSTROM_VELOCITIES,
+};
 use super::{StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
@@ -83,7 +85,7 @@ impl Stepper for Rkn4 {
         stage_accelerations(
             model,
             s.contact.as_mut(),
-            (&y[..n], &mut self.a[0]),
+            (&y[..n], NYSTROM_VELOCITIES, &mut self.a[0]),
             (t, 0),
             window,
         );
@@ -105,7 +107,7 @@ impl Stepper for Rkn4 {
             stage_accelerations(
                 model,
                 s.contact.as_mut(),
-                (&s.q_stage, &mut self.a[stage + 1]),
+                (&s.q_stage, NYSTROM_VELOCITIES, &mut self.a[stage + 1]),
                 (t + C[stage + 1] * h, stage + 1),
                 window,
             );

@@ -1,0 +1,107 @@
+//! `[damping]` and each defect's `damping` or `quality_factor`: the dissipation of a chain
+//! (woodpile_sim::damping). SI scenes give N·s/m (N·s/m^{3/2} for a Hertzian contact dashpot),
+//! converted here; the converted values are listed in the JSON's `physical` block.
+
+use woodpile_sim::model::{Coupling, Resonator};
+use woodpile_sim::{DashpotLaw, Damping};
+
+use super::check::{invalid, non_negative, positive, Invalid};
+use super::physical::Si;
+use crate::raw;
+
+/// The damping `file` declares, in the model's units, with the converted values an SI scene
+/// lists; `None` when it declares none.
+pub(crate) fn damping(
+    file: &raw::SceneFile,
+    resonators: &[Resonator],
+    masses: &[f64],
+    si: Option<&Si>,
+) -> Result<Option<(Damping, Vec<(String, f64)>)>, Invalid> {
+    let table = file.damping.as_ref();
+    let any_defect = file
+        .defect
+        .iter()
+        .any(|d| d.damping.is_some() || d.quality_factor.is_some());
+    if table.is_none() && !any_defect {
+        return Ok(None);
+    }
+    let law = match table.and_then(|t| t.law.as_deref()) {
+        None | Some("linear") => DashpotLaw::Linear,
+        Some("hertzian") => DashpotLaw::Hertzian,
+        Some(other) => {
+            return Err(invalid(
+                "damping.law",
+                format!("must be \"linear\" or \"hertzian\", got \"{other}\""),
+            ))
+        }
+    };
+    let listed = std::cell::RefCell::new(Vec::new());
+    let convert = |key: &str, value: Option<f64>, scale: fn(&Si, f64) -> f64| {
+        let value = non_negative(key, value.unwrap_or(0.0))?;
+        Ok::<f64, Invalid>(match si {
+            Some(si) if value > 0.0 => {
+                let scaled = scale(si, value);
+                listed.borrow_mut().push((key.replace(['.', '[', ']'], "_"), scaled));
+                scaled
+            }
+            _ => value,
+        })
+    };
+    let contact_scale: fn(&Si, f64) -> f64 = match law {
+        DashpotLaw::Linear => |si, c| si.scales.dashpot(c),
+        DashpotLaw::Hertzian => |si, c| si.scales.hertzian_dashpot(c),
+    };
+    let contact = convert("damping.contact", table.and_then(|t| t.contact), contact_scale)?;
+    let ground = convert("damping.ground", table.and_then(|t| t.ground), |si, c| {
+        si.scales.dashpot(c)
+    })?;
+    let mut per_resonator = Vec::with_capacity(resonators.len());
+    for (j, (d, r)) in file.defect.iter().zip(resonators).enumerate() {
+        let c = match (d.damping, d.quality_factor) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    format!("defect[{j}].quality_factor"),
+                    "give damping or quality_factor, not both",
+                ))
+            }
+            (Some(c), None) => convert(&format!("defect[{j}].damping"), Some(c), |si, c| {
+                si.scales.dashpot(c)
+            })?,
+            (None, Some(q)) => {
+                let c = from_quality_factor(&format!("defect[{j}].quality_factor"), q, r, masses)?;
+                if si.is_some() {
+                    listed.borrow_mut().push((format!("defect_{j}__damping"), c));
+                }
+                c
+            }
+            (None, None) => 0.0,
+        };
+        per_resonator.push(c);
+    }
+    let damping = Damping::new(contact, law, ground, per_resonator)
+        .map_err(|e| invalid("damping", e.to_string()))?;
+    Ok(Some((damping, listed.into_inner())))
+}
+
+/// c_j of a linear resonator with quality factor `q`: the pair vibrates against each other
+/// with reduced mass μ = m_host ε / (m_host + ε) at ω = sqrt(κ / μ), and Q = μ ω / c.
+fn from_quality_factor(
+    key: &str,
+    q: f64,
+    r: &Resonator,
+    masses: &[f64],
+) -> Result<f64, Invalid> {
+    let q = positive(key, q)?;
+    let kappa = match r.coupling {
+        Coupling::Constant(k) if r.p == 1 && k > 0.0 => k,
+        _ => {
+            return Err(invalid(
+                key,
+                "a quality factor needs a linear resonator (p = 1) with a constant kappa > 0; give damping instead",
+            ))
+        }
+    };
+    let host = masses[r.site];
+    let reduced = host * r.eps / (host + r.eps);
+    Ok(reduced * (kappa / reduced).sqrt() / q)
+}
