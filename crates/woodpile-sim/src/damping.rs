@@ -139,8 +139,16 @@ impl Model {
         let mut power = 0.0;
         let boundary = self.boundary();
         // Bonds b join sites b − 1 and b; a wall is a member at rest.
-        let first = if lo == 0 && boundary.left_wall() { 0 } else { lo + 1 };
-        let last = if hi == n_sites - 1 && boundary.right_wall() { n_sites } else { hi };
+        let first = if lo == 0 && boundary.left_wall() {
+            0
+        } else {
+            lo + 1
+        };
+        let last = if hi == n_sites - 1 && boundary.right_wall() {
+            n_sites
+        } else {
+            hi
+        };
         for bond in first..=last {
             let left = bond.checked_sub(1);
             let right = (bond < n_sites).then_some(bond);
@@ -207,7 +215,14 @@ impl Model {
             }
             _ => elastic,
         };
-        (BondForce { total, elastic, rest }, (total - elastic) * rate)
+        (
+            BondForce {
+                total,
+                elastic,
+                rest,
+            },
+            (total - elastic) * rate,
+        )
     }
 
     /// The fastest rate, 1/time, at which the chain's dashpots and soft ends act in a
@@ -219,7 +234,10 @@ impl Model {
         let n = self.n_sites();
         let inv = |site: Option<usize>| site.map_or(0.0, |i| self.inv_mass()[i]);
         let mut rate: f64 = 0.0;
-        for (site, end) in [(0, self.boundary().left()), (n - 1, self.boundary().right())] {
+        for (site, end) in [
+            (0, self.boundary().left()),
+            (n - 1, self.boundary().right()),
+        ] {
             if let Some((spring, damping)) = end.soft() {
                 let inv_m = self.inv_mass()[site];
                 rate = rate.max((spring * inv_m).sqrt()).max(damping * inv_m);

@@ -34,6 +34,6 @@ pub mod testing;
 pub mod units;
 
 pub use contact::ContactLaw;
-pub use damping::{DashpotLaw, Damping};
+pub use damping::{Damping, DashpotLaw};
 pub use error::{ModelError, OverBudget, SimError, StepSetBy};
 pub use model::{Boundary, Coupling, End, Model, Resonator};

@@ -108,7 +108,10 @@ mod tests {
         let dimensionless = s.dashpot(c) / (s.spring(k) * (t_phys / s.time_s()));
         assert!((dimensionless - c / (k * t_phys)).abs() < 1e-12);
         // The Hertzian dashpot at an overlap of one length scale is the linear one.
-        assert!((s.hertzian_dashpot(c) / s.length_m().sqrt() - s.dashpot(c)).abs() < 1e-12 * s.dashpot(c));
+        assert!(
+            (s.hertzian_dashpot(c) / s.length_m().sqrt() - s.dashpot(c)).abs()
+                < 1e-12 * s.dashpot(c)
+        );
     }
 
     /// The rescaling makes the Hertz law unit-free: a L^{1/2} T^2 / M = 1.

@@ -55,7 +55,10 @@ impl Layout {
 /// A soft end `{ spring = k, damping = c }`: a linear spring and a dashpot on a rigid support
 /// (both default to 0; an SI scene gives N/m and N·s/m).
 fn soft_end(key: &str, table: &toml::Table, si: Option<&Si>) -> Result<End, Invalid> {
-    if let Some(other) = table.keys().find(|k| !["spring", "damping"].contains(&k.as_str())) {
+    if let Some(other) = table
+        .keys()
+        .find(|k| !["spring", "damping"].contains(&k.as_str()))
+    {
         return Err(invalid(
             format!("{key}.{other}"),
             "unknown key; a soft end has spring and damping",

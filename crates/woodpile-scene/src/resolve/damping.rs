@@ -3,7 +3,7 @@
 //! converted here; the converted values are listed in the JSON's `physical` block.
 
 use woodpile_sim::model::{Coupling, Resonator};
-use woodpile_sim::{DashpotLaw, Damping};
+use woodpile_sim::{Damping, DashpotLaw};
 
 use super::check::{invalid, non_negative, positive, Invalid};
 use super::physical::Si;
@@ -41,7 +41,9 @@ pub(crate) fn damping(
         Ok::<f64, Invalid>(match si {
             Some(si) if value > 0.0 => {
                 let scaled = scale(si, value);
-                listed.borrow_mut().push((key.replace(['.', '[', ']'], "_"), scaled));
+                listed
+                    .borrow_mut()
+                    .push((key.replace(['.', '[', ']'], "_"), scaled));
                 scaled
             }
             _ => value,
@@ -51,7 +53,11 @@ pub(crate) fn damping(
         DashpotLaw::Linear => |si, c| si.scales.dashpot(c),
         DashpotLaw::Hertzian => |si, c| si.scales.hertzian_dashpot(c),
     };
-    let contact = convert("damping.contact", table.and_then(|t| t.contact), contact_scale)?;
+    let contact = convert(
+        "damping.contact",
+        table.and_then(|t| t.contact),
+        contact_scale,
+    )?;
     let ground = convert("damping.ground", table.and_then(|t| t.ground), |si, c| {
         si.scales.dashpot(c)
     })?;
@@ -70,7 +76,9 @@ pub(crate) fn damping(
             (None, Some(q)) => {
                 let c = from_quality_factor(&format!("defect[{j}].quality_factor"), q, r, masses)?;
                 if si.is_some() {
-                    listed.borrow_mut().push((format!("defect_{j}__damping"), c));
+                    listed
+                        .borrow_mut()
+                        .push((format!("defect_{j}__damping"), c));
                 }
                 c
             }
@@ -85,12 +93,7 @@ pub(crate) fn damping(
 
 /// c_j of a linear resonator with quality factor `q`: the pair vibrates against each other
 /// with reduced mass μ = m_host ε / (m_host + ε) at ω = sqrt(κ / μ), and Q = μ ω / c.
-fn from_quality_factor(
-    key: &str,
-    q: f64,
-    r: &Resonator,
-    masses: &[f64],
-) -> Result<f64, Invalid> {
+fn from_quality_factor(key: &str, q: f64, r: &Resonator, masses: &[f64]) -> Result<f64, Invalid> {
     let q = positive(key, q)?;
     let kappa = match r.coupling {
         Coupling::Constant(k) if r.p == 1 && k > 0.0 => k,

@@ -147,7 +147,9 @@ pub(crate) fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Re
     let error = match woodpile_sim::run::budget::check(scenario) {
         Ok(()) => return Ok(()),
         Err(SimError::OverBudget(over)) => over,
-        Err(e @ SimError::VelocityForces { .. }) => return Err(invalid("run.method", e.to_string())),
+        Err(e @ SimError::VelocityForces { .. }) => {
+            return Err(invalid("run.method", e.to_string()))
+        }
         Err(other) => return Err(invalid("run", other.to_string())),
     };
     let longest_step = 0.25;

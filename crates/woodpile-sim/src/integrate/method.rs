@@ -82,7 +82,9 @@ impl Method {
 
     /// The named methods that may run a dissipative chain.
     pub fn with_velocity_forces() -> impl Iterator<Item = Method> {
-        Method::ALL.into_iter().filter(|m| m.takes_velocity_forces())
+        Method::ALL
+            .into_iter()
+            .filter(|m| m.takes_velocity_forces())
     }
 
     /// Largest dt * omega for which the method is stable on the linear oscillator

@@ -61,7 +61,13 @@ impl Stepper for Rk4Fused {
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
         if !locates_switches(model, &self.scratch) {
             self.stages(model, y, span);
-            finish_step(self.scratch.contact.as_mut(), model, (y, &mut self.scratch.y_new), span.h, span.window);
+            finish_step(
+                self.scratch.contact.as_mut(),
+                model,
+                (y, &mut self.scratch.y_new),
+                span.h,
+                span.window,
+            );
             return StepOutcome::Accepted { h_next: span.h };
         }
         // A contact dashpot's force switches inside a step: it jumps to γ ċ as a contact
@@ -73,7 +79,10 @@ impl Stepper for Rk4Fused {
         for split in 0..=MAX_LOCATED {
             self.stages(model, y, rest);
             let s = &mut self.scratch;
-            let contact = s.contact.as_mut().expect("a located step keeps contact events");
+            let contact = s
+                .contact
+                .as_mut()
+                .expect("a located step keeps contact events");
             let switch = match split < MAX_LOCATED {
                 true => contact.first_switch(model, (y, &s.y_new), rest.h, rest.window),
                 false => None,
@@ -94,7 +103,13 @@ impl Stepper for Rk4Fused {
                     };
                     self.stages(model, y, first);
                     let s = &mut self.scratch;
-                    finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), first.h, first.window);
+                    finish_step(
+                        s.contact.as_mut(),
+                        model,
+                        (y, &mut s.y_new),
+                        first.h,
+                        first.window,
+                    );
                     if let Some(contact) = s.contact.as_mut() {
                         contact.correct_next(bond);
                     }
@@ -107,7 +122,13 @@ impl Stepper for Rk4Fused {
             }
         }
         let s = &mut self.scratch;
-        finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), rest.h, rest.window);
+        finish_step(
+            s.contact.as_mut(),
+            model,
+            (y, &mut s.y_new),
+            rest.h,
+            rest.window,
+        );
         StepOutcome::Accepted { h_next: span.h }
     }
 
