@@ -198,6 +198,9 @@ impl Grid {
             names.push(axis.name.clone());
         }
         let ok = |i: usize| points[i].as_ref().ok();
+        // D on every row of a sweep whose scene declares dissipation (0 where it dissipates
+        // nothing), as in a pipeline sweep's table.
+        let dissipation = self.template.declares_dissipation();
         let mut float =
             |name: &str, f: &dyn Fn(&Point, Option<usize>) -> Option<f64>| -> PyResult<()> {
                 let v: Vec<f64> = rows
@@ -215,11 +218,17 @@ impl Grid {
             float("R", &|p, k| sample(p, k, |s| &s.reflected))?;
             float("T", &|p, k| sample(p, k, |s| &s.transmitted))?;
             float("E_tr", &|p, k| sample(p, k, |s| &s.trapped))?;
+            if dissipation {
+                float("D", &|p, k| sample(p, k, |s| &s.dissipated))?;
+            }
             float("E", &|p, k| sample(p, k, |s| &s.energy))?;
         } else {
             float("R", &|p, _| Some(p.outcome.fractions.reflected))?;
             float("T", &|p, _| Some(p.outcome.fractions.transmitted))?;
             float("E_tr", &|p, _| Some(p.outcome.fractions.trapped))?;
+            if dissipation {
+                float("D", &|p, _| Some(p.outcome.fractions.dissipated))?;
+            }
             float("E_initial", &|p, _| Some(p.outcome.e_initial))?;
             float("E_final", &|p, _| Some(p.outcome.e_final))?;
         }

@@ -63,6 +63,8 @@ pub struct PointData {
     /// S(t), the striker's share: only for a scene with a striker, so that a paper point's
     /// data (and file) is what it was before strikers existed.
     pub striker: Option<Vec<f64>>,
+    /// D(t), the dissipated share: only for a dissipative scene, for the same reason.
+    pub dissipated: Option<Vec<f64>>,
 }
 
 /// Which energy a sweep's fractions split.
@@ -124,6 +126,7 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
         transmitted: series.transmitted,
         trapped: series.trapped,
         striker: s.region.has_striker().then_some(series.striker),
+        dissipated: s.model.is_dissipative().then_some(series.dissipated),
         energy: series.energy,
     })
 }
@@ -274,8 +277,24 @@ fn encode(key: &Key, result: &PointResult) -> Vec<u8> {
             put_f64(&mut w, p.e_final);
             w.extend_from_slice(&(p.t.len() as u64).to_le_bytes());
             let columns = [&p.t, &p.reflected, &p.transmitted, &p.trapped, &p.energy];
-            for column in columns.into_iter().chain(&p.striker) {
-                column.iter().for_each(|&x| put_f64(&mut w, x));
+            let put_column = |w: &mut Vec<u8>, column: &[f64]| {
+                column.iter().for_each(|&x| put_f64(w, x));
+            };
+            for column in columns {
+                put_column(&mut w, column);
+            }
+            // The optional columns: a striker's S alone as it always was (so that its points
+            // keep their bytes), and with D each behind its tag.
+            match &p.dissipated {
+                None => p.striker.iter().for_each(|s| put_column(&mut w, s)),
+                Some(d) => {
+                    for (tag, column) in [(b'S', p.striker.as_ref()), (b'D', Some(d))] {
+                        if let Some(column) = column {
+                            w.push(tag);
+                            put_column(&mut w, column);
+                        }
+                    }
+                }
             }
         }
     }
@@ -312,12 +331,24 @@ fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
             let (steps, rhs_evals) = (r.u64()?, r.u64()?);
             let (e_initial, e_final) = (r.f64()?, r.f64()?);
             let n = usize::try_from(r.u64()?).ok()?;
-            let with_striker = match r.bytes.len() {
-                len if len == n.checked_mul(5 * 8)? => false,
-                len if len == n.checked_mul(6 * 8)? => true,
-                _ => return None,
-            };
-            let mut column = || (0..n).map(|_| r.f64()).collect::<Option<Vec<f64>>>();
+            // Five columns, then S untagged (a striker's point as it always was), or tagged
+            // optional columns (S and D with damping), which never add up to six columns.
+            let legacy_striker = n > 0 && r.bytes.len() == n.checked_mul(6 * 8)?;
+            let column = |r: &mut Reader| (0..n).map(|_| r.f64()).collect::<Option<Vec<f64>>>();
+            let base: Vec<Vec<f64>> = (0..5).map(|_| column(&mut r)).collect::<Option<_>>()?;
+            let [t, reflected, transmitted, trapped, energy] =
+                <[Vec<f64>; 5]>::try_from(base).ok()?;
+            let (mut striker, mut dissipated) = (None, None);
+            if legacy_striker {
+                striker = Some(column(&mut r)?);
+            }
+            while !r.bytes.is_empty() {
+                match r.take(1)?[0] {
+                    b'S' if striker.is_none() => striker = Some(column(&mut r)?),
+                    b'D' if dissipated.is_none() => dissipated = Some(column(&mut r)?),
+                    _ => return None,
+                }
+            }
             Ok(PointData {
                 method,
                 dt,
@@ -327,15 +358,13 @@ fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
                 energy_drift,
                 e_initial,
                 e_final,
-                t: column()?,
-                reflected: column()?,
-                transmitted: column()?,
-                trapped: column()?,
-                energy: column()?,
-                striker: match with_striker {
-                    true => Some(column()?),
-                    false => None,
-                },
+                t,
+                reflected,
+                transmitted,
+                trapped,
+                energy,
+                striker,
+                dissipated,
             })
         }
         _ => return None,
@@ -388,6 +417,7 @@ mod tests {
             trapped: vec![1.0, 0.7],
             energy: vec![0.5, 0.5],
             striker: None,
+            dissipated: None,
         }
     }
 
@@ -440,6 +470,21 @@ mod tests {
         };
         store.save(&key, &Ok(with.clone())).unwrap();
         assert_eq!(store.load(&key), Some(Ok(with)));
+    }
+
+    #[test]
+    fn the_dissipated_share_round_trips_with_and_without_a_striker() {
+        let (_dir, store, _) = store_with_sample("five");
+        for (name, striker) in [("d", None), ("sd", Some(vec![0.0, 0.25]))] {
+            let key = Key::of(&serde_json::json!(name));
+            let with = PointData {
+                striker,
+                dissipated: Some(vec![0.0, 0.5]),
+                ..sample()
+            };
+            store.save(&key, &Ok(with.clone())).unwrap();
+            assert_eq!(store.load(&key), Some(Ok(with)));
+        }
     }
 
     #[test]

@@ -41,6 +41,30 @@ impl Template {
         Ok(Self { table })
     }
 
+    /// Whether the scene declares dissipation (a `[damping]` table, a defect's `damping` or
+    /// `quality_factor`, or a soft end's `damping`), whatever values its axes take: the
+    /// sweep's table then has the dissipated share `D` on every row (0 where the values
+    /// dissipate nothing).
+    pub fn declares_dissipation(&self) -> bool {
+        let has = |value: Option<&toml::Value>, keys: &[&str]| {
+            value
+                .and_then(toml::Value::as_table)
+                .is_some_and(|t| keys.iter().any(|k| t.contains_key(*k)))
+        };
+        let defects = self.table.get("defect").and_then(toml::Value::as_array);
+        let boundary = self
+            .table
+            .get("chain")
+            .and_then(|c| c.get("boundary"))
+            .and_then(toml::Value::as_table);
+        self.table.contains_key("damping")
+            || defects.is_some_and(|list| {
+                list.iter()
+                    .any(|d| has(Some(d), &["damping", "quality_factor"]))
+            })
+            || boundary.is_some_and(|ends| ends.values().any(|end| has(Some(end), &["damping"])))
+    }
+
     /// The scene table at the grid point `values` (one per axis, in `axes` order).
     pub fn instantiate(
         &self,

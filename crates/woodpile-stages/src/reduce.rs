@@ -99,7 +99,11 @@ impl Reduce {
             None => picks,
             Some(m) => maximize(&picks, axes, m),
         };
-        let reduced: Vec<Reduced> = rows.iter().map(|pick| Reduced { axes, pick }).collect();
+        let shares = sweep.shares();
+        let reduced: Vec<Reduced> = rows
+            .iter()
+            .map(|pick| Reduced { axes, pick, shares })
+            .collect();
         let failed: usize = rows.iter().map(|p| p.failed).sum();
         Ok(Output::table(
             rows_frame(&reduced)?,
@@ -112,6 +116,8 @@ impl Reduce {
 struct Reduced<'a> {
     axes: &'a [Axis],
     pick: &'a Pick,
+    /// Whether the input has the striker's share S and the dissipated share D.
+    shares: [bool; 2],
 }
 
 impl Row for Reduced<'_> {
@@ -135,6 +141,16 @@ impl Row for Reduced<'_> {
             (Fraction::Reflected.column(), at(|r| r.r).into()),
             (Fraction::Transmitted.column(), at(|r| r.tr).into()),
             (Fraction::Trapped.column(), at(|r| r.e_tr).into()),
+        ]);
+        for (present, (column, share)) in self.shares.into_iter().zip([
+            (sweep::STRIKER, p.row.and_then(|r| r.s)),
+            (sweep::DISSIPATED, p.row.and_then(|r| r.d)),
+        ]) {
+            if present {
+                cells.push((column, share.into()));
+            }
+        }
+        cells.extend([
             (sweep::ENERGY, at(|r| r.e).into()),
             (
                 sweep::ERROR_ESTIMATE,
@@ -155,6 +171,10 @@ struct Sample {
     r: f64,
     tr: f64,
     e_tr: f64,
+    /// The striker's share S, where the sweep has one.
+    s: Option<f64>,
+    /// The dissipated share D, where the sweep has one.
+    d: Option<f64>,
     e: f64,
     error_estimate: Option<f64>,
 }
@@ -177,6 +197,9 @@ struct SweepRows {
     r: Vec<Option<f64>>,
     tr: Vec<Option<f64>>,
     e_tr: Vec<Option<f64>>,
+    /// S and D, for the sweeps that have them.
+    s: Option<Vec<Option<f64>>>,
+    d: Option<Vec<Option<f64>>>,
     e: Vec<Option<f64>>,
     error_estimate: Vec<Option<f64>>,
     failure: Vec<Option<String>>,
@@ -194,10 +217,17 @@ impl SweepRows {
             r: f64_column(frame, Fraction::Reflected.column())?,
             tr: f64_column(frame, Fraction::Transmitted.column())?,
             e_tr: f64_column(frame, Fraction::Trapped.column())?,
+            s: optional_column(frame, sweep::STRIKER)?,
+            d: optional_column(frame, sweep::DISSIPATED)?,
             e: f64_column(frame, sweep::ENERGY)?,
             error_estimate: f64_column(frame, sweep::ERROR_ESTIMATE)?,
             failure: str_column(frame, sweep::FAILURE)?,
         })
+    }
+
+    /// Whether the table has S and D.
+    fn shares(&self) -> [bool; 2] {
+        [self.s.is_some(), self.d.is_some()]
     }
 
     fn row(&self, i: usize) -> Option<Sample> {
@@ -206,6 +236,8 @@ impl SweepRows {
             r: self.r[i]?,
             tr: self.tr[i]?,
             e_tr: self.e_tr[i]?,
+            s: self.s.as_ref().and_then(|c| c[i]),
+            d: self.d.as_ref().and_then(|c| c[i]),
             e: self.e[i]?,
             error_estimate: self.error_estimate[i],
         })
@@ -261,6 +293,17 @@ impl SweepRows {
             start = end;
         }
         Ok(picks)
+    }
+}
+
+/// A float column the sweep table has only for some scenes (S, D), or `None`.
+fn optional_column(
+    frame: &polars::prelude::DataFrame,
+    name: &str,
+) -> Result<Option<Vec<Option<f64>>>> {
+    match frame.column(name) {
+        Ok(_) => Ok(Some(f64_column(frame, name)?)),
+        Err(_) => Ok(None),
     }
 }
 

@@ -11,6 +11,8 @@ pub mod sweep {
     pub const TIME: &str = "t";
     /// The striker's share S (only in sweeps whose scenes have a `[striker]`).
     pub const STRIKER: &str = "S";
+    /// The dissipated share D (sweeps of scenes with damping).
+    pub const DISSIPATED: &str = "D";
     /// The total energy (or, for a kinetic series, the kinetic share of the impact energy).
     pub const ENERGY: &str = "E";
     /// The method of the reported run.

@@ -60,6 +60,8 @@ pub struct Sweep {
     file: PathBuf,
     /// Whether its scenes have a striker: the table then has the striker's share `S`.
     with_striker: bool,
+    /// Whether its scene declares dissipation: the table then has the dissipated share `D`.
+    with_dissipation: bool,
 }
 
 impl Sweep {
@@ -93,12 +95,14 @@ impl Sweep {
                 reason,
                 source: None,
             })?;
+        let with_dissipation = template.declares_dissipation();
         let sweep = Sweep {
             axes,
             series,
             template,
             file: file.to_path_buf(),
             with_striker: false,
+            with_dissipation,
         };
         // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
         // the grid exercise the extremes of every axis. A placeholder cannot add or remove a
@@ -237,6 +241,7 @@ impl Sweep {
                     result,
                     sample: k,
                     with_striker: self.with_striker,
+                    with_dissipation: self.with_dissipation,
                 });
             }
         }
@@ -253,6 +258,7 @@ struct SampleRow<'a> {
     result: &'a PointResult,
     sample: usize,
     with_striker: bool,
+    with_dissipation: bool,
 }
 
 impl Row for SampleRow<'_> {
@@ -280,6 +286,11 @@ impl Row for SampleRow<'_> {
         if self.with_striker {
             let share = ok.and_then(|p| p.striker.as_ref().map(|s| s[self.sample]));
             cells.push((columns::STRIKER, share.into()));
+        }
+        if self.with_dissipation {
+            // A point whose values dissipate nothing has no D series: it lost nothing.
+            let lost = ok.map(|p| p.dissipated.as_ref().map_or(0.0, |d| d[self.sample]));
+            cells.push((columns::DISSIPATED, lost.into()));
         }
         cells.extend([
             (columns::ENERGY, at(|p| &p.energy).into()),
