@@ -158,6 +158,34 @@ impl Grid {
             .unwrap_or_else(|panic| Err(internal_message(&panic)))
     }
 
+    /// Each axis's value on every row (integer axes as integers), named in `names`.
+    fn axis_columns(
+        &self,
+        py: Python<'_>,
+        out: &Bound<'_, PyDict>,
+        rows: &[(usize, Option<usize>)],
+        names: &mut Vec<String>,
+    ) -> PyResult<()> {
+        for (a, axis) in self.axes.iter().enumerate() {
+            let value = |i: usize| point(&self.axes, i)[a];
+            if axis.is_integer() {
+                let v: Vec<i64> = rows
+                    .iter()
+                    .map(|&(i, _)| match value(i) {
+                        AxisValue::Int(x) => x,
+                        AxisValue::Float(x) => x as i64,
+                    })
+                    .collect();
+                out.set_item(&axis.name, v.into_pyarray(py))?;
+            } else {
+                let v: Vec<f64> = rows.iter().map(|&(i, _)| value(i).as_f64()).collect();
+                out.set_item(&axis.name, v.into_pyarray(py))?;
+            }
+            names.push(axis.name.clone());
+        }
+        Ok(())
+    }
+
     /// The table, column by column: one row per point, or per point and sample.
     fn columns<'py>(
         &self,
@@ -180,23 +208,7 @@ impl Grid {
         let mut names = vec!["point".to_string()];
         let index: Vec<i64> = rows.iter().map(|&(i, _)| i as i64).collect();
         out.set_item("point", index.into_pyarray(py))?;
-        for (a, axis) in self.axes.iter().enumerate() {
-            let value = |i: usize| point(&self.axes, i)[a];
-            if axis.is_integer() {
-                let v: Vec<i64> = rows
-                    .iter()
-                    .map(|&(i, _)| match value(i) {
-                        AxisValue::Int(x) => x,
-                        AxisValue::Float(x) => x as i64,
-                    })
-                    .collect();
-                out.set_item(&axis.name, v.into_pyarray(py))?;
-            } else {
-                let v: Vec<f64> = rows.iter().map(|&(i, _)| value(i).as_f64()).collect();
-                out.set_item(&axis.name, v.into_pyarray(py))?;
-            }
-            names.push(axis.name.clone());
-        }
+        self.axis_columns(py, &out, &rows, &mut names)?;
         let ok = |i: usize| points[i].as_ref().ok();
         // D on every row of a sweep whose scene declares dissipation (0 where it dissipates
         // nothing), as in a pipeline sweep's table.

@@ -8,7 +8,8 @@
 //! The pieces, in the order a simulation uses them:
 //! - [`model`]: the chain, its boundary, its resonators and their coupling law (Eqs. 3, 7, 14).
 //! - [`force`]: the right-hand side, accelerations from positions.
-//! - [`damping`]: dashpots, ground damping and the dissipated power (velocity-dependent forces).
+//! - [`damping`]: dashpots, ground damping and soft ends; [`damped_force`]: their forces, which
+//!   depend on velocities, and the dissipated power.
 //! - [`energy`]: energy density, total energy, R/T/E_tr fractions (Eq. 5 generalised).
 //! - [`integrate`]: the steppers (RK4, Störmer–Verlet, symplectic compositions, DOP853) and the
 //!   single driver that owns the time loop, sampling and failure detection.
@@ -19,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod contact;
+pub mod damped_force;
 pub mod damping;
 pub mod energy;
 mod error;

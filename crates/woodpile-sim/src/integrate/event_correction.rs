@@ -11,7 +11,7 @@ use super::contact_event::{
     BondPath,
 };
 use crate::contact::ContactLaw;
-use crate::damping::BondRecord;
+use crate::damped_force::BondRecord;
 use crate::model::{Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).

@@ -1,0 +1,204 @@
+//! The forces of a dissipative chain ([`crate::damping`]): accelerations from positions *and*
+//! velocities, with the dissipated power the ledger integrates. Only a scene that declares
+//! dissipation runs this loop; the conservative one ([`crate::force`]) keeps its bits.
+
+use crate::force::{hertz_force, odd_power};
+use crate::model::{Model, Window};
+
+/// Where a dissipative force loop records each bond's force and dashpot power (indexing of
+/// [`Model::accelerations_in`]'s recorded bonds: entry b is bond b, walls at 0 and `n_sites`).
+pub(crate) struct BondRecord<'a> {
+    /// The bond's total force, clipped at zero (what the contact-event scan reads).
+    pub force: &'a mut [f64],
+    /// The bond's dashpot power (F − elastic) ċ.
+    pub power: &'a mut [f64],
+}
+
+impl Model {
+    /// Accelerations `q'' = M^{-1} F(t, q, q')` of a dissipative model on the sites of `window`
+    /// (and every resonator), written into `acc`, for positions `q` and velocities `v` (each
+    /// of length `n_dof`); returns the dissipated power of the window. With `record`, every
+    /// bond's force and dashpot power are kept for the contact-event correction.
+    ///
+    /// The conservative loop ([`Model::accelerations_in`]) stays as it is: this one is simple
+    /// rather than fast, and only a scene that declares dissipation runs it.
+    pub fn damped_accelerations_in(
+        &self,
+        t: f64,
+        (q, v): (&[f64], &[f64]),
+        acc: &mut [f64],
+        window: Window,
+    ) -> f64 {
+        self.damped_recording(t, (q, v), acc, window, None)
+    }
+
+    pub(crate) fn damped_recording(
+        &self,
+        t: f64,
+        (q, v): (&[f64], &[f64]),
+        acc: &mut [f64],
+        window: Window,
+        mut record: Option<BondRecord<'_>>,
+    ) -> f64 {
+        let n_sites = self.n_sites();
+        let (lo, hi) = (window.lo, window.hi);
+        let (u, w) = q[..self.n_dof()].split_at(n_sites);
+        let (u_dot, w_dot) = v[..self.n_dof()].split_at(n_sites);
+        let (acc_u, acc_w) = acc[..self.n_dof()].split_at_mut(n_sites);
+        acc_u[lo..=hi].fill(0.0);
+        let mut power = 0.0;
+        let boundary = self.boundary();
+        // Bonds b join sites b − 1 and b; a wall is a member at rest.
+        let first = if lo == 0 && boundary.left_wall() {
+            0
+        } else {
+            lo + 1
+        };
+        let last = if hi == n_sites - 1 && boundary.right_wall() {
+            n_sites
+        } else {
+            hi
+        };
+        for bond in first..=last {
+            let left = bond.checked_sub(1);
+            let right = (bond < n_sites).then_some(bond);
+            let at = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
+            let r = at(u, left) - at(u, right);
+            let rate = at(u_dot, left) - at(u_dot, right);
+            let (force, dashpot_power) = self.contact_force(bond, r, rate);
+            if let Some(rec) = record.as_mut() {
+                rec.force[bond] = force.total;
+                rec.power[bond] = dashpot_power;
+            }
+            power += dashpot_power;
+            let net = force.total - force.rest;
+            if let Some(i) = left {
+                acc_u[i] -= net;
+            }
+            if let Some(i) = right {
+                acc_u[i] += net;
+            }
+        }
+        power += self.soft_ends(u, u_dot, acc_u, window);
+        let damping = self.damping();
+        let ground = damping.map_or(0.0, |d| d.ground);
+        if ground > 0.0 {
+            for i in lo..=hi {
+                acc_u[i] -= ground * u_dot[i];
+                power += ground * u_dot[i] * u_dot[i];
+            }
+        }
+        for (j, r) in self.resonators().iter().enumerate() {
+            if r.site < lo || r.site > hi {
+                continue;
+            }
+            let c = damping.map_or(0.0, |d| d.resonator(j));
+            let slip = u_dot[r.site] - w_dot[j];
+            let f = r.coupling.at(t) * odd_power(u[r.site] - w[j], r.p) + c * slip;
+            power += c * slip * slip;
+            acc_u[r.site] -= f;
+            acc_w[j] = f / r.eps;
+        }
+        for i in lo..=hi {
+            acc_u[i] *= self.inv_mass()[i];
+        }
+        power
+    }
+
+    /// Bond `bond`'s force at relative displacement `r` (left minus right) closing at `rate`,
+    /// and its dashpot power: see the module documentation.
+    #[inline(always)]
+    pub(crate) fn contact_force(&self, bond: usize, r: f64, rate: f64) -> (BondForce, f64) {
+        let (c, elastic, rest) = match self.contacts() {
+            None => (r, hertz_force(r), 0.0),
+            Some(law) => (
+                law.static_overlap(bond) + r,
+                law.elastic(bond, r),
+                law.static_force(bond),
+            ),
+        };
+        // At c = 0 the dashpot already acts: a contact closing from touching (an impulse
+        // given to a site beside one at rest) feels γ ċ from its first instant.
+        let total = match self.damping() {
+            Some(d) if d.contact > 0.0 && c >= 0.0 => {
+                (elastic + d.law.force(d.contact, c, rate)).max(0.0)
+            }
+            _ => elastic,
+        };
+        (
+            BondForce {
+                total,
+                elastic,
+                rest,
+            },
+            (total - elastic) * rate,
+        )
+    }
+
+    /// The fastest rate, 1/time, at which the chain's dashpots and soft ends act in a
+    /// motion of total energy `energy`: a dashpot c between masses m1 and m2 relaxes at
+    /// c (1/m1 + 1/m2), a soft end's spring vibrates at sqrt(k / m). An explicit step must
+    /// stay well below its inverse, as below a resonator's period ([`crate::integrate::Plan::resolving_dt`]);
+    /// 0 when the chain has none of them.
+    pub fn max_dissipation_rate(&self, energy: f64) -> f64 {
+        let n = self.n_sites();
+        let inv = |site: Option<usize>| site.map_or(0.0, |i| self.inv_mass()[i]);
+        let mut rate: f64 = 0.0;
+        for (site, end) in [
+            (0, self.boundary().left()),
+            (n - 1, self.boundary().right()),
+        ] {
+            if let Some((spring, damping)) = end.soft() {
+                let inv_m = self.inv_mass()[site];
+                rate = rate.max((spring * inv_m).sqrt()).max(damping * inv_m);
+            }
+        }
+        let Some(d) = self.damping() else {
+            return rate;
+        };
+        let lightest = self.inv_mass()[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
+        rate = rate.max(d.ground * lightest);
+        for (j, r) in self.resonators().iter().enumerate() {
+            let inv_pair = self.inv_mass()[r.site] + 1.0 / r.eps;
+            rate = rate.max(d.resonator(j) * inv_pair);
+        }
+        if d.contact > 0.0 {
+            for bond in 0..=n {
+                let pair = inv(bond.checked_sub(1)) + inv((bond < n).then_some(bond));
+                let overlap = match self.contacts() {
+                    None => (2.5 * energy.max(0.0)).powf(0.4),
+                    Some(law) => law.overlap_within(bond, energy),
+                };
+                rate = rate.max(d.law.force(d.contact, overlap, 1.0) * pair);
+            }
+        }
+        rate
+    }
+
+    /// The soft ends' spring and dashpot forces on the window's end sites, added to `acc_u`;
+    /// returns their dashpots' power.
+    fn soft_ends(&self, u: &[f64], u_dot: &[f64], acc_u: &mut [f64], window: Window) -> f64 {
+        let last = self.n_sites() - 1;
+        let ends = [
+            (window.lo == 0, 0, self.boundary().left()),
+            (window.hi == last, last, self.boundary().right()),
+        ];
+        let mut power = 0.0;
+        for (inside, site, end) in ends {
+            if let (true, Some((spring, damping))) = (inside, end.soft()) {
+                acc_u[site] -= spring * u[site] + damping * u_dot[site];
+                power += damping * u_dot[site] * u_dot[site];
+            }
+        }
+        power
+    }
+}
+
+/// One contact's force: the total the sites feel (clipped at zero), its elastic part, and the
+/// static force the rest state balances (0 without precompression).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BondForce {
+    pub total: f64,
+    pub elastic: f64,
+    pub rest: f64,
+}
