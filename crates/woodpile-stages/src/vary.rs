@@ -12,12 +12,17 @@
 //! [set]                                           # laid over each best scene, "$axis" placeholders
 //! striker = { mass = "$M", velocity = 1.0 }
 //! chain = { boundary = { left = "free", right = "fixed" } }
+//! [set_each]                                      # optional: laid over every element of an array of tables
+//! defect = { quality_factor = "$Q" }
 //! ```
 //!
 //! `[set]` merges into the best scene table by table: a key inside a table that both have
 //! replaces only that key, and any other value (arrays of tables such as `[[defect]]`
-//! included) replaces the best scene's whole value. An `unset` key that the best scene does not
-//! have is an error, so that a misspelt key cannot silently leave the scene as it was.
+//! included) replaces the best scene's whole value. `[set_each]` reaches inside an array of
+//! tables whose length the best scenes decide (each design has its own defects): its table is
+//! merged into every element. An `unset` key that the best scene does not have is an error, and
+//! so is a `set_each` name that is not an array of tables there, so that a misspelt key cannot
+//! silently leave the scene as it was.
 //!
 //! Output: each input's sweep table (one row per sample of each point, `S` after `E_tr` with a
 //! striker), stacked in the order of `inputs`, after a `design` column naming the input stage
@@ -53,6 +58,7 @@ pub const DESIGN_INDEX: &str = "design_index";
 pub struct Vary {
     axes: Vec<Axis>,
     set: toml::Table,
+    set_each: toml::Table,
     unset: Vec<String>,
     file: std::path::PathBuf,
 }
@@ -62,11 +68,23 @@ impl Vary {
         let table: toml::Table = fields.required("axes")?;
         let axes = parse_axes(fields.nested("axes", table))?;
         let set: toml::Table = fields.required("set")?;
+        let set_each: toml::Table = fields.optional("set_each")?.unwrap_or_default();
+        if let Some((name, _)) = set_each.iter().find(|(_, v)| !v.is_table()) {
+            return Err(fields.error(
+                &format!("set_each.{name}"),
+                format!("expected a table, laid over every element of the array of tables `{name}`"),
+            ));
+        }
         // Every placeholder names an axis and every axis is used, before any input exists.
-        Template::new(set.clone(), &axes).map_err(|(key, reason)| {
-            let key = key
-                .strip_prefix("scene")
-                .map_or(key.clone(), |k| format!("set{k}"));
+        let mut placed = set.clone();
+        placed.insert("set_each".into(), toml::Value::Table(set_each.clone()));
+        Template::new(placed, &axes).map_err(|(key, reason)| {
+            let key = match key.strip_prefix("scene.set_each") {
+                Some(k) => format!("set_each{k}"),
+                None => key
+                    .strip_prefix("scene")
+                    .map_or(key.clone(), |k| format!("set{k}")),
+            };
             fields.error(&key, reason)
         })?;
         let unset: Vec<String> = fields.optional("unset")?.unwrap_or_default();
@@ -76,6 +94,7 @@ impl Vary {
         Ok(Vary {
             axes,
             set,
+            set_each,
             unset,
             file: fields.file().to_path_buf(),
         })
@@ -100,10 +119,37 @@ impl Vary {
             })?;
         }
         woodpile_pipeline::stage::merge(&mut scene, self.set.clone());
+        for (name, over) in &self.set_each {
+            set_each(&mut scene, name, over).map_err(|reason| {
+                PipelineError::stage(
+                    stage,
+                    format!("set_each: `{name}` {reason} in `{design}`'s best scene"),
+                )
+            })?;
+        }
         Sweep::over(self.axes.clone(), Series::Energy, scene, &self.file).map_err(|e| {
             PipelineError::stage(stage, format!("`{design}`'s best scene, varied: {e}"))
         })
     }
+}
+
+/// Merges `over` (a table) into every element of the array of tables `name` of `scene`.
+fn set_each(
+    scene: &mut toml::Table,
+    name: &str,
+    over: &toml::Value,
+) -> std::result::Result<(), &'static str> {
+    let (Some(toml::Value::Array(elements)), toml::Value::Table(over)) = (scene.get_mut(name), over)
+    else {
+        return Err("is not an array of tables");
+    };
+    for element in elements {
+        let toml::Value::Table(element) = element else {
+            return Err("is not an array of tables");
+        };
+        woodpile_pipeline::stage::merge(element, over.clone());
+    }
+    Ok(())
 }
 
 /// Removes the dotted `key` from `table`; the error says why it could not.
@@ -212,6 +258,21 @@ mod tests {
         assert_eq!(
             base,
             table("chain = { n = 100, boundary = \"fixed\", precompression = 0.5 }\n[[defect]]\nsite = 3\neps = 2.0\n")
+        );
+    }
+
+    #[test]
+    fn set_each_reaches_every_element_and_names_a_missing_array() {
+        let mut base = table("[[defect]]\nsite = 0\neps = 1.0\n[[defect]]\nsite = 3\neps = 2.0\n");
+        let over = toml::Value::Table(table("damping = 0.5\n"));
+        set_each(&mut base, "defect", &over).unwrap();
+        assert_eq!(
+            base,
+            table("[[defect]]\nsite = 0\neps = 1.0\ndamping = 0.5\n[[defect]]\nsite = 3\neps = 2.0\ndamping = 0.5\n")
+        );
+        assert_eq!(
+            set_each(&mut base, "segment", &over),
+            Err("is not an array of tables")
         );
     }
 

@@ -3,7 +3,7 @@
 //! the `panels` column. The grid shaping of heat maps is `woodpile_plot::Grid`'s.
 
 use polars::prelude::DataFrame;
-use woodpile_plot::{Grid, HeatPanel, LinePanel, Panel, Series, SeriesStyle};
+use woodpile_plot::{Grid, HeatPanel, LinePanel, Mark, MarkAt, Panel, Series, SeriesStyle};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::table::{f64_column, matching_rows, str_column};
@@ -157,6 +157,7 @@ impl PanelSpec {
             y_label,
             series: series_name,
             styles,
+            mark_halving,
             ..
         } = &self.plot
         else {
@@ -197,7 +198,7 @@ impl PanelSpec {
                 })
                 .collect(),
         };
-        let series = series
+        let series: Vec<Series> = series
             .into_iter()
             .map(|s: Series| Series {
                 style: styles
@@ -207,12 +208,16 @@ impl PanelSpec {
                 ..s
             })
             .collect();
+        let mut marks = self.marks.clone();
+        if *mark_halving {
+            marks.extend(series.iter().filter_map(halving_mark));
+        }
         Panel::Lines(LinePanel {
             title,
             x_label: x_label.clone(),
             y_label: y_label.clone(),
             series,
-            marks: self.marks.clone(),
+            marks,
             view: self.view,
         })
     }
@@ -265,5 +270,58 @@ impl PanelSpec {
             marks: self.marks.clone(),
             view: self.view,
         })
+    }
+}
+
+/// A vertical mark where `series` first falls to half its first value, in the table's order
+/// (the lossless end: γ = 0 first, or the largest quality factor first), found by
+/// interpolating between the two samples around the crossing (in log x when both are
+/// positive, as the axes these curves are drawn on). `None` when it never does.
+fn halving_mark(series: &Series) -> Option<Mark> {
+    let points: Vec<(f64, f64)> = series
+        .points
+        .iter()
+        .copied()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .collect();
+    let half = 0.5 * points.first()?.1;
+    let crossing = points.windows(2).find(|w| w[0].1 > half && w[1].1 <= half)?;
+    let [(x0, y0), (x1, y1)] = [crossing[0], crossing[1]];
+    let share = (y0 - half) / (y0 - y1);
+    let x = match x0 > 0.0 && x1 > 0.0 {
+        true => (x0.ln() + share * (x1.ln() - x0.ln())).exp(),
+        false => x0 + share * (x1 - x0),
+    };
+    Some(Mark {
+        at: MarkAt::X(x),
+        label: format!("{} halves", series.label),
+    })
+}
+
+#[cfg(test)]
+mod halving_tests {
+    use super::*;
+
+    fn series(points: &[(f64, f64)]) -> Series {
+        Series {
+            label: "E_tr".into(),
+            points: points.to_vec(),
+            style: SeriesStyle::default(),
+        }
+    }
+
+    #[test]
+    fn the_halving_point_is_interpolated_in_log_x() {
+        let falling = series(&[(0.0, 0.8), (0.01, 0.7), (0.1, 0.6), (1.0, 0.2)]);
+        let mark = halving_mark(&falling).unwrap();
+        // Half of 0.8 is 0.4, halfway from 0.6 to 0.2: log-halfway from 0.1 to 1.
+        let MarkAt::X(x) = mark.at else { panic!() };
+        assert!((x - 0.1f64.sqrt()).abs() < 1e-12, "{x}");
+        assert_eq!(mark.label, "E_tr halves");
+        assert!(halving_mark(&series(&[(0.0, 0.8), (1.0, 0.5)])).is_none());
+        // A falling quality factor: the table starts at the lossless end, the largest x.
+        let quality = series(&[(1e4, 0.6), (100.0, 0.5), (10.0, 0.2)]);
+        let MarkAt::X(q) = halving_mark(&quality).unwrap().at else { panic!() };
+        assert!((q - 10f64.powf(1.5)).abs() < 1e-9, "{q}");
     }
 }

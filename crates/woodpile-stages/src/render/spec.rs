@@ -55,6 +55,9 @@ pub enum Plot {
         y_label: String,
         /// `series_style`: a curve's colour, dash, marker and legend text, by its name.
         styles: Vec<CurveStyle>,
+        /// `mark_halving`: mark where each curve first falls to half its value at its
+        /// smallest x.
+        mark_halving: bool,
     },
     /// z over an (x, y) grid.
     Heatmap {
@@ -159,6 +162,7 @@ pub(super) fn parse_panel(
                 series_label: f.optional("series_label")?,
                 x_label,
                 y_label,
+                mark_halving: flag(&mut f, "mark_halving")?,
             };
             if let Plot::Lines {
                 y,
