@@ -376,3 +376,54 @@ pub fn chain_audit_scene(rng: &mut Lcg) -> Scenario {
         ..base
     }
 }
+
+/// One scene of the audit of dissipation (`auto_audit --damped`): an audit scene, or half the
+/// time one of the experiment's chain ([`chain_audit_scene`]), given every kind of damping a
+/// scene can declare: a contact dashpot (γ from 1e-4 to 0.3, linear or Hertzian law, equally
+/// likely), on half the scenes ground damping (g from 1e-4 to 1e-2), on each resonator with
+/// probability one half a dashpot (c from 1e-3 to 1), and on half the chains with a free right
+/// end a soft end there (spring up to 0.1, dashpot from 0.05 to 2).
+pub fn damped_audit_scene(rng: &mut Lcg) -> Scenario {
+    let base = match rng.uniform() < 0.5 {
+        true => chain_audit_scene(rng),
+        false => audit_scene(rng),
+    };
+    let law = match rng.uniform() < 0.5 {
+        true => crate::DashpotLaw::Linear,
+        false => crate::DashpotLaw::Hertzian,
+    };
+    let contact = rng.log_uniform(1e-4, 0.3);
+    let ground = match rng.uniform() < 0.5 {
+        true => rng.log_uniform(1e-4, 1e-2),
+        false => 0.0,
+    };
+    let old = &base.model;
+    let resonator: Vec<f64> = old
+        .resonators()
+        .iter()
+        .map(|_| match rng.uniform() < 0.5 {
+            true => rng.log_uniform(1e-3, 1.0),
+            false => 0.0,
+        })
+        .collect();
+    let soft = crate::End::Soft {
+        spring: 0.1 * rng.uniform(),
+        damping: rng.log_uniform(0.05, 2.0),
+    };
+    let boundary = match (old.boundary().right(), rng.uniform() < 0.5) {
+        (crate::End::Free, true) => Boundary::ends(old.boundary().left(), soft),
+        _ => old.boundary(),
+    };
+    let n = old.n_sites();
+    let masses = (0..n).map(|i| old.site_mass(i)).collect();
+    let mut model = Model::with_masses(n, boundary, old.resonators().to_vec(), Some(masses))
+        .expect("a valid survey model");
+    if let Some(law) = old.contacts() {
+        model = model.with_contacts(law.clone()).expect("a valid survey contact law");
+    }
+    let damping = crate::Damping::new(contact, law, ground, resonator).expect("valid damping");
+    Scenario {
+        model: model.with_damping(damping).expect("a valid damped model"),
+        ..base
+    }
+}
