@@ -151,3 +151,33 @@ def test_a_bad_chain_key_is_a_scene_error_naming_it():
     scene = dict(STRUCK, chain={"n": 40, "boundary": "fixed"})
     with pytest.raises(woodpile.SceneError, match="striker"):
         woodpile.simulate(scene)
+
+
+DAMPED = dict(
+    STANDARD,
+    chain={"n": 60, "boundary": {"left": "fixed", "right": {"spring": 0.05, "damping": 0.5}}},
+    defect=[{"site": 0, "eps": 3.0, "kappa": 0.7, "quality_factor": 20.0}],
+    damping={"contact": 0.02, "law": "hertzian", "ground": 1e-3},
+)
+
+
+def test_a_damped_scene_keeps_its_ledger_in_the_result_and_the_series():
+    r = woodpile.simulate(DAMPED)
+    assert r.normalisation == "E(0)" and r.method == "rk4-contact"
+    assert r.D is not None and r.D > 0.1
+    assert abs(r.R + r.T + r.E_tr + r.D - 1.0) < 1e-6
+    assert list(r.series.columns) == ["t", "R", "T", "E_tr", "D", "E"]
+    assert r.series["D"].iloc[-1] == r.D
+    assert (r.series["D"].diff().dropna() >= 0).all()
+    # A Nyström method cannot take velocity-dependent forces: a SceneError naming the key.
+    with pytest.raises(woodpile.SceneError, match="run.method"):
+        woodpile.simulate(dict(DAMPED, run={"t_end": 60.0, "method": "verlet", "dt": 0.01}))
+
+
+def test_a_sweep_over_a_damping_key_has_d_on_every_row():
+    scene = dict(STANDARD, damping={"contact": "$gamma"})
+    frame = woodpile.sweep(scene, {"gamma": [0.0, 0.05]})
+    assert list(frame["gamma"]) == [0.0, 0.05]
+    assert frame["D"].iloc[0] == 0.0 and frame["D"].iloc[1] > frame["D"].iloc[0]
+    total = frame["R"] + frame["T"] + frame["E_tr"] + frame["D"]
+    assert (abs(total - 1.0) < 1e-6).all()

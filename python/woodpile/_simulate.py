@@ -24,9 +24,12 @@ class SimulationResult:
 
     Attributes:
         S: the striker's share at ``t_end`` for a scene with a ``[striker]``, else None.
-        series: a DataFrame with columns ``t``, ``R``, ``T``, ``E_tr`` (``S`` with a striker), ``E`` at every
-            ``run.sample_every``. R, T and E_tr are the shares of the energy left of,
-            right of and inside the region at that time (R = 1 before the wave arrives).
+        D: the share of E(0) dissipated by ``t_end`` for a scene with damping, else None
+            (the shares are then of E(0), ``normalisation == "E(0)"``, and sum to 1 with D).
+        series: a DataFrame with columns ``t``, ``R``, ``T``, ``E_tr`` (``S`` with a striker,
+            ``D`` with damping), ``E`` at every ``run.sample_every``. R, T and E_tr are the
+            shares of the energy left of, right of and inside the region at that time (R = 1
+            before the wave arrives).
         t: the sample times (a float64 array).
         sites: the paper site numbers of the field's columns (int64), or None.
         velocity: site velocities, float64, shape (len(t), len(sites)), or None.
@@ -37,6 +40,7 @@ class SimulationResult:
     T: float
     E_tr: float
     S: Optional[float]
+    D: Optional[float]
     E_initial: float
     E_final: float
     error_estimate: Optional[float]
@@ -70,6 +74,7 @@ class SimulationResult:
             setattr(self, key, value)
         self.physical = self._report.get("physical")
         self.S = self._report.get("S")
+        self.D = self._report.get("D")
         self._series_columns: Dict[str, np.ndarray] = raw["series"]
         self._series: Optional[pd.DataFrame] = None
         self.t = raw.get("t", self._series_columns["t"])
@@ -79,11 +84,11 @@ class SimulationResult:
 
     @property
     def series(self) -> pd.DataFrame:
-        """R, T, E_tr and E at every ``run.sample_every`` (columns t, R, T, E_tr, E): the
-        arrays the simulation returned, made a DataFrame on first access."""
+        """R, T, E_tr and E at every ``run.sample_every`` (columns t, R, T, E_tr, (S,) (D,)
+        E): the arrays the simulation returned, made a DataFrame on first access."""
         if self._series is None:
             columns = self._series_columns
-            names = ("t", "R", "T", "E_tr", "S", "E")
+            names = ("t", "R", "T", "E_tr", "S", "D", "E")
             self._series = pd.DataFrame({name: columns[name] for name in names if name in columns})
         return self._series
 

@@ -30,7 +30,8 @@ def sweep(scene: Scene, axes: Mapping[str, Axis], *, series: bool = False) -> pd
 
     Returns:
         A DataFrame: ``point``, the axes, then ``R``, ``T``, ``E_tr`` (or, with
-        ``series``, ``t``, ``R``, ``T``, ``E_tr``, ``E``), ``error_estimate``, ``dt``,
+        ``series``, ``t``, ``R``, ``T``, ``E_tr``, ``E``; ``D`` after ``E_tr`` when the scene
+        declares damping), ``error_estimate``, ``dt``,
         ``steps``, ``rhs_evals``, ``method`` and ``failure``. A point that failed is a row
         with NaN fractions and its reason in ``failure`` (None for the others).
 

@@ -389,3 +389,40 @@ fn fixed_steps_on_a_kappa_ramp_are_checked_by_halving() {
     let estimate = json_number(&stdout, "error_estimate");
     assert!(estimate > 0.0 && estimate < 1e-6, "{stdout}");
 }
+
+/// A damped scene: `D` and `normalisation` in the JSON, the shares of E(0) summing to one with
+/// D, the ledger as `energy_drift`, and a column `D` in `--series`; a Nyström method is refused
+/// with exit 2 naming `run.method`.
+#[test]
+fn a_damped_scene_reports_its_ledger() {
+    let damped = "[chain]\nn = 30\nboundary = { left = \"free\", right = { spring = 0.05, damping = 0.5 } }\n[[defect]]\nsite = 0\neps = 0.5\ndamping = 0.05\n[damping]\ncontact = 0.1\n[run]\nt_end = 60.0\ntolerance = 1e-8\n";
+    let path = scene_file(damped);
+    let series = path.with_extension("parquet");
+    let out = simulate_command(&path)
+        .arg("--series")
+        .arg(&series)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["normalisation"], "E(0)");
+    assert_eq!(v["energy_conserved"], false);
+    assert_eq!(v["method"], "rk4-contact");
+    let share = |k: &str| v[k].as_f64().unwrap();
+    let sum = share("R") + share("T") + share("E_tr") + share("D");
+    assert!((sum - 1.0).abs() < 1e-8, "{sum}");
+    assert!(share("D") > 0.5 && share("energy_drift") < 1e-7);
+    let columns = woodpile_pipeline::table::read(&series).unwrap();
+    let names: Vec<String> = columns
+        .get_column_names()
+        .iter()
+        .map(|c| c.to_string())
+        .collect();
+    assert_eq!(names, ["t", "R", "T", "E_tr", "D", "E"]);
+    let nystrom = scene_file(&format!("{damped}method = \"rkn4-contact\"\ndt = 0.01\n"));
+    assert_refused(&nystrom, &["run.method", "rk4-contact"]);
+}

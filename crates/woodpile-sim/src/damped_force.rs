@@ -99,8 +99,8 @@ impl Model {
             acc_u[r.site] -= f;
             acc_w[j] = f / r.eps;
         }
-        for i in lo..=hi {
-            acc_u[i] *= self.inv_mass()[i];
+        for (a, inv_m) in acc_u[lo..=hi].iter_mut().zip(&self.inv_mass()[lo..=hi]) {
+            *a *= inv_m;
         }
         power
     }

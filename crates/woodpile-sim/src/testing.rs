@@ -419,7 +419,9 @@ pub fn damped_audit_scene(rng: &mut Lcg) -> Scenario {
     let mut model = Model::with_masses(n, boundary, old.resonators().to_vec(), Some(masses))
         .expect("a valid survey model");
     if let Some(law) = old.contacts() {
-        model = model.with_contacts(law.clone()).expect("a valid survey contact law");
+        model = model
+            .with_contacts(law.clone())
+            .expect("a valid survey contact law");
     }
     let damping = crate::Damping::new(contact, law, ground, resonator).expect("valid damping");
     Scenario {

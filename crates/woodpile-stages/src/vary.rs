@@ -72,7 +72,9 @@ impl Vary {
         if let Some((name, _)) = set_each.iter().find(|(_, v)| !v.is_table()) {
             return Err(fields.error(
                 &format!("set_each.{name}"),
-                format!("expected a table, laid over every element of the array of tables `{name}`"),
+                format!(
+                    "expected a table, laid over every element of the array of tables `{name}`"
+                ),
             ));
         }
         // Every placeholder names an axis and every axis is used, before any input exists.
@@ -139,7 +141,8 @@ fn set_each(
     name: &str,
     over: &toml::Value,
 ) -> std::result::Result<(), &'static str> {
-    let (Some(toml::Value::Array(elements)), toml::Value::Table(over)) = (scene.get_mut(name), over)
+    let (Some(toml::Value::Array(elements)), toml::Value::Table(over)) =
+        (scene.get_mut(name), over)
     else {
         return Err("is not an array of tables");
     };

@@ -407,3 +407,71 @@ fn a_design_site_range_is_bounded() {
         );
     }
 }
+
+/// A sweep may vary any damping key: its table has `D` on every row (0 where the axis sets the
+/// damping to zero, whose point is the undamped scene itself), R + T + E_tr + D = 1 on every
+/// row, and a reduce carries D. A vary's `[set_each]` damps every resonator of a best scene.
+#[test]
+fn damping_keys_sweep_reduce_and_vary() {
+    let damped = SWEEP
+        .replace("L = [0, 1]", "L = [0]\ngamma = [0.0, 0.05]")
+        .replace(
+            "method = \"rk4\", dt = 0.02",
+            "method = \"rk4-contact\", dt = 0.01",
+        )
+        .replace(
+            "[[scene.defect]]",
+            "damping = { contact = \"$gamma\" }\n[[scene.defect]]",
+        );
+    let p = Project::new(&[("sweep", &damped), ("at_end", REDUCE)]);
+    p.counted(&[]);
+    let out = table::read(&p.output("sweep")).unwrap();
+    let column = |name: &str| table::f64_column(&out, name).unwrap();
+    let (gamma, d) = (column("gamma"), column("D"));
+    let shares: Vec<Vec<Option<f64>>> = ["R", "T", "E_tr", "D"].map(column).to_vec();
+    for row in 0..out.height() {
+        let sum: f64 = shares.iter().map(|c| c[row].unwrap()).sum();
+        assert!((sum - 1.0).abs() < 1e-6, "row {row}: {sum}");
+        if gamma[row] == Some(0.0) {
+            assert_eq!(d[row], Some(0.0));
+        }
+    }
+    assert!((0..out.height()).any(|r| d[r].unwrap() > 0.01));
+    let reduced = table::read(&p.output("at_end")).unwrap();
+    let lost = table::f64_column(&reduced, "D").unwrap();
+    assert_eq!(lost.len(), 6);
+    assert!(lost.iter().any(|x| x.unwrap() > 0.01));
+
+    let quality = r#"
+kind = "vary"
+inputs = ["optimum"]
+[axes]
+Q = [1e6, 2.0]
+[set]
+run = { method = "rk4-contact", dt = 0.01 }
+[set_each]
+defect = { quality_factor = "$Q" }
+"#;
+    let p = vary_project(quality);
+    p.counted(&[]);
+    let out = table::read(&p.output("varied")).unwrap();
+    let (q, t) = (
+        table::f64_column(&out, "Q").unwrap(),
+        table::f64_column(&out, "t").unwrap(),
+    );
+    let d = table::f64_column(&out, "D").unwrap();
+    let at_end = |value: f64| {
+        (0..out.height())
+            .find(|&r| q[r] == Some(value) && t[r] == Some(12.0))
+            .unwrap()
+    };
+    assert!(d[at_end(1e6)].unwrap() < 1e-3 && d[at_end(2.0)].unwrap() > 0.01);
+    let e = vary_project(&quality.replace("defect = {", "segment = {"))
+        .run(&[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("set_each: `segment` is not an array of tables"),
+        "{e}"
+    );
+}

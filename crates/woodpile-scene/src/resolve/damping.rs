@@ -9,6 +9,9 @@ use super::check::{invalid, non_negative, positive, Invalid};
 use super::physical::Si;
 use crate::raw;
 
+/// Values an SI scene converted, by name, for the JSON's `physical` block.
+type Listed = Vec<(String, f64)>;
+
 /// The damping `file` declares, in the model's units, with the converted values an SI scene
 /// lists; `None` when it declares none.
 pub(crate) fn damping(
@@ -16,7 +19,7 @@ pub(crate) fn damping(
     resonators: &[Resonator],
     masses: &[f64],
     si: Option<&Si>,
-) -> Result<Option<(Damping, Vec<(String, f64)>)>, Invalid> {
+) -> Result<Option<(Damping, Listed)>, Invalid> {
     let table = file.damping.as_ref();
     let any_defect = file
         .defect

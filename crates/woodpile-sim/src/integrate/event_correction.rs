@@ -24,6 +24,9 @@ pub(crate) type Quadrature<const S: usize> = fn([f64; S], f64) -> (f64, f64);
 /// more than 1e-16 and saves most of the correction's cost.
 const NEGLIGIBLE_FORCE: f64 = 1e-14;
 
+/// A bond and its members: (bond, left site or None for a wall, right site or None).
+pub(crate) type BondSites = (usize, Option<usize>, Option<usize>);
+
 /// A bond's correction: (left site or None for a wall, right site or None, impulse, position).
 type Correction = (Option<usize>, Option<usize>, f64, f64);
 
@@ -112,10 +115,10 @@ pub(crate) struct ContactEvents<const S: usize> {
     corrected: Vec<(usize, f64)>,
     /// Bonds corrected so far.
     events: u64,
-    /// Scratch: the bonds that changed contact in this step, as (bond, left site, right site).
-    changed: Vec<(usize, Option<usize>, Option<usize>)>,
+    /// Scratch: the bonds that changed contact in this step.
+    changed: Vec<BondSites>,
     /// Bonds the next step corrects whatever its scan finds ([`ContactEvents::correct_next`]).
-    carried: Vec<(usize, Option<usize>, Option<usize>)>,
+    carried: Vec<BondSites>,
 }
 
 impl<const S: usize> ContactEvents<S> {
@@ -292,7 +295,7 @@ impl<const S: usize> ContactEvents<S> {
         (start, end): (&[f64], &[f64]),
         h: f64,
         window: Window,
-    ) -> Option<(f64, (usize, Option<usize>, Option<usize>))> {
+    ) -> Option<(f64, BondSites)> {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
         let (q, v) = start.split_at(n);
@@ -317,7 +320,7 @@ impl<const S: usize> ContactEvents<S> {
 
     /// Makes the next step correct `bond` (as [`ContactEvents::first_switch`] gives it) whether
     /// or not the scan finds it changed: a step that begins just after the bond's force switched.
-    pub(crate) fn correct_next(&mut self, bond: (usize, Option<usize>, Option<usize>)) {
+    pub(crate) fn correct_next(&mut self, bond: BondSites) {
         self.carried.push(bond);
     }
 

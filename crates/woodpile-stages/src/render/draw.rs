@@ -285,7 +285,9 @@ fn halving_mark(series: &Series) -> Option<Mark> {
         .filter(|(x, y)| x.is_finite() && y.is_finite())
         .collect();
     let half = 0.5 * points.first()?.1;
-    let crossing = points.windows(2).find(|w| w[0].1 > half && w[1].1 <= half)?;
+    let crossing = points
+        .windows(2)
+        .find(|w| w[0].1 > half && w[1].1 <= half)?;
     let [(x0, y0), (x1, y1)] = [crossing[0], crossing[1]];
     let share = (y0 - half) / (y0 - y1);
     let x = match x0 > 0.0 && x1 > 0.0 {
@@ -321,7 +323,9 @@ mod halving_tests {
         assert!(halving_mark(&series(&[(0.0, 0.8), (1.0, 0.5)])).is_none());
         // A falling quality factor: the table starts at the lossless end, the largest x.
         let quality = series(&[(1e4, 0.6), (100.0, 0.5), (10.0, 0.2)]);
-        let MarkAt::X(q) = halving_mark(&quality).unwrap().at else { panic!() };
+        let MarkAt::X(q) = halving_mark(&quality).unwrap().at else {
+            panic!()
+        };
         assert!((q - 10f64.powf(1.5)).abs() < 1e-9, "{q}");
     }
 }
