@@ -59,76 +59,13 @@ impl Stepper for Rk4Fused {
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
-        if !locates_switches(model, &self.scratch) {
-            self.stages(model, y, span);
-            finish_step(
-                self.scratch.contact.as_mut(),
-                model,
-                (y, &mut self.scratch.y_new),
-                span.h,
-                span.window,
-            );
-            return StepOutcome::Accepted { h_next: span.h };
-        }
-        // A contact dashpot's force switches inside a step: it jumps to γ ċ as a contact
-        // closes (linear law), and has a kink where its clip starts. RK4's later stages would
-        // carry those into every stage state, which the bond's own correction cannot undo
-        // (order 2 instead of 3). So the step ends where the first force switches, and goes on
-        // from there.
-        let mut rest = span;
-        for split in 0..=MAX_LOCATED {
-            self.stages(model, y, rest);
-            let s = &mut self.scratch;
-            let contact = s
-                .contact
-                .as_mut()
-                .expect("a located step keeps contact events");
-            let switch = match split < MAX_LOCATED {
-                true => contact.first_switch(model, (y, &s.y_new), rest.h, rest.window),
-                false => None,
-            };
-            // Switches within MIN_LOCATED of a step's ends (in the whole step's measure) are
-            // left to the correction. A located step ends LATE after its switch, so that its
-            // last stage alone sees the new force; the next step is corrected on that bond,
-            // whose force is not smooth just behind its start.
-            let away = |x: f64| {
-                x * rest.h > MIN_LOCATED * span.h && (1.0 - x) * rest.h > MIN_LOCATED * span.h
-            };
-            match switch.filter(|&(x, _)| away(x)) {
-                None => break,
-                Some((x, bond)) => {
-                    let first = StepSpan {
-                        h: x * rest.h + LATE * span.h,
-                        ..rest
-                    };
-                    self.stages(model, y, first);
-                    let s = &mut self.scratch;
-                    finish_step(
-                        s.contact.as_mut(),
-                        model,
-                        (y, &mut s.y_new),
-                        first.h,
-                        first.window,
-                    );
-                    if let Some(contact) = s.contact.as_mut() {
-                        contact.correct_next(bond);
-                    }
-                    rest = StepSpan {
-                        t: rest.t + first.h,
-                        h: rest.h - first.h,
-                        ..rest
-                    };
-                }
+        match locates_switches(model, &self.scratch) {
+            true => self.located_step(model, y, span),
+            false => {
+                self.stages(model, y, span);
+                self.finish(model, y, span);
             }
         }
-        let s = &mut self.scratch;
-        finish_step(
-            s.contact.as_mut(),
-            model,
-            (y, &mut s.y_new),
-            rest.h,
-            rest.window,
-        );
         StepOutcome::Accepted { h_next: span.h }
     }
 
@@ -157,6 +94,62 @@ fn locates_switches(model: &Model, scratch: &FixedStepScratch<4>) -> bool {
 }
 
 impl Rk4Fused {
+    /// The step `span` in parts that end at its force switches. A contact dashpot's force
+    /// switches inside a step: it jumps to γ ċ as a contact closes (linear law), and has a
+    /// kink where its clip starts. RK4's later stages would carry those into every stage
+    /// state, which the bond's own correction cannot undo (order 2 instead of 2.5). So a part
+    /// ends LATE after the first switch, so that its last stage alone sees the new force, and
+    /// the next part is corrected on that bond, whose force is not smooth just behind its
+    /// start. Switches within MIN_LOCATED of a part's ends (in the whole step's measure) are
+    /// left to the correction.
+    fn located_step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
+        let mut rest = span;
+        for _ in 0..MAX_LOCATED {
+            self.stages(model, y, rest);
+            let s = &mut self.scratch;
+            let contact = s
+                .contact
+                .as_mut()
+                .expect("a located step keeps contact events");
+            let away = |x: f64| {
+                x * rest.h > MIN_LOCATED * span.h && (1.0 - x) * rest.h > MIN_LOCATED * span.h
+            };
+            let switch = contact.first_switch(model, (y, &s.y_new), rest.h, rest.window);
+            let Some((x, bond)) = switch.filter(|&(x, _)| away(x)) else {
+                return self.finish(model, y, rest);
+            };
+            let part = StepSpan {
+                h: x * rest.h + LATE * span.h,
+                ..rest
+            };
+            self.stages(model, y, part);
+            self.finish(model, y, part);
+            if let Some(contact) = self.scratch.contact.as_mut() {
+                contact.correct_next(bond);
+            }
+            rest = StepSpan {
+                t: rest.t + part.h,
+                h: rest.h - part.h,
+                ..rest
+            };
+        }
+        self.stages(model, y, rest);
+        self.finish(model, y, rest);
+    }
+
+    /// Corrects the new state the last [`Rk4Fused::stages`] left (contact events) and copies it
+    /// into `y` over `span`'s window.
+    fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
+        let s = &mut self.scratch;
+        finish_step(
+            s.contact.as_mut(),
+            model,
+            (y, &mut s.y_new),
+            span.h,
+            span.window,
+        );
+    }
+
     /// RK4's four stages from `y` over `span`, the new state (uncorrected) left in the
     /// scratch's `y_new`.
     fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan) {

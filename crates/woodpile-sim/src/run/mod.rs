@@ -414,8 +414,7 @@ fn check_run<O: Observer + ?Sized>(
 /// to 99 times better than it was accurate (seed 7). Each rule below removed those misses on
 /// the seed it was chosen on and was then measured on another (docs/methods.md, "The audit").
 struct Strictness {
-    /// The largest error estimate accepted: half the tolerance; a sixteenth with a nonlinear
-    /// resonator; a sixty-fourth with a ramped coupling as well.
+    /// The largest error estimate accepted ([`accepted_estimate`]).
     accept: f64,
     /// Accept only from a third run on, so that the asymptotic-regime check has three runs to
     /// judge (a ramped coupling and a nonlinear resonator).
@@ -447,12 +446,15 @@ fn resonator_kinds(model: &Model) -> (bool, bool) {
 }
 
 /// The largest error estimate `auto` accepts at tolerance `tol` on `model` ([`Strictness`]):
-/// half the tolerance; a sixteenth with a nonlinear resonator; a sixty-fourth with a ramped
-/// coupling as well.
+/// half the tolerance; a quarter on a dissipative chain, whose errors can jump with the step
+/// (the damped audit's seed 2026, scene 45: a pair at dt = 0.0186 estimated 4.7e-8 against an
+/// error of 1.02e-7 at tolerance 1e-7); a sixteenth with a nonlinear resonator; a sixty-fourth
+/// with a ramped coupling as well.
 pub fn accepted_estimate(model: &Model, tol: f64) -> f64 {
     match resonator_kinds(model) {
         (true, true) => tol / 64.0,
         (true, false) => tol / 16.0,
+        (false, _) if model.is_dissipative() => 0.25 * tol,
         (false, _) => 0.5 * tol,
     }
 }
