@@ -71,11 +71,11 @@ bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, batc
 	$(MAKE) --no-print-directory unused-cost
 	$(CARGO) bench -p woodpile-bench
 
-# The last commit before the experiment's chain (striker, precompression, segments, exponent).
-COST_BASE := b4562e1
+# The last commit before dissipation (dashpots, ground damping, soft ends, the energy ledger).
+COST_BASE := e37d8ad
 OLD_TARGET := $(abspath $(or $(CARGO_TARGET_DIR),target))/old
 
-unused-cost: build ## What the experiment chain's features cost scenes that do not use them: COST_BASE's binary against this one
+unused-cost: build ## What features a scene does not use cost it: COST_BASE's binary against this one
 	rm -rf $(BASELINE)/old-src && mkdir -p $(BASELINE)/old-src
 	git archive $(COST_BASE) | tar -x -C $(BASELINE)/old-src
 	cd $(BASELINE)/old-src && CARGO_TARGET_DIR=$(OLD_TARGET) $(CARGO) build --release -q -p woodpile-cli

@@ -1,6 +1,6 @@
-//! What the experiment's chain (a striker, precompression, segments, any exponent, per-end
-//! walls) costs the scenes that declare none of it: two `woodpile` binaries, one built before
-//! those features and one after, run on the same scene files side by side in one run.
+//! What features a scene does not use cost it (the experiment's chain, dissipation): two
+//! `woodpile` binaries, one built before those features (`COST_BASE` in the Makefile) and one
+//! after, run on the same scene files side by side in one run.
 //!
 //! Scenes: the paper sample of `make bench` (8 seeded points each of F4, F7 coarse and F7
 //! fine, at the sweeps' own settings) and the standard scene (`scenes/single_eps10.toml`,
