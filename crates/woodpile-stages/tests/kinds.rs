@@ -475,3 +475,27 @@ defect = { quality_factor = "$Q" }
         "{e}"
     );
 }
+
+/// A design's `each_resonator` lays defect keys on every resonator it places: a design
+/// searched under damped resonators writes them into its best scene. The keys the design
+/// itself sets are refused.
+#[test]
+fn a_design_places_damped_resonators() {
+    let damped = design(20, 0, 1e-6, 1e-7, "samples = 2, spreads = [0.01]").replacen(
+        "kind = \"design\"",
+        "kind = \"design\"\neach_resonator = { damping = 0.05 }",
+        1,
+    );
+    let p = Project::new(&[("trap", &damped)]);
+    p.counted(&[]);
+    let best: toml::Table =
+        toml::from_str(&std::fs::read_to_string(p.results().join("trap.best.toml")).unwrap())
+            .unwrap();
+    let defects = best["defect"].as_array().unwrap();
+    assert!(!defects.is_empty());
+    assert!(defects
+        .iter()
+        .all(|d| d["damping"].as_float() == Some(0.05)));
+    let e = load_error(&[("trap", &damped.replace("damping = 0.05", "eps = 2.0"))]);
+    assert!(e.contains("each_resonator.eps"), "{e}");
+}

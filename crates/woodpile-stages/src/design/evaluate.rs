@@ -23,6 +23,7 @@ impl Design {
                 d.insert("eps".into(), toml::Value::Float(r.eps));
                 d.insert("kappa".into(), toml::Value::Float(r.kappa));
                 d.insert("p".into(), toml::Value::Integer(r.p));
+                d.extend(self.each_resonator.clone());
                 toml::Value::Table(d)
             })
             .collect();

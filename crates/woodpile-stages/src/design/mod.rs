@@ -12,6 +12,7 @@
 //! goal = "max"                        # or "min"
 //! verify_tolerance = 1e-8             # the best design is simulated again at this tolerance
 //! robustness = { samples = 200, spreads = [0.01, 0.05] }   # optional: every eps and kappa off by ±spread
+//! each_resonator = { quality_factor = 300.0 }   # optional: defect keys every placed resonator gets
 //! [scene]                             # a scene file without defects; its fractions region is required
 //! chain = { n = 100, boundary = "fixed" }
 //! impulse = { site = -25, velocity = 1.0 }
@@ -95,6 +96,9 @@ pub struct Design {
     /// The search space.
     pub space: Space,
     template: toml::Table,
+    /// Defect keys laid on every resonator the design places (a `damping` or
+    /// `quality_factor`: designing under the losses a real rod has).
+    each_resonator: toml::Table,
     file: PathBuf,
 }
 
@@ -151,6 +155,16 @@ impl Design {
             return Err(fields.error("space", "is required"));
         };
         let space = parse_space(fields.nested("space", space))?;
+        let each_resonator: toml::Table = fields.optional("each_resonator")?.unwrap_or_default();
+        if let Some(placed) = ["site", "eps", "kappa", "p"]
+            .into_iter()
+            .find(|k| each_resonator.contains_key(*k))
+        {
+            return Err(fields.error(
+                &format!("each_resonator.{placed}"),
+                "the design sets each resonator's site, eps, kappa and p",
+            ));
+        }
         let template: toml::Table = fields.required("scene")?;
         if template.contains_key("defect") {
             return Err(fields.error(
@@ -178,6 +192,7 @@ impl Design {
             robustness,
             space,
             template,
+            each_resonator,
             file: fields.file().to_path_buf(),
         };
         // The extremes of the space must make valid scenes: catch a bad template now.
