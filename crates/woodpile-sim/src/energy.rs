@@ -193,7 +193,7 @@ pub fn energy_density(model: &Model, t: f64, y: &[f64], density: &mut [f64]) {
     if boundary.right_wall() {
         density[n_sites - 1] += potential(n_sites, u[n_sites - 1]);
     }
-    if boundary.has_soft_end() {
+    if model.has_soft_end() {
         let [left, right] = spring_end_energies(model, u);
         density[0] += left;
         density[n_sites - 1] += right;
@@ -234,13 +234,13 @@ pub fn total_energy(model: &Model, t: f64, y: &[f64]) -> f64 {
     for bond in 0..n_sites - 1 {
         e += potential(bond + 1, u[bond] - u[bond + 1]);
     }
-    match (model.boundary().left_wall(), model.boundary().right_wall()) {
+    match (model.walls()[0], model.walls()[1]) {
         (true, true) => e += potential(0, -u[0]) + potential(n_sites, u[n_sites - 1]),
         (true, false) => e += potential(0, -u[0]),
         (false, true) => e += potential(n_sites, u[n_sites - 1]),
         (false, false) => {}
     }
-    if model.boundary().has_soft_end() {
+    if model.has_soft_end() {
         e += spring_end_energies(model, u).iter().sum::<f64>();
     }
     for (j, r) in model.resonators().iter().enumerate() {

@@ -5,7 +5,7 @@
 //! chain's contacts are closed.
 
 use crate::contact::ContactLaw;
-use crate::model::{Boundary, Model, Window};
+use crate::model::{Model, Window};
 
 /// Hertz contact force for an overlap `d`: `[d]_+^{3/2}`.
 #[inline(always)]
@@ -96,10 +96,10 @@ impl Model {
         let (lo, hi) = (window.lo, window.hi);
 
         match self.contacts() {
-            None => Self::hertz_chain(self.boundary(), u, acc_u, window, bond_force),
-            Some(law) => Self::law_chain(law, self.boundary(), u, acc_u, window, bond_force),
+            None => Self::hertz_chain(self.walls(), u, acc_u, window, bond_force),
+            Some(law) => Self::law_chain(law, self.walls(), u, acc_u, window, bond_force),
         }
-        if self.boundary().has_soft_end() {
+        if self.has_soft_end() {
             self.spring_ends(u, acc_u, window);
         }
         for (j, r) in self.resonators().iter().enumerate() {
@@ -121,7 +121,7 @@ impl Model {
     /// no precompression), written into `acc_u`; with `bond_force`, every bond force too.
     #[inline(always)]
     fn hertz_chain(
-        boundary: Boundary,
+        [left_wall, right_wall]: [bool; 2],
         u: &[f64],
         acc_u: &mut [f64],
         window: Window,
@@ -155,19 +155,19 @@ impl Model {
                     record_w[bond - 1] = f;
                     previous = f;
                 }
-                if lo == 0 && boundary.left_wall() {
+                if lo == 0 && left_wall {
                     record[0] = hertz_force(-u[0]);
                 }
-                if hi == n_sites - 1 && boundary.right_wall() {
+                if hi == n_sites - 1 && right_wall {
                     record[n_sites] = hertz_force(u[n_sites - 1]);
                 }
             }
         }
         acc_w[u_w.len() - 1] = previous;
-        if lo == 0 && boundary.left_wall() {
+        if lo == 0 && left_wall {
             acc_u[0] += hertz_force(-u[0]);
         }
-        if hi == n_sites - 1 && boundary.right_wall() {
+        if hi == n_sites - 1 && right_wall {
             acc_u[n_sites - 1] -= hertz_force(u[n_sites - 1]);
         }
     }
@@ -180,7 +180,7 @@ impl Model {
     #[inline(always)]
     fn law_chain(
         law: &ContactLaw,
-        boundary: Boundary,
+        [left_wall, right_wall]: [bool; 2],
         u: &[f64],
         acc_u: &mut [f64],
         window: Window,
@@ -199,14 +199,14 @@ impl Model {
             previous = f;
         }
         acc_u[hi] = previous;
-        if lo == 0 && boundary.left_wall() {
+        if lo == 0 && left_wall {
             let elastic = law.elastic(0, -u[0]);
             if let Some(record) = bond_force.as_deref_mut() {
                 record[0] = elastic;
             }
             acc_u[0] += elastic - law.static_force(0);
         }
-        if hi == n_sites - 1 && boundary.right_wall() {
+        if hi == n_sites - 1 && right_wall {
             let elastic = law.elastic(n_sites, u[n_sites - 1]);
             if let Some(record) = bond_force {
                 record[n_sites] = elastic;
@@ -216,7 +216,10 @@ impl Model {
     }
 
     /// The springs of soft ends (without dashpots: a model with one is dissipative and runs
-    /// [`Model::damped_accelerations_in`]), added to the window's end sites.
+    /// [`Model::damped_accelerations_in`]), added to the window's end sites. Out of line: the
+    /// force loop of chains without them should not carry it.
+    #[inline(never)]
+    #[cold]
     fn spring_ends(&self, u: &[f64], acc_u: &mut [f64], window: Window) {
         let last = self.n_sites() - 1;
         if let (0, Some((spring, _))) = (window.lo, self.boundary().left().soft()) {
@@ -253,7 +256,7 @@ impl Model {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::Resonator;
+    use crate::model::{Boundary, Resonator};
 
     /// The force is minus the gradient of the potential energy: check by central differences.
     #[test]

@@ -95,13 +95,13 @@ impl Boundary {
     /// Whether a wall lies beyond the first site.
     #[inline(always)]
     pub fn left_wall(self) -> bool {
-        self.left() == End::Fixed
+        matches!(self.left(), End::Fixed)
     }
 
     /// Whether a wall lies beyond the last site.
     #[inline(always)]
     pub fn right_wall(self) -> bool {
-        self.right() == End::Fixed
+        matches!(self.right(), End::Fixed)
     }
 
     /// Whether either end is soft (a spring, perhaps with a dashpot).
@@ -231,6 +231,10 @@ pub struct Model {
     damping: Option<Box<Damping>>,
     /// Whether anything dissipates: the state then ends with D ([`Model::state_len`]).
     dissipative: bool,
+    /// Whether walls lie beyond the first and the last site, and whether an end is soft:
+    /// what the force loop asks of the boundary at every evaluation, answered once.
+    walls: [bool; 2],
+    soft_end: bool,
 }
 
 impl Model {
@@ -289,6 +293,8 @@ impl Model {
             contacts: None,
             damping: None,
             dissipative: boundary.dissipates(),
+            walls: [boundary.left_wall(), boundary.right_wall()],
+            soft_end: boundary.has_soft_end(),
         })
     }
 
@@ -376,6 +382,18 @@ impl Model {
     /// The boundary condition.
     pub fn boundary(&self) -> Boundary {
         self.boundary
+    }
+
+    /// Whether walls lie beyond the first and the last site.
+    #[inline(always)]
+    pub fn walls(&self) -> [bool; 2] {
+        self.walls
+    }
+
+    /// Whether an end is soft (a spring, perhaps with a dashpot).
+    #[inline(always)]
+    pub fn has_soft_end(&self) -> bool {
+        self.soft_end
     }
 
     /// The resonators, in the order their coordinates follow the sites in the state.

@@ -177,9 +177,11 @@ impl<const S: usize> ContactEvents<S> {
     ) {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
-        for bond in self.carried.drain(..) {
-            if !self.changed.contains(&bond) {
-                self.changed.push(bond);
+        if !self.carried.is_empty() {
+            for bond in self.carried.drain(..) {
+                if !self.changed.contains(&bond) {
+                    self.changed.push(bond);
+                }
             }
         }
         let (q, v) = start.split_at(n);
@@ -396,15 +398,12 @@ impl<const S: usize> ContactEvents<S> {
         let wall_changed = |bond: usize, d_end: f64| {
             changes_contact::<S>(std::array::from_fn(|s| forces[s][bond]), d_end)
         };
-        let boundary = model.boundary();
-        if lo == 0 && boundary.left_wall() && wall_changed(0, offset(0) - new_q[0]) {
+        let [left_wall, right_wall] = model.walls();
+        if lo == 0 && left_wall && wall_changed(0, offset(0) - new_q[0]) {
             changed.push((0, None, Some(0)));
         }
         let last = n_sites - 1;
-        if hi == last
-            && boundary.right_wall()
-            && wall_changed(n_sites, offset(n_sites) + new_q[last])
-        {
+        if hi == last && right_wall && wall_changed(n_sites, offset(n_sites) + new_q[last]) {
             changed.push((n_sites, Some(last), None));
         }
     }
@@ -514,6 +513,8 @@ pub(crate) const NYSTROM_VELOCITIES: &[f64] = &[];
 /// Stage `stage`'s accelerations `acc` at positions `q` (and velocities `v`, which only a
 /// dissipative model reads), recording every bond force into `contact` when a contact-event
 /// method keeps them. Returns the stage's dissipated power (0 for a conservative chain).
+/// Inlined into each method's stage loop, as it was before the dissipative branch existed.
+#[inline(always)]
 pub(crate) fn stage_accelerations<const S: usize>(
     model: &Model,
     contact: Option<&mut ContactEvents<S>>,
@@ -522,17 +523,31 @@ pub(crate) fn stage_accelerations<const S: usize>(
     window: Window,
 ) -> f64 {
     if model.is_dissipative() {
-        let record = contact.map(|c| BondRecord {
-            force: &mut c.stage_force[stage],
-            power: &mut c.stage_power[stage],
-        });
-        return model.damped_recording(t, (q, v), acc, window, record);
+        return damped_stage_accelerations(model, contact, (q, v, acc), (t, stage), window);
     }
     match contact {
         None => model.accelerations_in(t, q, acc, window),
         Some(c) => model.accelerations_recording(t, q, acc, window, &mut c.stage_force[stage]),
     }
     0.0
+}
+
+/// [`stage_accelerations`] of a dissipative chain. Kept out of line: the conservative
+/// methods' stage loops inline [`stage_accelerations`], and should not carry this path's code.
+#[inline(never)]
+#[cold]
+fn damped_stage_accelerations<const S: usize>(
+    model: &Model,
+    contact: Option<&mut ContactEvents<S>>,
+    (q, v, acc): (&[f64], &[f64], &mut [f64]),
+    (t, stage): (f64, usize),
+    window: Window,
+) -> f64 {
+    let record = contact.map(|c| BondRecord {
+        force: &mut c.stage_force[stage],
+        power: &mut c.stage_power[stage],
+    });
+    model.damped_recording(t, (q, v), acc, window, record)
 }
 
 /// Ends a step of a method that can correct contact events: corrects `y_new` (the new state,
