@@ -197,7 +197,7 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-stages", "stability.rs:run", 138),
     ("woodpile-plot", "draw.rs:lines_panel", 137),
     ("woodpile-plot", "heat.rs:panel", 130),
-    ("woodpile-stages", "render/spec.rs:parse_panel", 124),
+    ("woodpile-stages", "render/spec.rs:parse_panel", 112),
     ("woodpile-bench", "main.rs:main", 117),
     ("woodpile-py", "sweep.rs:columns", 93),
     ("woodpile-stages", "render/draw.rs:draw", 101),

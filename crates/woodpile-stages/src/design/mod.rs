@@ -155,16 +155,7 @@ impl Design {
             return Err(fields.error("space", "is required"));
         };
         let space = parse_space(fields.nested("space", space))?;
-        let each_resonator: toml::Table = fields.optional("each_resonator")?.unwrap_or_default();
-        if let Some(placed) = ["site", "eps", "kappa", "p"]
-            .into_iter()
-            .find(|k| each_resonator.contains_key(*k))
-        {
-            return Err(fields.error(
-                &format!("each_resonator.{placed}"),
-                "the design sets each resonator's site, eps, kappa and p",
-            ));
-        }
+        let each_resonator = parse_each_resonator(fields)?;
         let template: toml::Table = fields.required("scene")?;
         if template.contains_key("defect") {
             return Err(fields.error(
@@ -503,5 +494,21 @@ impl Kind for Design {
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
         vec![best_path(results, stage)]
+    }
+}
+
+/// `each_resonator`: defect keys laid on every resonator the design places, but none of the
+/// keys the design sets itself.
+fn parse_each_resonator(fields: &mut Fields<'_>) -> Result<toml::Table> {
+    let each: toml::Table = fields.optional("each_resonator")?.unwrap_or_default();
+    match ["site", "eps", "kappa", "p"]
+        .into_iter()
+        .find(|k| each.contains_key(*k))
+    {
+        Some(placed) => Err(fields.error(
+            &format!("each_resonator.{placed}"),
+            "the design sets each resonator's site, eps, kappa and p",
+        )),
+        None => Ok(each),
     }
 }

@@ -164,20 +164,7 @@ pub(super) fn parse_panel(
                 y_label,
                 mark_halving: flag(&mut f, "mark_halving")?,
             };
-            if let Plot::Lines {
-                y,
-                series,
-                series_label,
-                ..
-            } = &plot
-            {
-                if series.is_some() && y.len() != 1 {
-                    return Err(f.error("y", "with `series`, give exactly one y column"));
-                }
-                if series.is_none() && series_label.is_some() {
-                    return Err(f.error("series_label", "needs `series`"));
-                }
-            }
+            check_series(&plot, &f)?;
             f.finish()?;
             plot
         }
@@ -285,6 +272,25 @@ fn parse_z_range(f: &mut Fields<'_>, colours: &Colours) -> Result<ZRange> {
             }
         }
     }
+}
+
+/// A `[lines]` with `series` draws one y column, and `series_label` needs `series`.
+fn check_series(plot: &Plot, f: &Fields<'_>) -> Result<()> {
+    if let Plot::Lines {
+        y,
+        series,
+        series_label,
+        ..
+    } = plot
+    {
+        if series.is_some() && y.len() != 1 {
+            return Err(f.error("y", "with `series`, give exactly one y column"));
+        }
+        if series.is_none() && series_label.is_some() {
+            return Err(f.error("series_label", "needs `series`"));
+        }
+    }
+    Ok(())
 }
 
 /// `series_style = { E_tr = { colour = "#009e73", dash = "dashed", marker = "circle", label =
