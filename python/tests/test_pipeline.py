@@ -109,3 +109,23 @@ def test_read_refuses_a_table_without_a_seal(small_pipeline):
     pd.DataFrame({"x": [1.0]}).to_parquet(p.table_path("small_sweep"))
     with pytest.raises(ValueError, match="not a woodpile table"):
         p.read("small_sweep")
+
+
+def test_run_a_variant_with_set(small_pipeline):
+    p = woodpile.Pipeline(small_pipeline)
+    summary = p.run("small_fractions", set={"small_fractions.at": 20.0})
+    variants = [s["stage"] for s in summary["stages"] if s["stage"].startswith("small_fractions--")]
+    assert len(variants) == 1
+    table = p.read(variants[0])
+    assert (table.t == 20.0).all()
+    with pytest.raises(woodpile.SceneError, match="no_such_key"):
+        p.run(set={"small_fractions.no_such_key": 1})
+
+
+def test_new_study_runs_as_written(tmp_path):
+    p = woodpile.new_study(tmp_path / "study")
+    assert (p.status().state == "missing").all()
+    assert p.run()["ran"] > 0
+    assert (p.status().state == "fresh").all()
+    with pytest.raises(woodpile.SceneError):
+        woodpile.new_study(tmp_path / "study")

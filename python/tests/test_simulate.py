@@ -181,3 +181,10 @@ def test_a_sweep_over_a_damping_key_has_d_on_every_row():
     assert frame["D"].iloc[0] == 0.0 and frame["D"].iloc[1] > frame["D"].iloc[0]
     total = frame["R"] + frame["T"] + frame["E_tr"] + frame["D"]
     assert (abs(total - 1.0) < 1e-6).all()
+
+
+def test_a_wave_reaching_an_end_before_t_end_warns():
+    short = {"chain": {"n": 20}, "impulse": {"site": -15}, "run": {"t_end": 60.0, "tolerance": 1e-6}}
+    with pytest.warns(woodpile.EndReachedWarning, match="reached an end of the chain"):
+        r = woodpile.simulate(short)
+    assert 10.0 < r.end_reached_at < 60.0

@@ -1,7 +1,7 @@
 """woodpile: granular chains with internal resonator defects, from Python.
 
 Simulate one scene (``simulate``) or a grid of them on every core (``sweep``), and drive the
-figure pipeline of a woodpile project (``Pipeline``). Scenes are dicts with the keys of a
+figure pipeline of a woodpile project (``Pipeline``; ``new_study`` makes one). Scenes are dicts with the keys of a
 scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile repository.
 
 >>> import woodpile
@@ -12,16 +12,18 @@ scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile 
 """
 
 from ._core import SceneError, SimulationError, __version__, scene_toml
-from ._pipeline import Pipeline
-from ._simulate import SimulationResult, simulate
+from ._pipeline import Pipeline, new_study
+from ._simulate import EndReachedWarning, SimulationResult, simulate
 from ._sweep import sweep
 
 __all__ = [
+    "EndReachedWarning",
     "Pipeline",
     "SceneError",
     "SimulationError",
     "SimulationResult",
     "__version__",
+    "new_study",
     "scene_toml",
     "simulate",
     "sweep",

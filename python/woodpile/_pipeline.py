@@ -16,7 +16,7 @@ import os
 import shutil
 import subprocess
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
 import pandas as pd
 
@@ -112,19 +112,26 @@ class Pipeline:
         *,
         force: bool = False,
         dry_run: bool = False,
+        set: Optional[Mapping[str, Any]] = None,
     ) -> Dict[str, Any]:
         """Bring ``stage`` (a name, several, or all when None) up to date, upstream first.
 
+        ``set={"f4_fractions.at": 120.0}`` runs a variant of a stage with keys of its file
+        set, without editing it (``woodpile run --set``): its table is
+        ``results/<stage>--<key>-<value>.parquet``, named in the summary's ``stages``.
+
         Returns the run's summary: ``stages`` (each ``stage``, ``runs``, ``why``,
         ``points``, ``cached``), ``ran``, ``fresh``, ``scenes_simulated``, ``seconds``.
-        Raises ``SceneError`` for a bad stage definition and ``SimulationError`` when a
-        stage fails (the message names every failure)."""
+        Raises ``SceneError`` for a bad stage definition or ``set`` key and
+        ``SimulationError`` when a stage fails (the message names every failure)."""
         names: List[str] = [] if stage is None else [stage] if isinstance(stage, str) else list(stage)
         args = ["run", "--json"]
         if force:
             args.append("--force")
         if dry_run:
             args.append("--dry-run")
+        for key, value in (set or {}).items():
+            args += ["--set", f"{key}={_toml_value(value)}"]
         # After `--`, a name is a name: "--force" cannot pass for the flag.
         return json.loads(self._command(args, names))
 
@@ -175,6 +182,44 @@ class Pipeline:
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no figure for stage `{stage}` (run it first)")
         return path
+
+
+def new_study(path: PathLike, *, woodpile: Optional[PathLike] = None) -> Pipeline:
+    """Make a new study folder at ``path`` that runs as written (``woodpile new study``):
+    a sweep, its reduction and a figure, with a README of what to change. Returns its
+    ``Pipeline``. Raises ``SceneError`` when ``path`` exists."""
+    target = Path(path).absolute()
+    binary = str(woodpile) if woodpile is not None else find_woodpile()
+    done = subprocess.run(
+        [binary, "new", "study", str(target)], cwd=target.parent, capture_output=True, text=True
+    )
+    if done.returncode == 2:
+        raise _core.SceneError(_message(done.stderr))
+    if done.returncode != 0:
+        raise _core.SimulationError(_message(done.stderr))
+    return Pipeline(target, woodpile=binary)
+
+
+def _toml_value(value: Any) -> str:
+    """``value`` as a TOML value for ``woodpile run --set`` (numbers, booleans, strings,
+    lists and tables of them; NumPy scalars included)."""
+    if hasattr(value, "item") and not isinstance(value, (list, tuple, dict)):
+        value = value.item()
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if value != value or value in (float("inf"), float("-inf")):
+            raise _core.SceneError(f"set: {value} is not a number a stage file can hold")
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{json.dumps(str(k))} = {_toml_value(v)}" for k, v in value.items()) + "}"
+    raise _core.SceneError(f"set: a {type(value).__name__} is not a TOML value")
 
 
 def _message(stderr: str) -> str:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 import os
 from typing import Any, Dict, List, Optional, Tuple, Union
 
@@ -62,6 +63,7 @@ class SimulationResult:
     wall_s: float
     version: str
     physical: Optional[Dict[str, Any]]
+    end_reached_at: Optional[float]
 
     t: np.ndarray
     sites: Optional[np.ndarray]
@@ -149,4 +151,18 @@ def simulate(
 
     The GIL is released while the scene runs, so other Python threads go on.
     """
-    return SimulationResult(_core.simulate(scene, fields, field_sites))
+    result = SimulationResult(_core.simulate(scene, fields, field_sites))
+    reached = result.end_reached_at
+    if reached is not None and reached < result.t_end:
+        warnings.warn(
+            f"the wave reached an end of the chain at t = {reached}, before t_end = "
+            f"{result.t_end}: R and T include what that end sent back",
+            EndReachedWarning,
+            stacklevel=2,
+        )
+    return result
+
+
+class EndReachedWarning(UserWarning):
+    """A run's wave reached an end of the chain before ``t_end`` (``end_reached_at``): its
+    R and T include what that end sent back."""

@@ -10,7 +10,7 @@ use serde_json::{json, Value};
 use woodpile_pipeline::canonical::{code_version, scene_json, Key};
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::{self, Columns};
-use woodpile_scene::report::simulate_report;
+use woodpile_scene::report::{simulate_report, wall_note};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::run::{simulate, Outcome};
@@ -67,6 +67,9 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     .map_err(Failure::simulation)?;
     let wall_s = started.elapsed().as_secs_f64();
     let report = simulate_report(&scene, &outcome, wall_s);
+    if let Some(note) = wall_note(&scene, &outcome) {
+        eprintln!("note: {}: {note}", args.scene.display());
+    }
     let (series, field) = observers;
     if let Some(path) = &args.series {
         write_series(path, &args.scene, &scene, &outcome, &series)?;

@@ -426,3 +426,20 @@ fn a_damped_scene_reports_its_ledger() {
     let nystrom = scene_file(&format!("{damped}method = \"rkn4-contact\"\ndt = 0.01\n"));
     assert_refused(&nystrom, &["run.method", "rk4-contact"]);
 }
+
+/// A wave that reaches a wall before `t_end`: the JSON says when, and stderr notes that R and
+/// T include what the wall sent back; a run that ends first says nothing.
+#[test]
+fn a_wave_reaching_an_end_before_t_end_is_noted() {
+    let short = "[chain]\nn = 20\n[impulse]\nsite = -15\n[run]\nt_end = 60.0\ntolerance = 1e-6\n";
+    let (out, _) = simulate(short);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let reached = json_number(&String::from_utf8(out.stdout).unwrap(), "end_reached_at");
+    assert!(reached > 10.0 && reached < 60.0, "{reached}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("note:") && stderr.contains(&format!("t = {reached}")), "{stderr}");
+    let (quiet, _) = simulate(&short.replace("t_end = 60.0", "t_end = 5.0"));
+    let v: serde_json::Value = serde_json::from_slice(&quiet.stdout).unwrap();
+    assert!(v["end_reached_at"].is_null());
+    assert!(quiet.stderr.is_empty());
+}

@@ -41,6 +41,7 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         "normalisation": if dissipative { "E(0)" } else { "E(t_end)" },
         "region": scene.region_paper,
         "t_end": scenario.t_end,
+        "end_reached_at": out.stats.end_reached_at,
         "version": env!("CARGO_PKG_VERSION"),
     });
     if scenario.region.has_striker() {
@@ -62,4 +63,14 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         }
     }
     report
+}
+
+/// The note for a run whose wave reached an end of the chain before `t_end`, naming the time:
+/// its R and T then hold what that end sent back. `None` when it did not.
+pub fn wall_note(scene: &Scene, out: &Outcome) -> Option<String> {
+    let t_end = scene.scenario.t_end;
+    let reached = out.stats.end_reached_at.filter(|&t| t < t_end)?;
+    Some(format!(
+        "the wave reached an end of the chain at t = {reached}, before t_end = {t_end}: R and T include what that end sent back (a longer chain, or an earlier t_end, keeps them apart)"
+    ))
 }
