@@ -7,6 +7,7 @@
 mod interrupt;
 mod pool;
 mod scene_input;
+mod series;
 mod simulate;
 mod sweep;
 

@@ -9,30 +9,39 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use woodpile_scene::report::simulate_report;
 use woodpile_scene::Scene;
-use woodpile_sim::observe::{FractionSeries, SiteField};
+use woodpile_sim::observe::SiteField;
 use woodpile_sim::run::simulate as run;
 
 use crate::interrupt::{on_this_thread, Watch};
 use crate::scene_input::{shown, Source};
+use crate::series::SeriesKind;
 use crate::{SceneError, SimulationError};
 
-/// _simulate(scene, fields=False, field_sites=None) -> dict
+/// _simulate(scene, fields=False, field_sites=None, series=None) -> dict
 /// --
 ///
 /// The native call behind `woodpile.simulate`: a dict with `report` (the CLI's JSON text),
 /// `series` (t, R, T, E_tr, E arrays, S with a striker, D with damping) and, when a field is asked for, `t`, `sites`,
 /// `velocity` and `displacement`.
 #[pyfunction]
-#[pyo3(signature = (scene, fields = false, field_sites = None))]
+#[pyo3(signature = (scene, fields = false, field_sites = None, series = None))]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     fields: bool,
     field_sites: Option<(i64, i64)>,
+    series: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let kind = match series {
+        Some(value) => SeriesKind::parse(value, false)?.unwrap_or(SeriesKind::Energy),
+        None => SeriesKind::Energy,
+    };
     let source = Source::of(scene)?;
     let label = shown(&source.label());
     let scene = source.scene()?;
+    let recorder = kind
+        .recorder(&scene.scenario)
+        .map_err(|reason| SceneError::new_err(format!("{label}: series: {reason}")))?;
     let sites = match field_sites {
         Some(range) => Some(internal_sites(&scene, range)?),
         None if fields => Some((0, scene.scenario.model.n_sites() - 1)),
@@ -44,7 +53,7 @@ pub(crate) fn simulate<'py>(
             .map_err(|reason| SceneError::new_err(format!("{label}: field: {reason}")))?;
     }
     let (outcome, wall_s, series, field) = on_this_thread(py, |stop| {
-        let series = FractionSeries::new(&s.model, s.region);
+        let series = recorder;
         let started = Instant::now();
         match sites {
             Some((first, last)) => {

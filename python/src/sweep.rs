@@ -11,6 +11,8 @@ use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use woodpile_scene::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
+
+use crate::series::SeriesKind;
 use woodpile_scene::Scene;
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::run::{simulate, Outcome};
@@ -38,19 +40,23 @@ impl Point {
     }
 }
 
-/// _sweep(scene, axes, series=False) -> dict
+/// _sweep(scene, axes, series=None) -> dict
 /// --
 ///
 /// The native call behind `woodpile.sweep`: `names` (the columns in order) and each column as
 /// an array or list; `valid` masks the integer columns of failed points.
 #[pyfunction]
-#[pyo3(signature = (scene, axes, series = false))]
+#[pyo3(signature = (scene, axes, series = None))]
 pub(crate) fn sweep<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     axes: &Bound<'py, PyDict>,
-    series: bool,
+    series: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let kind = match series {
+        Some(value) => SeriesKind::parse(value, true)?,
+        None => None,
+    };
     let source = Source::of(scene)?;
     let label = shown(&source.label());
     let template = source.table()?;
@@ -75,7 +81,7 @@ pub(crate) fn sweep<'py>(
     // every axis's extremes, as a sweep stage checks them.
     grid.scene_at(0).map_err(SceneError::new_err)?;
     let last = grid.scene_at(count - 1).map_err(SceneError::new_err)?;
-    if series {
+    if kind.is_some() {
         woodpile_scene::grid::check_sweep_memory(count, &last)
             .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
     }
@@ -83,12 +89,12 @@ pub(crate) fn sweep<'py>(
         crate::pool::run_parallel(|| {
             (0..count)
                 .into_par_iter()
-                .map(|i| grid.simulate(i, series, cancel))
+                .map(|i| grid.simulate(i, kind, cancel))
                 .collect()
         })
     })?
     .map_err(pyo3::exceptions::PyValueError::new_err)?;
-    grid.columns(py, &points, series)
+    grid.columns(py, &points, kind.is_some())
 }
 
 /// A stage-file key of the template without its `scene.` prefix: in Python the dict is the scene.
@@ -127,7 +133,12 @@ impl Grid {
             .map_err(|e| format!("{e}{at}"))
     }
 
-    fn simulate(&self, index: usize, series: bool, cancel: &AtomicBool) -> Result<Point, String> {
+    fn simulate(
+        &self,
+        index: usize,
+        series: Option<SeriesKind>,
+        cancel: &AtomicBool,
+    ) -> Result<Point, String> {
         if cancel.load(Ordering::Relaxed) {
             return Err("cancelled".into());
         }
@@ -135,9 +146,9 @@ impl Grid {
         let s = &scene.scenario;
         let stop = || cancel.load(Ordering::Relaxed);
         let run = || -> Result<Point, String> {
-            if series {
+            if let Some(kind) = series {
                 let mut watched = Watch {
-                    inner: FractionSeries::new(&s.model, s.region),
+                    inner: kind.recorder(s)?,
                     stop: &stop,
                 };
                 let outcome = simulate(s, &mut watched).map_err(|e| e.to_string())?;

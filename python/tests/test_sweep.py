@@ -181,3 +181,20 @@ print(len(woodpile.sweep(long, {"eps": np.linspace(0.1, 4.0, 150)})))
 """
     done = _python(code, env={"RAYON_NUM_THREADS": "2"}, timeout=120)
     assert done.returncode == 0 and done.stdout.strip() == "150", done.stderr[-2000:]
+
+
+def test_a_kinetic_series_starts_with_the_impact_energy_left_of_the_region():
+    scene = {"chain": {"n": 30}, "impulse": {"site": -20}, "defect": [{"site": 0, "eps": "$eps"}],
+             "run": {"t_end": 20.0, "tolerance": 1e-6}}
+    frame = woodpile.sweep(scene, {"eps": [1.0, 2.0]}, series="kinetic")
+    first = frame[frame.t == 0.0]
+    assert (first.R == 1.0).all() and (first.E_tr == 0.0).all()
+    energy = woodpile.sweep(scene, {"eps": [1.0, 2.0]}, series=True)
+    assert (abs(frame.R.values - energy.R.values) > 1e-3).any()
+    r = woodpile.simulate(dict(scene, defect=[{"site": 0, "eps": 1.0}]), series="kinetic")
+    assert r.series.R.iloc[0] == 1.0
+    for bad in ("kinetik", 3):
+        with pytest.raises(woodpile.SceneError, match="series"):
+            woodpile.sweep(scene, {"eps": [1.0]}, series=bad)
+    with pytest.raises(woodpile.SceneError, match="series"):
+        woodpile.simulate(dict(scene, defect=[]), series="total")

@@ -126,6 +126,7 @@ def simulate(
     *,
     fields: bool = False,
     field_sites: Optional[Tuple[int, int]] = None,
+    series: str = "energy",
 ) -> SimulationResult:
     """Simulate one scene and return its fractions, series and (optionally) field.
 
@@ -135,6 +136,9 @@ def simulate(
             file (``str`` or ``os.PathLike``). Keys left out take the paper's defaults.
         fields: also record every site's velocity and displacement at every sample.
         field_sites: record only the paper sites ``lo..=hi`` (implies ``fields``).
+        series: what ``series`` splits: ``"energy"`` (shares of the total energy) or
+            ``"kinetic"`` (kinetic energy over the impact energy, the woodpile experiment's
+            measure, paper Fig. 2).
 
     Returns:
         A ``SimulationResult``: ``R``, ``T``, ``E_tr`` (fractions at ``t_end``),
@@ -151,7 +155,7 @@ def simulate(
 
     The GIL is released while the scene runs, so other Python threads go on.
     """
-    result = SimulationResult(_core.simulate(scene, fields, field_sites))
+    result = SimulationResult(_core.simulate(scene, fields, field_sites, series))
     reached = result.end_reached_at
     if reached is not None and reached < result.t_end:
         warnings.warn(

@@ -13,7 +13,9 @@ from ._simulate import Scene
 Axis = Union[Sequence[float], Sequence[int], "np.ndarray", Mapping[str, float]]
 
 
-def sweep(scene: Scene, axes: Mapping[str, Axis], *, series: bool = False) -> pd.DataFrame:
+def sweep(
+    scene: Scene, axes: Mapping[str, Axis], *, series: Union[bool, str] = False
+) -> pd.DataFrame:
     """Simulate every point of a grid of scenes, on all cores, and return one table.
 
     The grid is a sweep stage's: ``scene`` holds ``"$name"`` placeholders (and may repeat a
@@ -26,7 +28,9 @@ def sweep(scene: Scene, axes: Mapping[str, Axis], *, series: bool = False) -> pd
         scene: the scene template: a dict, a TOML string or a path.
         axes: axis name -> values.
         series: one row per point and sample (columns t, R, T, E_tr, E) instead of one row
-            per point with the fractions at ``t_end``.
+            per point with the fractions at ``t_end``: ``True`` or ``"energy"`` for shares of
+            the total energy, ``"kinetic"`` for kinetic energy over the impact energy (as a
+            sweep stage's ``series = "kinetic"``; E is then the kinetic share).
 
     Returns:
         A DataFrame: ``point``, the axes, then ``R``, ``T``, ``E_tr`` (or, with

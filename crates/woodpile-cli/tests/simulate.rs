@@ -433,11 +433,18 @@ fn a_damped_scene_reports_its_ledger() {
 fn a_wave_reaching_an_end_before_t_end_is_noted() {
     let short = "[chain]\nn = 20\n[impulse]\nsite = -15\n[run]\nt_end = 60.0\ntolerance = 1e-6\n";
     let (out, _) = simulate(short);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let reached = json_number(&String::from_utf8(out.stdout).unwrap(), "end_reached_at");
     assert!(reached > 10.0 && reached < 60.0, "{reached}");
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("note:") && stderr.contains(&format!("t = {reached}")), "{stderr}");
+    assert!(
+        stderr.contains("note:") && stderr.contains(&format!("t = {reached}")),
+        "{stderr}"
+    );
     let (quiet, _) = simulate(&short.replace("t_end = 60.0", "t_end = 5.0"));
     let v: serde_json::Value = serde_json::from_slice(&quiet.stdout).unwrap();
     assert!(v["end_reached_at"].is_null());
