@@ -33,6 +33,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
     m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
     m.add_function(wrap_pyfunction!(table_integrity, m)?)?;

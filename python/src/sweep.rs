@@ -73,7 +73,7 @@ pub(crate) fn sweep<'py>(
     })?;
     let grid = Grid {
         axes,
-        template,
+        scenes: Scenes::Template(template),
         label,
     };
     let count = point_count(&grid.axes);
@@ -85,16 +85,36 @@ pub(crate) fn sweep<'py>(
         woodpile_scene::grid::check_sweep_memory(count, &last)
             .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
     }
-    let points: Vec<Result<Point, String>> = interruptible(py, |cancel| {
-        crate::pool::run_parallel(|| {
-            (0..count)
-                .into_par_iter()
-                .map(|i| grid.simulate(i, kind, cancel))
-                .collect()
-        })
-    })?
-    .map_err(pyo3::exceptions::PyValueError::new_err)?;
-    grid.columns(py, &points, kind.is_some())
+    grid.run(py, count, kind)
+}
+
+/// _simulate_many(scenes) -> dict
+/// --
+///
+/// The native call behind `woodpile.simulate_many`: every scene of the list (dicts, TOML
+/// strings or paths) simulated on all cores with the GIL released, one row each in input
+/// order, as `_sweep` returns its points (without axes). A scene that fails to simulate is a
+/// row with its reason; one that is invalid is a `SceneError` naming its index.
+#[pyfunction]
+pub(crate) fn simulate_many<'py>(
+    py: Python<'py>,
+    scenes: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut list = Vec::new();
+    for (index, item) in scenes.try_iter()?.enumerate() {
+        let source = Source::of(&item?)?;
+        let scene = source
+            .scene()
+            .map_err(|e| SceneError::new_err(format!("scenes[{index}]: {}", e.value(py))))?;
+        list.push(scene);
+    }
+    let count = list.len();
+    let grid = Grid {
+        axes: Vec::new(),
+        scenes: Scenes::List(list),
+        label: "<scenes>".into(),
+    };
+    grid.run(py, count, None)
 }
 
 /// A stage-file key of the template without its `scene.` prefix: in Python the dict is the scene.
@@ -104,13 +124,51 @@ fn unprefixed(key: &str) -> &str {
 
 struct Grid {
     axes: Vec<Axis>,
-    template: Template,
+    scenes: Scenes,
     label: String,
 }
 
+/// Where a grid's scenes come from: a template over its axes, or a list given whole.
+enum Scenes {
+    Template(Template),
+    List(Vec<Scene>),
+}
+
 impl Grid {
+    /// Simulates the grid's `count` points on every core with the GIL released, and returns
+    /// their table.
+    fn run<'py>(
+        &self,
+        py: Python<'py>,
+        count: usize,
+        kind: Option<SeriesKind>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let points: Vec<Result<Point, String>> = interruptible(py, |cancel| {
+            crate::pool::run_parallel(|| {
+                (0..count)
+                    .into_par_iter()
+                    .map(|i| self.simulate(i, kind, cancel))
+                    .collect()
+            })
+        })?
+        .map_err(pyo3::exceptions::PyValueError::new_err)?;
+        self.columns(py, &points, kind.is_some())
+    }
+
+    /// Whether its scenes declare dissipation: the table then has `D` on every row.
+    fn declares_dissipation(&self) -> bool {
+        match &self.scenes {
+            Scenes::Template(template) => template.declares_dissipation(),
+            Scenes::List(list) => list.iter().any(|s| s.scenario.model.is_dissipative()),
+        }
+    }
+
     /// The validated scene of point `index`, or the error naming its axis values.
     fn scene_at(&self, index: usize) -> Result<Scene, String> {
+        let template = match &self.scenes {
+            Scenes::List(list) => return Ok(list[index].clone()),
+            Scenes::Template(template) => template,
+        };
         let values = point(&self.axes, index);
         let at: Vec<String> = self
             .axes
@@ -123,8 +181,7 @@ impl Grid {
         } else {
             format!(" (at {})", at.join(", "))
         };
-        let table = self
-            .template
+        let table = template
             .instantiate(&self.axes, &values)
             .map_err(|(key, reason)| {
                 format!("{}: key `{}`: {reason}{at}", self.label, unprefixed(&key))
@@ -223,7 +280,7 @@ impl Grid {
         let ok = |i: usize| points[i].as_ref().ok();
         // D on every row of a sweep whose scene declares dissipation (0 where it dissipates
         // nothing), as in a pipeline sweep's table.
-        let dissipation = self.template.declares_dissipation();
+        let dissipation = self.declares_dissipation();
         let mut float =
             |name: &str, f: &dyn Fn(&Point, Option<usize>) -> Option<f64>| -> PyResult<()> {
                 let v: Vec<f64> = rows

@@ -198,3 +198,19 @@ def test_a_kinetic_series_starts_with_the_impact_energy_left_of_the_region():
             woodpile.sweep(scene, {"eps": [1.0]}, series=bad)
     with pytest.raises(woodpile.SceneError, match="series"):
         woodpile.simulate(dict(scene, defect=[]), series="total")
+
+
+def test_simulate_many_runs_any_list_in_order_as_simulate_does():
+    base = {"chain": {"n": 40}, "impulse": {"site": -20}, "run": {"t_end": 30.0, "tolerance": 1e-6}}
+    scenes = [dict(base, defect=[{"site": 0, "eps": eps}]) for eps in (3.0, 0.5, 1.5)]
+    scenes.append(woodpile.scene_toml(scenes[0]))
+    scenes.append(dict(base, defect=[{"site": 0, "eps": 1.0}], run={"t_end": 30.0, "method": "rk4", "dt": 5.0}))
+    frame = woodpile.simulate_many(scenes)
+    assert list(frame.point) == [0, 1, 2, 3, 4]
+    for i in range(3):
+        one = woodpile.simulate(scenes[i])
+        assert frame.R[i] == one.R and frame.E_tr[i] == one.E_tr and frame.method[i] == one.method
+    assert frame.E_tr[3] == frame.E_tr[0]
+    assert frame.failure[4] is not None and np.isnan(frame.E_tr[4])
+    with pytest.raises(woodpile.SceneError, match=r"scenes\[1\]"):
+        woodpile.simulate_many([scenes[0], dict(base, defect=[{"site": 0, "eps": -1.0}])])

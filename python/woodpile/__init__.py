@@ -14,7 +14,7 @@ scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile 
 from ._core import SceneError, SimulationError, __version__, scene_toml
 from ._pipeline import Pipeline, new_study
 from ._simulate import EndReachedWarning, SimulationResult, simulate
-from ._sweep import sweep
+from ._sweep import simulate_many, sweep
 
 __all__ = [
     "EndReachedWarning",
@@ -26,5 +26,6 @@ __all__ = [
     "new_study",
     "scene_toml",
     "simulate",
+    "simulate_many",
     "sweep",
 ]

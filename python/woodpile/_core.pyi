@@ -1,7 +1,7 @@
 """Type stubs of the native module (``woodpile._core``); use the ``woodpile`` package's API."""
 
 import os
-from typing import Any, Dict, Mapping, Optional, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 Scene = Union[Dict[str, Any], str, "os.PathLike[str]"]
 
@@ -19,6 +19,7 @@ def simulate(
 def sweep(
     scene: Scene, axes: Mapping[str, Any], series: Union[bool, str] = False
 ) -> Dict[str, Any]: ...
+def simulate_many(scenes: Sequence[Scene]) -> Dict[str, Any]: ...
 def scene_toml(scene: Scene) -> str: ...
 
 def table_integrity(data: bytes) -> str:

@@ -1,4 +1,4 @@
-"""A grid of scenes: ``sweep``."""
+"""Many scenes at once: a grid (``sweep``) or any list (``simulate_many``)."""
 
 from __future__ import annotations
 
@@ -46,7 +46,34 @@ def sweep(
 
     The GIL is released while the sweep runs.
     """
-    raw: Dict[str, Any] = _core.sweep(scene, dict(axes), series)
+    return _frame(_core.sweep(scene, dict(axes), series))
+
+
+def simulate_many(scenes: Sequence[Scene]) -> pd.DataFrame:
+    """Simulate any list of scenes on all cores, with the GIL released: the points an
+    optimiser picks rather than a grid (SciPy's ``differential_evolution`` with
+    ``vectorized=True`` hands over a population at once).
+
+    Args:
+        scenes: dicts with the keys of a scene file, TOML strings or paths, in any mix.
+
+    Returns:
+        A DataFrame with one row per scene, in input order: ``point`` (the scene's index),
+        ``R``, ``T``, ``E_tr`` (``D`` with damping), ``E_initial``, ``E_final``,
+        ``error_estimate``, ``dt``, ``steps``, ``rhs_evals``, ``method`` and ``failure``. A
+        scene whose simulation failed is a row with NaN fractions and its reason in
+        ``failure``; each number is what ``simulate`` gives for that scene, bit for bit.
+
+    Raises:
+        SceneError: a scene is invalid (the message names its index, ``scenes[i]``).
+        KeyboardInterrupt: Ctrl-C stops the runs within about a second.
+    """
+    return _frame(_core.simulate_many(list(scenes)))
+
+
+def _frame(raw: Dict[str, Any]) -> pd.DataFrame:
+    """The native table (``names`` in order, each a column) as a DataFrame: integer columns
+    of failed points masked, text columns as objects."""
     valid = np.asarray(raw["valid"], dtype=bool)
     columns: Dict[str, Any] = {}
     for name in raw["names"]:
