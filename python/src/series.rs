@@ -48,7 +48,7 @@ impl SeriesKind {
             SeriesKind::Energy => Ok(FractionSeries::new(model, region)),
             SeriesKind::Kinetic => {
                 let impact = scenario.impact_energy();
-                if !(impact > 0.0) {
+                if impact.is_nan() || impact <= 0.0 {
                     return Err(
                         "a kinetic series is divided by the impact energy, which is zero".into(),
                     );
