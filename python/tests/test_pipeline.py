@@ -129,3 +129,12 @@ def test_new_study_runs_as_written(tmp_path):
     assert (p.status().state == "fresh").all()
     with pytest.raises(woodpile.SceneError):
         woodpile.new_study(tmp_path / "study")
+
+
+def test_run_streams_the_commands_progress_when_asked(small_pipeline, capfd):
+    p = woodpile.Pipeline(small_pipeline)
+    p.run(progress=True)
+    err = capfd.readouterr().err
+    assert "small_sweep" in err and "done" in err
+    p.run(force=True, progress=False)
+    assert capfd.readouterr().err == ""

@@ -15,6 +15,8 @@ import json
 import os
 import shutil
 import subprocess
+import sys
+import threading
 from pathlib import Path
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Union
 
@@ -82,7 +84,12 @@ class Pipeline:
     def __repr__(self) -> str:
         return f"Pipeline({str(self.root)!r})"
 
-    def _command(self, args: Sequence[str], names: Sequence[str] = ()) -> str:
+    def _command(
+        self, args: Sequence[str], names: Sequence[str] = (), echo: bool = False
+    ) -> str:
+        """Runs the ``woodpile`` command on this project and returns its stdout; with
+        ``echo``, its progress lines (stderr) reach ``sys.stderr`` as they come, which a
+        notebook shows in the cell."""
         binary = self._woodpile or find_woodpile()
         self._woodpile = binary
         where = [
@@ -91,14 +98,34 @@ class Pipeline:
             "--figures", str(self.figures_dir),
         ]
         tail = ["--", *names] if names else []
-        done = subprocess.run(
-            [binary, *args, *where, *tail], cwd=self.root, capture_output=True, text=True
+        process = subprocess.Popen(
+            [binary, *args, *where, *tail],
+            cwd=self.root,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
         )
-        if done.returncode == 2:
-            raise _core.SceneError(_message(done.stderr))
-        if done.returncode != 0:
-            raise _core.SimulationError(_message(done.stderr))
-        return done.stdout
+        stderr: List[str] = []
+
+        def read_stderr() -> None:
+            assert process.stderr is not None
+            for line in process.stderr:
+                stderr.append(line)
+                if echo:
+                    sys.stderr.write(line)
+                    sys.stderr.flush()
+
+        reader = threading.Thread(target=read_stderr, daemon=True)
+        reader.start()
+        assert process.stdout is not None
+        stdout = process.stdout.read()
+        code = process.wait()
+        reader.join()
+        if code == 2:
+            raise _core.SceneError(_message("".join(stderr)))
+        if code != 0:
+            raise _core.SimulationError(_message("".join(stderr)))
+        return stdout
 
     def status(self) -> pd.DataFrame:
         """Every stage with its kind, its state (``fresh``, ``stale``, ``missing`` or
@@ -113,12 +140,17 @@ class Pipeline:
         force: bool = False,
         dry_run: bool = False,
         set: Optional[Mapping[str, Any]] = None,
+        progress: Optional[bool] = None,
     ) -> Dict[str, Any]:
         """Bring ``stage`` (a name, several, or all when None) up to date, upstream first.
 
         ``set={"f4_fractions.at": 120.0}`` runs a variant of a stage with keys of its file
         set, without editing it (``woodpile run --set``): its table is
         ``results/<stage>--<key>-<value>.parquet``, named in the summary's ``stages``.
+
+        ``progress`` streams the command's per-stage progress lines into ``sys.stderr`` (a
+        notebook shows them in the cell) as they come; by default it does in an interactive
+        session (a notebook, or a terminal), and ``False`` silences it.
 
         Returns the run's summary: ``stages`` (each ``stage``, ``runs``, ``why``,
         ``points``, ``cached``), ``ran``, ``fresh``, ``scenes_simulated``, ``seconds``.
@@ -132,8 +164,9 @@ class Pipeline:
             args.append("--dry-run")
         for key, value in (set or {}).items():
             args += ["--set", f"{key}={_toml_value(value)}"]
+        echo = _interactive() if progress is None else progress
         # After `--`, a name is a name: "--force" cannot pass for the flag.
-        return json.loads(self._command(args, names))
+        return json.loads(self._command(args, names, echo=echo))
 
     def table_path(self, stage: str) -> Path:
         """Where ``stage``'s table is (``results/<stage>.parquet``)."""
@@ -182,6 +215,11 @@ class Pipeline:
         if not path.is_file():
             raise FileNotFoundError(f"{path}: no figure for stage `{stage}` (run it first)")
         return path
+
+
+def _interactive() -> bool:
+    """Whether someone is watching: a notebook kernel, or stderr on a terminal."""
+    return "ipykernel" in sys.modules or sys.stderr.isatty()
 
 
 def new_study(path: PathLike, *, woodpile: Optional[PathLike] = None) -> Pipeline:
