@@ -7,10 +7,11 @@ use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use woodpile_scene::report::simulate_report;
+use woodpile_scene::report::{simulate_report, unverified_report};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::SiteField;
 use woodpile_sim::run::simulate as run;
+use woodpile_sim::SimError;
 
 use crate::interrupt::{on_this_thread, Watch};
 use crate::scene_input::{shown, Source};
@@ -76,8 +77,7 @@ pub(crate) fn simulate<'py>(
             }
         }
     })?;
-    let outcome = outcome
-        .map_err(|e| SimulationError::new_err(format!("{label}: simulation failed: {e}")))?;
+    let outcome = outcome.map_err(|e| failure(py, &scene, &label, e))?;
     let report = simulate_report(&scene, &outcome, wall_s.as_secs_f64());
     let out = PyDict::new(py);
     out.set_item("report", report.to_string())?;
@@ -126,4 +126,26 @@ fn add_field(
     out.set_item("displacement", grid(field.displacement)?.into_pyarray(py))?;
     out.set_item("t", field.t.into_pyarray(py))?;
     Ok(())
+}
+
+/// The `SimulationError` of a failed run. A refused `auto` keeps its finest run on it, as
+/// `result` (the CLI's `unverified` object: fractions, step and estimate, `verified: false`);
+/// any other failure has `result = None`.
+fn failure(py: Python<'_>, scene: &Scene, label: &str, error: SimError) -> PyErr {
+    let err = SimulationError::new_err(format!("{label}: simulation failed: {error}"));
+    let kept = match &error {
+        SimError::NotConverged {
+            finest: Some(finest),
+            ..
+        } => Some(unverified_report(scene, finest).to_string()),
+        _ => None,
+    };
+    let result = kept.and_then(|text| {
+        let json = py.import("json").ok()?;
+        json.call_method1("loads", (text,)).ok()
+    });
+    // Setting an attribute on a fresh exception cannot fail in practice; if it did, the
+    // error itself still says why the run failed.
+    let _ = err.value(py).setattr("result", result);
+    err
 }

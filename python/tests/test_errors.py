@@ -150,3 +150,17 @@ def test_kernel_files_are_refused_unread():
     holding the GIL."""
     with pytest.raises(woodpile.SceneError, match="a kernel file"):
         woodpile.simulate("/proc/self/status")
+
+
+def test_a_refused_run_keeps_its_finest_run_on_the_error():
+    stiff = {"chain": {"n": 10}, "impulse": {"site": -5},
+             "defect": [{"site": 0, "eps": 0.3, "kappa": 2.0, "p": 7}],
+             "run": {"t_end": 20.0, "tolerance": 1e-13}}
+    with pytest.raises(woodpile.SimulationError, match="could not verify") as caught:
+        woodpile.simulate(stiff)
+    kept = caught.value.result
+    assert kept["verified"] is False
+    assert abs(kept["R"] + kept["T"] + kept["E_tr"] - 1.0) < 1e-9
+    with pytest.raises(woodpile.SimulationError) as blown:
+        woodpile.simulate({"run": {"method": "rk4", "dt": 5.0, "t_end": 30.0}})
+    assert blown.value.result is None

@@ -10,10 +10,11 @@ use serde_json::{json, Value};
 use woodpile_pipeline::canonical::{code_version, scene_json, Key};
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::{self, Columns};
-use woodpile_scene::report::{simulate_report, wall_note};
+use woodpile_scene::report::{simulate_report, unverified_report, wall_note};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::run::{simulate, Outcome};
+use woodpile_sim::SimError;
 
 use crate::Failure;
 
@@ -62,9 +63,22 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         simulate(s, &mut observers)
     } else {
         simulate(s, &mut ())
+    };
+    if let Err(SimError::NotConverged {
+        finest: Some(finest),
+        ..
+    }) = &outcome
+    {
+        // The minutes the finest run took are not thrown away: its numbers, marked so.
+        let kept = serde_json::json!({ "unverified": unverified_report(&scene, finest) });
+        say!(
+            "{}",
+            crate::reports::json_text(&kept, args.pretty).map_err(Failure::simulation)?
+        );
     }
-    .with_context(|| format!("{}: simulation failed", args.scene.display()))
-    .map_err(Failure::simulation)?;
+    let outcome = outcome
+        .with_context(|| format!("{}: simulation failed", args.scene.display()))
+        .map_err(Failure::simulation)?;
     let wall_s = started.elapsed().as_secs_f64();
     let report = simulate_report(&scene, &outcome, wall_s);
     if let Some(note) = wall_note(&scene, &outcome) {

@@ -450,3 +450,22 @@ fn a_wave_reaching_an_end_before_t_end_is_noted() {
     assert!(v["end_reached_at"].is_null());
     assert!(quiet.stderr.is_empty());
 }
+
+/// A refused `auto` keeps its finest run: exit 3, the reason on stderr, and on stdout its
+/// fractions under `unverified`, marked `verified: false`, with an estimate above the tolerance.
+#[test]
+fn a_refused_run_keeps_its_finest_run_marked_unverified() {
+    let stiff = "[chain]\nn = 10\n[impulse]\nsite = -5\n[[defect]]\nsite = 0\neps = 0.3\nkappa = 2.0\np = 7\n[run]\nt_end = 20.0\ntolerance = 1e-13\n";
+    let (out, _) = simulate(stiff);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("could not verify"));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let kept = &v["unverified"];
+    assert_eq!(kept["verified"], false);
+    let sum: f64 = ["R", "T", "E_tr"]
+        .iter()
+        .map(|k| kept[k].as_f64().unwrap())
+        .sum();
+    assert!((sum - 1.0).abs() < 1e-9, "{sum}");
+    assert!(kept["error_estimate"].as_f64().unwrap() > 1e-13 * 6.25e-2);
+}

@@ -74,3 +74,28 @@ pub fn wall_note(scene: &Scene, out: &Outcome) -> Option<String> {
         "the wave reached an end of the chain at t = {reached}, before t_end = {t_end}: R and T include what that end sent back (a longer chain, or an earlier t_end, keeps them apart)"
     ))
 }
+
+/// What a refused `auto` keeps of its finest run, marked unverified: the fractions at `t_end`
+/// (S and D where the scene has them), the step, and the last estimate, which did not meet
+/// the tolerance. `woodpile simulate` prints it under `unverified` with exit 3, and Python's
+/// `SimulationError.result` holds it.
+pub fn unverified_report(scene: &Scene, finest: &woodpile_sim::Unverified) -> Value {
+    let f = finest.fractions;
+    let scenario = &scene.scenario;
+    let mut report = json!({
+        "R": f.reflected,
+        "T": f.transmitted,
+        "E_tr": f.trapped,
+        "dt": finest.dt,
+        "error_estimate": finest.estimate.is_finite().then_some(finest.estimate),
+        "tolerance": scenario.accuracy.tolerance,
+        "verified": false,
+    });
+    if scenario.region.has_striker() {
+        report["S"] = json!(f.striker);
+    }
+    if scenario.model.is_dissipative() {
+        report["D"] = json!(f.dissipated);
+    }
+    report
+}

@@ -152,6 +152,8 @@ pub enum SimError {
         /// What failed at that step: the estimate, the energy drift, or the pair not being in
         /// its asymptotic regime.
         why: String,
+        /// The finest run the ladder made, unverified: what a caller may keep, marked so.
+        finest: Option<Box<Unverified>>,
     },
     /// The observer asked for the run to stop (see `Observer::cancelled`).
     #[error("cancelled at t = {t:.6}")]
@@ -173,6 +175,18 @@ pub enum SimError {
     /// The run would exceed its step or sample budget: refused before it starts.
     #[error(transparent)]
     OverBudget(#[from] OverBudget),
+}
+
+/// The finest run of a refused `auto` ladder: numbers that are not verified, kept so that the
+/// minutes it took are not lost (`woodpile simulate` prints them under `unverified`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unverified {
+    /// Its fractions at `t_end`.
+    pub fractions: crate::energy::Fractions,
+    /// The step it took.
+    pub dt: f64,
+    /// The last Richardson estimate, against the run at twice its step (infinite if none).
+    pub estimate: f64,
 }
 
 /// What sets the step that makes a run too long.

@@ -154,11 +154,20 @@ fn verified<O: Observer + ?Sized>(
             Rung::Refine(reason) => why = reason,
         }
     }
+    // After a refusal the finest run is the next rung's coarse one.
+    let finest = ladder.coarse.take().map(|run| {
+        Box::new(crate::error::Unverified {
+            fractions: run.fractions,
+            dt: run.stats.max_step,
+            estimate: ladder.estimate,
+        })
+    });
     Err(SimError::NotConverged {
         tolerance: ladder.tol,
         estimate: ladder.estimate,
         dt: 2.0 * ladder.dt,
         why: why.to_string(),
+        finest,
     })
 }
 
