@@ -80,22 +80,22 @@ pub fn wall_note(scene: &Scene, out: &Outcome) -> Option<String> {
 /// the tolerance. `woodpile simulate` prints it under `unverified` with exit 3, and Python's
 /// `SimulationError.result` holds it.
 pub fn unverified_report(scene: &Scene, finest: &woodpile_sim::Unverified) -> Value {
-    let f = finest.fractions;
+    let [reflected, transmitted, trapped, striker, dissipated] = finest.shares;
     let scenario = &scene.scenario;
     let mut report = json!({
-        "R": f.reflected,
-        "T": f.transmitted,
-        "E_tr": f.trapped,
+        "R": reflected,
+        "T": transmitted,
+        "E_tr": trapped,
         "dt": finest.dt,
         "error_estimate": finest.estimate.is_finite().then_some(finest.estimate),
         "tolerance": scenario.accuracy.tolerance,
         "verified": false,
     });
     if scenario.region.has_striker() {
-        report["S"] = json!(f.striker);
+        report["S"] = json!(striker);
     }
     if scenario.model.is_dissipative() {
-        report["D"] = json!(f.dissipated);
+        report["D"] = json!(dissipated);
     }
     report
 }

@@ -179,10 +179,12 @@ pub enum SimError {
 
 /// The finest run of a refused `auto` ladder: numbers that are not verified, kept so that the
 /// minutes it took are not lost (`woodpile simulate` prints them under `unverified`).
+/// (Its shares are plain numbers rather than `energy::Fractions`, so that this leaf module
+/// imports nothing.)
 #[derive(Debug, Clone, PartialEq)]
 pub struct Unverified {
-    /// Its fractions at `t_end`.
-    pub fractions: crate::energy::Fractions,
+    /// Its R, T, E_tr, S and D at `t_end`, as `energy::Fractions` has them.
+    pub shares: [f64; 5],
     /// The step it took.
     pub dt: f64,
     /// The last Richardson estimate, against the run at twice its step (infinite if none).

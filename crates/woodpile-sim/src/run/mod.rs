@@ -156,8 +156,15 @@ fn verified<O: Observer + ?Sized>(
     }
     // After a refusal the finest run is the next rung's coarse one.
     let finest = ladder.coarse.take().map(|run| {
+        let f = run.fractions;
         Box::new(crate::error::Unverified {
-            fractions: run.fractions,
+            shares: [
+                f.reflected,
+                f.transmitted,
+                f.trapped,
+                f.striker,
+                f.dissipated,
+            ],
             dt: run.stats.max_step,
             estimate: ladder.estimate,
         })
