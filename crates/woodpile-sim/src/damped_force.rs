@@ -32,6 +32,8 @@ impl Model {
         self.damped_recording(t, (q, v), acc, window, None)
     }
 
+    /// [`Model::damped_accelerations_in`], recording every bond's force and dashpot power
+    /// into `record` when a contact-event method keeps them.
     pub(crate) fn damped_recording(
         &self,
         t: f64,
