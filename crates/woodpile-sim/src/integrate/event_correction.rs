@@ -79,12 +79,7 @@ fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
 /// (0 for a conservative chain).
 fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, f64, f64) {
     if model.is_dissipative() {
-        // The path is of the total overlap; the force law takes the relative displacement.
-        let delta = model.contacts().map_or(0.0, |law| law.static_overlap(bond));
-        return damped_path_integrals(path, h, |c, rate| {
-            let (force, power) = model.contact_force(bond, c - delta, rate);
-            (force.total, power)
-        });
+        return damped_path_integrals(path, h, damped_force(model, bond));
     }
     match model.contacts() {
         None => {
@@ -96,6 +91,17 @@ fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, 
             let (impulse, moment) = path_integrals_of(path, h, |d| law.power(d));
             (a * impulse, a * moment, 0.0)
         }
+    }
+}
+
+/// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the
+/// path integrals and the switch search take them (the path is of the total overlap; the
+/// force law takes the relative displacement, without the static overlap).
+fn damped_force(model: &Model, bond: usize) -> impl Fn(f64, f64) -> (f64, f64) + '_ {
+    let delta = model.contacts().map_or(0.0, |law| law.static_overlap(bond));
+    move |c, rate| {
+        let (force, power) = model.contact_force(bond, c - delta, rate);
+        (force.total, power)
     }
 }
 
@@ -270,27 +276,16 @@ impl<const S: usize> ContactEvents<S> {
         window: Window,
         after: f64,
     ) -> Option<f64> {
-        let n = model.n_dof();
-        self.scan(model, &end[..n], window);
-        let (q, v) = start.split_at(n);
-        let (new_q, new_v) = end.split_at(n);
-        let mut first: Option<f64> = None;
-        for &(bond, left, right) in &self.changed {
-            let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(self.stage_forces(bond), end_force(model, bond, &path)) {
-                continue;
-            }
-            if let Some(x) = first_crossing(&path, h, after) {
-                first = Some(first.map_or(x, |f| f.min(x)));
-            }
-        }
-        first
+        let crossing = |_: usize, path: &BondPath| first_crossing(path, h, after);
+        self.earliest(model, (start, end), window, crossing)
+            .map(|(x, _)| x)
     }
 
     /// The earliest moment, as a fraction of the step in (0, 1), at which the force of a
     /// damped contact of `window` switches along its path ([`first_switch`]: it closes, or its
-    /// clip starts), not counting [`negligible`] ones: where `rk4-contact` ends a step on a
-    /// dissipative chain, so that no step carries a jump or a kink of a force in its stages.
+    /// clip starts), not counting [`negligible`] ones, and its bond: where `rk4-contact` ends a
+    /// step on a dissipative chain, so that no step carries a jump or a kink of a force in its
+    /// stages.
     pub(crate) fn first_switch(
         &mut self,
         model: &Model,
@@ -298,22 +293,31 @@ impl<const S: usize> ContactEvents<S> {
         h: f64,
         window: Window,
     ) -> Option<(f64, BondSites)> {
+        let switch =
+            |bond: usize, path: &BondPath| first_switch(path, h, damped_force(model, bond));
+        self.earliest(model, (start, end), window, switch)
+    }
+
+    /// The earliest `moment` (a fraction of the step, or none) over the bonds of `window` that
+    /// changed during the step from `start` to `end` and are not [`negligible`], with its bond.
+    fn earliest(
+        &mut self,
+        model: &Model,
+        (start, end): (&[f64], &[f64]),
+        window: Window,
+        moment: impl Fn(usize, &BondPath) -> Option<f64>,
+    ) -> Option<(f64, BondSites)> {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
         let (q, v) = start.split_at(n);
         let (new_q, new_v) = end.split_at(n);
-        let mut first = None;
+        let mut first: Option<(f64, BondSites)> = None;
         for &(bond, left, right) in &self.changed {
             let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
             if negligible(self.stage_forces(bond), end_force(model, bond, &path)) {
                 continue;
             }
-            let delta = model.contacts().map_or(0.0, |law| law.static_overlap(bond));
-            let switch = first_switch(&path, h, |c, rate| {
-                let (force, power) = model.contact_force(bond, c - delta, rate);
-                (force.total, power)
-            });
-            if let Some(x) = switch.filter(|&x| first.is_none_or(|(f, _)| x < f)) {
+            if let Some(x) = moment(bond, &path).filter(|&x| first.is_none_or(|(f, _)| x < f)) {
                 first = Some((x, (bond, left, right)));
             }
         }
