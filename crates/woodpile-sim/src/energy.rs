@@ -92,40 +92,29 @@ pub struct Fractions {
 impl Fractions {
     /// Splits a per-site density into the shares of `region`.
     pub fn from_density(density: &[f64], region: Region) -> Self {
-        let chain = region.striker_sites;
-        let left: f64 = density[chain..region.lo].iter().sum();
-        let inside: f64 = density[region.lo..=region.hi].iter().sum();
-        let right: f64 = density[region.hi + 1..].iter().sum();
-        let (striker, total) = match chain {
-            0 => (0.0, left + inside + right),
-            _ => {
-                let striker: f64 = density[..chain].iter().sum();
-                (striker, left + inside + right + striker)
-            }
-        };
+        let held = Held::of(density, region);
         Self {
-            reflected: left / total,
-            transmitted: right / total,
-            trapped: inside / total,
-            striker: striker / total,
             dissipated: 0.0,
-            total,
+            ..Self::divided(held, 0.0, held.total)
         }
     }
 
-    /// The shares of a dissipative chain: the density's shares and the energy `dissipated`
+    /// The shares of a dissipative chain: the density's parts and the energy `dissipated`
     /// so far, each divided by the initial energy `e_initial`, so that R + T + E_tr + S + D
     /// = 1 up to the integration error.
     pub fn of_ledger(density: &[f64], region: Region, dissipated: f64, e_initial: f64) -> Self {
-        let held = Self::from_density(density, region);
-        let scale = held.total / e_initial;
+        Self::divided(Held::of(density, region), dissipated, e_initial)
+    }
+
+    /// `held`'s parts and `dissipated`, each divided by `total`.
+    fn divided(held: Held, dissipated: f64, total: f64) -> Self {
         Self {
-            reflected: held.reflected * scale,
-            transmitted: held.transmitted * scale,
-            trapped: held.trapped * scale,
-            striker: held.striker * scale,
-            dissipated: dissipated / e_initial,
-            total: e_initial,
+            reflected: held.left / total,
+            transmitted: held.right / total,
+            trapped: held.inside / total,
+            striker: held.striker / total,
+            dissipated: dissipated / total,
+            total,
         }
     }
 
@@ -161,6 +150,39 @@ impl Fractions {
             .max((self.trapped - other.trapped).abs())
             .max((self.striker - other.striker).abs())
             .max((self.dissipated - other.dissipated).abs())
+    }
+}
+
+/// The energy a density holds left of, inside and right of a region, and in a striker.
+#[derive(Debug, Clone, Copy)]
+struct Held {
+    left: f64,
+    inside: f64,
+    right: f64,
+    striker: f64,
+    total: f64,
+}
+
+impl Held {
+    fn of(density: &[f64], region: Region) -> Held {
+        let chain = region.striker_sites;
+        let left: f64 = density[chain..region.lo].iter().sum();
+        let inside: f64 = density[region.lo..=region.hi].iter().sum();
+        let right: f64 = density[region.hi + 1..].iter().sum();
+        let (striker, total) = match chain {
+            0 => (0.0, left + inside + right),
+            _ => {
+                let striker: f64 = density[..chain].iter().sum();
+                (striker, left + inside + right + striker)
+            }
+        };
+        Held {
+            left,
+            inside,
+            right,
+            striker,
+            total,
+        }
     }
 }
 
