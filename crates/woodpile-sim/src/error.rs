@@ -67,6 +67,14 @@ pub enum ModelError {
     /// A precompression needs walls at both ends to hold it.
     #[error("a precompression needs fixed walls at both ends")]
     PrecompressionWithoutWalls,
+    /// More resonator dashpots than resonators.
+    #[error("{n_dampings} resonator dashpots given for {n_resonators} resonators")]
+    DampingCount {
+        /// Number of dashpots given.
+        n_dampings: usize,
+        /// Number of resonators.
+        n_resonators: usize,
+    },
     /// The per-site mass list does not match the number of sites.
     #[error("{n_masses} site masses given for a chain of {n_sites} sites")]
     MassCount {

@@ -302,13 +302,9 @@ impl Model {
     /// that the scene keeps the conservative path and its bits.
     pub fn with_damping(mut self, damping: Damping) -> Result<Self, ModelError> {
         if damping.resonator.len() > self.resonators.len() {
-            return Err(ModelError::Negative {
-                what: format!(
-                    "resonator damping count ({} for {} resonators)",
-                    damping.resonator.len(),
-                    self.resonators.len()
-                ),
-                value: -1.0,
+            return Err(ModelError::DampingCount {
+                n_dampings: damping.resonator.len(),
+                n_resonators: self.resonators.len(),
             });
         }
         if damping.dissipates() {

@@ -38,32 +38,22 @@ pub(crate) fn damping(
             ))
         }
     };
-    let listed = std::cell::RefCell::new(Vec::new());
-    let convert = |key: &str, value: Option<f64>, scale: fn(&Si, f64) -> f64| {
-        let value = non_negative(key, value.unwrap_or(0.0))?;
-        Ok::<f64, Invalid>(match si {
-            Some(si) if value > 0.0 => {
-                let scaled = scale(si, value);
-                listed
-                    .borrow_mut()
-                    .push((key.replace(['.', '[', ']'], "_"), scaled));
-                scaled
-            }
-            _ => value,
-        })
-    };
+    let mut listed = Listed::new();
     let contact_scale: fn(&Si, f64) -> f64 = match law {
         DashpotLaw::Linear => |si, c| si.scales.dashpot(c),
         DashpotLaw::Hertzian => |si, c| si.scales.hertzian_dashpot(c),
     };
-    let contact = convert(
-        "damping.contact",
-        table.and_then(|t| t.contact),
-        contact_scale,
+    let dashpot: fn(&Si, f64) -> f64 = |si, c| si.scales.dashpot(c);
+    let contact = converted(
+        ("damping.contact", table.and_then(|t| t.contact)),
+        (si, contact_scale),
+        &mut listed,
     )?;
-    let ground = convert("damping.ground", table.and_then(|t| t.ground), |si, c| {
-        si.scales.dashpot(c)
-    })?;
+    let ground = converted(
+        ("damping.ground", table.and_then(|t| t.ground)),
+        (si, dashpot),
+        &mut listed,
+    )?;
     let mut per_resonator = Vec::with_capacity(resonators.len());
     for (j, (d, r)) in file.defect.iter().zip(resonators).enumerate() {
         let c = match (d.damping, d.quality_factor) {
@@ -73,15 +63,15 @@ pub(crate) fn damping(
                     "give damping or quality_factor, not both",
                 ))
             }
-            (Some(c), None) => convert(&format!("defect[{j}].damping"), Some(c), |si, c| {
-                si.scales.dashpot(c)
-            })?,
+            (Some(c), None) => converted(
+                (&format!("defect[{j}].damping"), Some(c)),
+                (si, dashpot),
+                &mut listed,
+            )?,
             (None, Some(q)) => {
                 let c = from_quality_factor(&format!("defect[{j}].quality_factor"), q, r, masses)?;
                 if si.is_some() {
-                    listed
-                        .borrow_mut()
-                        .push((format!("defect_{j}__damping"), c));
+                    listed.push((format!("defect_{j}__damping"), c));
                 }
                 c
             }
@@ -91,7 +81,25 @@ pub(crate) fn damping(
     }
     let damping = Damping::new(contact, law, ground, per_resonator)
         .map_err(|e| invalid("damping", e.to_string()))?;
-    Ok(Some((damping, listed.into_inner())))
+    Ok(Some((damping, listed)))
+}
+
+/// The coefficient at `key` (default 0, checked ≥ 0), in the model's units: an SI scene's
+/// value converted by `scale` and listed under the key's name (dots and brackets made `_`).
+fn converted(
+    (key, value): (&str, Option<f64>),
+    (si, scale): (Option<&Si>, fn(&Si, f64) -> f64),
+    listed: &mut Listed,
+) -> Result<f64, Invalid> {
+    let value = non_negative(key, value.unwrap_or(0.0))?;
+    Ok(match si {
+        Some(si) if value > 0.0 => {
+            let scaled = scale(si, value);
+            listed.push((key.replace(['.', '[', ']'], "_"), scaled));
+            scaled
+        }
+        _ => value,
+    })
 }
 
 /// c_j of a linear resonator with quality factor `q`: the pair vibrates against each other
