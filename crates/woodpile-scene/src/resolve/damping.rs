@@ -12,6 +12,9 @@ use crate::raw;
 /// Values an SI scene converted, by name, for the JSON's `physical` block.
 type Listed = Vec<(String, f64)>;
 
+/// An SI coefficient in the model's units.
+type Scale = fn(&Si, f64) -> f64;
+
 /// The damping `file` declares, in the model's units, with the converted values an SI scene
 /// lists; `None` when it declares none.
 pub(crate) fn damping(
@@ -39,11 +42,11 @@ pub(crate) fn damping(
         }
     };
     let mut listed = Listed::new();
-    let contact_scale: fn(&Si, f64) -> f64 = match law {
+    let contact_scale: Scale = match law {
         DashpotLaw::Linear => |si, c| si.scales.dashpot(c),
         DashpotLaw::Hertzian => |si, c| si.scales.hertzian_dashpot(c),
     };
-    let dashpot: fn(&Si, f64) -> f64 = |si, c| si.scales.dashpot(c);
+    let dashpot: Scale = |si, c| si.scales.dashpot(c);
     let contact = converted(
         ("damping.contact", table.and_then(|t| t.contact)),
         (si, contact_scale),
@@ -88,7 +91,7 @@ pub(crate) fn damping(
 /// value converted by `scale` and listed under the key's name (dots and brackets made `_`).
 fn converted(
     (key, value): (&str, Option<f64>),
-    (si, scale): (Option<&Si>, fn(&Si, f64) -> f64),
+    (si, scale): (Option<&Si>, Scale),
     listed: &mut Listed,
 ) -> Result<f64, Invalid> {
     let value = non_negative(key, value.unwrap_or(0.0))?;
