@@ -71,6 +71,19 @@ where
     T: Send,
     F: FnOnce(&AtomicBool) -> T + Send,
 {
+    match interruptible_keeping(py, work)? {
+        (_, Some(signal)) => Err(signal),
+        (value, None) => Ok(value),
+    }
+}
+
+/// [`interruptible`], keeping what the work returned after it was stopped: the work's value
+/// and the signal's exception, if one arrived (a sweep's finished points survive Ctrl-C).
+pub(crate) fn interruptible_keeping<T, F>(py: Python<'_>, work: F) -> PyResult<(T, Option<PyErr>)>
+where
+    T: Send,
+    F: FnOnce(&AtomicBool) -> T + Send,
+{
     let cancel = AtomicBool::new(false);
     let done = AtomicBool::new(false);
     let waiter = std::thread::current();
@@ -91,13 +104,10 @@ where
                 }
             }
         }
-        let result = py.detach(|| worker.join());
-        if let Some(signal) = interrupted {
-            return Err(signal);
-        }
-        match result {
-            Ok(Ok(value)) => Ok(value),
-            Ok(Err(panic)) | Err(panic) => Err(internal_error(&panic)),
+        match (py.detach(|| worker.join()), interrupted) {
+            (Ok(Ok(value)), interrupted) => Ok((value, interrupted)),
+            (_, Some(signal)) => Err(signal),
+            (Ok(Err(panic)) | Err(panic), None) => Err(internal_error(&panic)),
         }
     })
 }

@@ -9,6 +9,7 @@ mod pool;
 mod scene_input;
 mod series;
 mod simulate;
+mod listed;
 mod sweep;
 
 use pyo3::prelude::*;

@@ -15,7 +15,8 @@ use woodpile_sim::SimError;
 
 use crate::interrupt::{on_this_thread, Watch};
 use crate::scene_input::{shown, Source};
-use crate::series::SeriesKind;
+use crate::series;
+use woodpile_points::Series;
 use crate::{SceneError, SimulationError};
 
 /// _simulate(scene, fields=False, field_sites=None, series=None) -> dict
@@ -34,8 +35,8 @@ pub(crate) fn simulate<'py>(
     series: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = match series {
-        Some(value) => SeriesKind::parse(value, false)?.unwrap_or(SeriesKind::Energy),
-        None => SeriesKind::Energy,
+        Some(value) => series::parse(value, false)?.unwrap_or(Series::Energy),
+        None => Series::Energy,
     };
     let source = Source::of(scene)?;
     let label = shown(&source.label());

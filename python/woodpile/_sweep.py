@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from typing import Any, Dict, Mapping, Sequence, Union
+import os
+from typing import Any, Dict, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import pandas as pd
@@ -14,7 +15,11 @@ Axis = Union[Sequence[float], Sequence[int], "np.ndarray", Mapping[str, float]]
 
 
 def sweep(
-    scene: Scene, axes: Mapping[str, Axis], *, series: Union[bool, str] = False
+    scene: Scene,
+    axes: Mapping[str, Axis],
+    *,
+    series: Union[bool, str] = False,
+    cache: Optional[Union[str, "os.PathLike[str]"]] = None,
 ) -> pd.DataFrame:
     """Simulate every point of a grid of scenes, on all cores, and return one table.
 
@@ -22,31 +27,47 @@ def sweep(
     defect over sites with ``"through": "$L"``), and each axis is a list of numbers (or a
     NumPy array) or a range, ``{"from": 0.1, "to": 10.0, "step": 0.1}`` or ``{"from": 0.1,
     "to": 100.0, "count": 31, "log": True}``, whose values are rounded to 12 significant
-    digits. Axes vary in name order, the last fastest.
+    digits. Axes vary in name order, the last fastest. The points are simulated by the same
+    code as a sweep stage's, so the table has the stage's columns and, with ``series``, its
+    rows, bit for bit.
 
     Args:
         scene: the scene template: a dict, a TOML string or a path.
         axes: axis name -> values.
-        series: one row per point and sample (columns t, R, T, E_tr, E) instead of one row
-            per point with the fractions at ``t_end``: ``True`` or ``"energy"`` for shares of
-            the total energy, ``"kinetic"`` for kinetic energy over the impact energy (as a
-            sweep stage's ``series = "kinetic"``; E is then the kinetic share).
+        series: one row per point and sample instead of one row per point at ``t_end``:
+            ``True`` or ``"energy"`` for shares of the total energy, ``"kinetic"`` for kinetic
+            energy over the impact energy (as a sweep stage's ``series = "kinetic"``; E is then
+            the kinetic share).
+        cache: a folder of cached points (a pipeline's ``results/points`` or any folder of
+            your own): points found there are read, not simulated, and every point simulated
+            is stored there the moment it finishes, so a sweep stopped by Ctrl-C or a crash
+            resumes with only the missing points to run.
 
     Returns:
-        A DataFrame: ``point``, the axes, then ``R``, ``T``, ``E_tr`` (or, with
-        ``series``, ``t``, ``R``, ``T``, ``E_tr``, ``E``; ``D`` after ``E_tr`` when the scene
-        declares damping), ``error_estimate``, ``dt``,
-        ``steps``, ``rhs_evals``, ``method`` and ``failure``. A point that failed is a row
-        with NaN fractions and its reason in ``failure`` (None for the others).
+        A DataFrame with a sweep stage's columns: ``point``, the axes (integer axes as
+        integers), ``t``, ``R``, ``T``, ``E_tr`` (``S`` with a striker, ``D`` when the scene
+        declares damping), ``E``, ``method``, ``dt``, ``steps``, ``error_estimate``,
+        ``energy_drift``, ``failure`` and ``scene_key`` (the point's cache key). A point
+        that failed is one row with NaN fractions and its reason in ``failure`` (None for the
+        others).
 
     Raises:
         SceneError: the template or the axes are invalid (checked on the grid's first and
-            last points before anything runs).
-        KeyboardInterrupt: Ctrl-C stops the sweep within about a second.
+            last points before anything runs, and on every point before it runs).
+        KeyboardInterrupt: Ctrl-C stops the sweep within about a second. The exception's
+            ``partial`` is the table of the points finished so far (with ``cache``, they are
+            also on disk).
 
     The GIL is released while the sweep runs.
     """
-    return _frame(_core.sweep(scene, dict(axes), series))
+    path = None if cache is None else os.fspath(cache)
+    try:
+        return _frame(_core.sweep(scene, dict(axes), series, path))
+    except KeyboardInterrupt as stopped:
+        partial = getattr(stopped, "partial", None)
+        if isinstance(partial, dict):
+            stopped.partial = _frame(partial)
+        raise
 
 
 def simulate_many(scenes: Sequence[Scene]) -> pd.DataFrame:
@@ -71,16 +92,20 @@ def simulate_many(scenes: Sequence[Scene]) -> pd.DataFrame:
     return _frame(_core.simulate_many(list(scenes)))
 
 
+#: Integer columns that are null where a point failed: pandas' nullable integers.
+_NULLABLE = ("steps", "rhs_evals")
+
+
 def _frame(raw: Dict[str, Any]) -> pd.DataFrame:
-    """The native table (``names`` in order, each a column) as a DataFrame: integer columns
-    of failed points masked, text columns as objects."""
-    valid = np.asarray(raw["valid"], dtype=bool)
+    """The native table (``names`` in order, each a column, ``masks`` the nulls of integer
+    columns) as a DataFrame: nullable integer columns masked, text columns as objects."""
+    masks = raw["masks"]
     columns: Dict[str, Any] = {}
     for name in raw["names"]:
         values = raw[name]
-        if name in ("steps", "rhs_evals"):
-            values = pd.arrays.IntegerArray(np.asarray(values, dtype=np.int64), ~valid)
-        elif name in ("method", "failure"):
+        if name in masks and name in _NULLABLE:
+            values = pd.arrays.IntegerArray(np.asarray(values, dtype=np.int64), masks[name])
+        elif isinstance(values, list):
             values = pd.Series(values, dtype=object)
         columns[name] = values
     return pd.DataFrame(columns)

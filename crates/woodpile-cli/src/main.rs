@@ -77,7 +77,7 @@ fn version() -> &'static str {
     static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     VERSION
         .get_or_init(|| {
-            woodpile_pipeline::canonical::code_version()
+            woodpile_points::canonical::code_version()
                 .trim_start_matches("woodpile ")
                 .to_string()
         })

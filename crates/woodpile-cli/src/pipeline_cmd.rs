@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 use woodpile_stages::KINDS;
 
-use woodpile_pipeline::atomic;
-use woodpile_pipeline::layout::output_path;
+use woodpile_points::atomic;
+use woodpile_points::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::shard::{merge, run_shard, Shard};
 use woodpile_pipeline::slurm::SlurmJob;
@@ -204,18 +204,14 @@ pub(crate) fn run_command(args: &RunArgs) -> Result<(), Failure> {
         figures: dirs.figures.clone(),
     };
     let started = std::time::Instant::now();
-    let before = woodpile_pipeline::points::simulations();
     let steps = run(&pipeline, &options, &Progress::new()).map_err(stage_failure)?;
-    let scenes = match args.dry_run {
-        true => 0,
-        false => woodpile_pipeline::points::simulations() - before,
-    };
+    let scenes: usize = steps.iter().map(|s| s.simulated).sum();
     let report = RunReport {
         dry_run: args.dry_run,
         stages: steps.iter().map(StageRun::of).collect(),
         ran: steps.iter().filter(|s| s.runs).count(),
         fresh: steps.iter().filter(|s| !s.runs).count(),
-        scenes_simulated: scenes,
+        scenes_simulated: scenes as u64,
         seconds: started.elapsed().as_secs_f64(),
     };
     if args.json {

@@ -121,6 +121,15 @@ impl PipelineError {
     }
 }
 
+impl From<woodpile_points::FileError> for PipelineError {
+    fn from(e: woodpile_points::FileError) -> Self {
+        match e {
+            woodpile_points::FileError::Io { path, source } => Self::Io { path, source },
+            woodpile_points::FileError::Refused { path, reason } => Self::Refused { path, reason },
+        }
+    }
+}
+
 /// Any error, as a source.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
 

@@ -14,9 +14,9 @@ use serde_json::Value;
 use crate::error::Result;
 use crate::events::Events;
 use crate::fields::Fields;
-use crate::layout::output_path;
+use woodpile_points::layout::output_path;
 use crate::manifest::Manifest;
-use crate::points::{PointStats, PointStore};
+use woodpile_points::{PointStats, PointStore};
 use crate::table;
 
 /// A stage kind: its parameters, and what it does with them.
@@ -228,6 +228,8 @@ pub struct Output {
     /// For a grid of scenes: its points' statistics (how many, how many failed), which the
     /// run's `done` line reports.
     pub points: Option<PointStats>,
+    /// Scenes the stage simulated (not read from the point cache): what a run reports.
+    pub simulated: usize,
 }
 
 impl Output {
@@ -238,6 +240,7 @@ impl Output {
             summary,
             failures: Vec::new(),
             points: None,
+            simulated: 0,
         }
     }
 
@@ -245,6 +248,21 @@ impl Output {
     pub fn with_points(self, stats: PointStats) -> Output {
         Output {
             points: Some(stats),
+            simulated: stats.simulated,
+            ..self
+        }
+    }
+
+    /// The output, with what failed inside the stage without stopping it.
+    pub fn with_failures(self, failures: Vec<String>) -> Output {
+        Output { failures, ..self }
+    }
+
+    /// The output of a stage that simulated `count` scenes outside a grid (a map, a survey,
+    /// an optimiser's evaluations).
+    pub fn with_simulated(self, count: usize) -> Output {
+        Output {
+            simulated: count,
             ..self
         }
     }

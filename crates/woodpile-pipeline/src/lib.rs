@@ -8,31 +8,26 @@
 //! - [`stage`], [`pipeline`], [`variant`]: parse stage files (and `--set` variants), check the
 //!   DAG, compute the keys.
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
-//! - [`points`] (with [`grid`], [`template`]): the per-scene cache and the grids behind it.
+//! - [`grid`], [`template`]: the grids of scenes a kind declares. Turning a scene into a
+//!   cached point is `woodpile_points`' job, below this crate, shared with the Python module.
 //! - [`shard`], [`slurm`]: sweeps split across a cluster and merged.
-//! - [`lock`]: one writer of a results tree at a time; [`layout`]: where everything lives.
+//! - [`lock`]: one writer of a results tree at a time.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
-//! - [`table`], [`manifest`], [`atomic`], [`canonical`], [`regular`], [`sealed_files`]:
-//!   parquet IO and row tables, self-description, atomic writes, blake3 keys of canonical
-//!   JSON, reading only regular files, the checksums of a stage's other files.
+//! - [`table`], [`manifest`], [`sealed_files`]: parquet IO and row tables, self-description,
+//!   the checksums of a stage's other files.
 //!
 //! Nothing here prints: progress goes to an [`events::Events`] implementation.
 #![warn(missing_docs)]
 
-pub mod atomic;
-pub mod canonical;
 pub mod diff;
 pub mod error;
 pub mod events;
 pub mod fields;
 pub mod grid;
 pub mod kind;
-pub mod layout;
 pub mod lock;
 pub mod manifest;
 pub mod pipeline;
-pub mod points;
-pub mod regular;
 pub mod run;
 pub mod sealed_files;
 pub mod shard;

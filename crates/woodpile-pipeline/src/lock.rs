@@ -14,8 +14,8 @@ use std::path::Path;
 
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
-use crate::layout::lock_path;
-use crate::regular;
+use woodpile_points::layout::lock_path;
+use woodpile_points::regular;
 
 /// Held while a run writes; dropping it releases the lock.
 #[derive(Debug)]

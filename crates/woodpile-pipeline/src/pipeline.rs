@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use serde_json::json;
 
-use crate::canonical::{code_version, Key};
+use woodpile_points::canonical::{code_version, Key};
 use crate::error::{PipelineError, Result};
 use crate::kind::{Inputs, Registry};
 use crate::stage::{Defaults, Stage};

@@ -5,16 +5,16 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
-use crate::atomic;
-use crate::canonical::code_version;
+use woodpile_points::atomic;
+use woodpile_points::canonical::code_version;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::kind::{Context, Sharing};
-use crate::layout::{output_path, points_dir};
+use woodpile_points::layout::{output_path, points_dir};
 use crate::lock::lock_results;
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
-use crate::points::PointStore;
+use woodpile_points::PointStore;
 use crate::stage::Stage;
 use crate::status::{state, State};
 use crate::{sealed_files, table};
@@ -47,6 +47,8 @@ pub struct Step {
     pub why: String,
     /// For sweeps that run: (points, of which cached).
     pub points: Option<(usize, usize)>,
+    /// Scenes it simulated (0 for a stage that did not run, or simulates nothing).
+    pub simulated: usize,
 }
 
 /// Runs (or plans) the pipeline; returns what each selected stage did. A run holds the
@@ -64,7 +66,7 @@ pub struct Step {
 pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Result<Vec<Step>> {
     let results = &options.results;
     for folder in [points_dir(results), results.join("parts")] {
-        crate::layout::check_tree_folder(&folder)
+        woodpile_points::layout::check_tree_folder(&folder)
             .map_err(|e| PipelineError::refused(&folder, e))?;
     }
     let store = PointStore::new(points_dir(results));
@@ -94,9 +96,12 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
                     let stage = selection[i];
                     let work = || match decide(pipeline, stage, options, &store, events) {
                         Ok((step, true)) => {
-                            let partial =
-                                run_stage(pipeline, stage, &step.why, options, &store, events);
-                            (Some(step), partial)
+                            match run_stage(pipeline, stage, &step.why, options, &store, events) {
+                                Ok((partial, simulated)) => {
+                                    (Some(Step { simulated, ..step }), Ok(partial))
+                                }
+                                Err(e) => (Some(step), Err(e)),
+                            }
                         }
                         Ok((step, false)) => (Some(step), Ok(Vec::new())),
                         Err(e) => (None, Err(e)),
@@ -157,6 +162,7 @@ fn decide(
                 runs: false,
                 why: "fresh".into(),
                 points: None,
+                simulated: 0,
             };
             return Ok((step, false));
         }
@@ -181,11 +187,13 @@ fn decide(
         runs: true,
         why,
         points,
+        simulated: 0,
     };
     Ok((step, true))
 }
 
-/// Runs a stage that [`decide`] found stale; returns the partial failures it recorded.
+/// Runs a stage that [`decide`] found stale; returns the partial failures it recorded and the
+/// scenes it simulated.
 fn run_stage(
     pipeline: &Pipeline,
     stage: &Stage,
@@ -193,17 +201,18 @@ fn run_stage(
     options: &RunOptions,
     store: &PointStore,
     events: &dyn Events,
-) -> Result<Vec<String>> {
+) -> Result<(Vec<String>, usize)> {
     events.stage_started(&stage.name, why);
-    let (summary, partial) = execute(pipeline, stage, options, store, events)?;
+    let (summary, partial, simulated) = execute(pipeline, stage, options, store, events)?;
     for failure in &partial {
         events.warn(&format!("stage `{}`: {failure}", stage.name));
     }
     events.stage_finished(&stage.name, &summary);
-    Ok(partial
+    let partial = partial
         .into_iter()
         .map(|f| format!("stage `{}`: {f}", stage.name))
-        .collect())
+        .collect();
+    Ok((partial, simulated))
 }
 
 /// Where each selected stage of a run is, shared by the workers.
@@ -285,6 +294,7 @@ impl<'a> Board<'a> {
                     runs: false,
                     why,
                     points: None,
+                    simulated: 0,
                 });
                 continue;
             }
@@ -369,7 +379,7 @@ fn execute(
     options: &RunOptions,
     store: &PointStore,
     events: &dyn Events,
-) -> Result<(String, Vec<String>)> {
+) -> Result<(String, Vec<String>, usize)> {
     let results = &options.results;
     let upstream = pipeline
         .selection(std::slice::from_ref(&stage.name))?
@@ -398,7 +408,7 @@ fn execute(
         ),
         None => format!("{rows} rows"),
     };
-    Ok((line, output.failures))
+    Ok((line, output.failures, output.simulated))
 }
 
 /// The manifest of `stage`'s output as computed from the current definitions.

@@ -16,10 +16,10 @@ use serde_json::json;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::kind::{PointGrid, PointsAt};
-use crate::layout::{output_path, parts_dir, points_dir};
+use woodpile_points::layout::{output_path, parts_dir, points_dir};
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
-use crate::points::{PointStats, PointStore};
+use woodpile_points::{PointStats, PointStore};
 use crate::run::manifest_for;
 use crate::stage::Stage;
 use crate::table::{self, f64_column};
@@ -93,7 +93,7 @@ impl std::fmt::Display for Shard {
 }
 
 fn part_path(results: &Path, stage: &str, key: &str, shard: Shard) -> PathBuf {
-    crate::layout::part_path(results, stage, key, shard.index, shard.count)
+    woodpile_points::layout::part_path(results, stage, key, shard.index, shard.count)
 }
 
 /// `(key, shard)` from a part file name.
@@ -172,12 +172,12 @@ pub fn run_shard(
         results.join("parts"),
         parts_dir(results, name),
     ] {
-        crate::layout::check_tree_folder(&folder)
+        woodpile_points::layout::check_tree_folder(&folder)
             .map_err(|e| PipelineError::refused(&folder, e))?;
     }
     let store = PointStore::new(points_dir(results));
     store.sweep_stale_temps();
-    crate::atomic::sweep_stale_temps(&parts_dir(results, name));
+    woodpile_points::atomic::sweep_stale_temps(&parts_dir(results, name));
     events.stage_started(name, &format!("shard {shard}"));
     let at = PointsAt {
         stage: name,

@@ -14,7 +14,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use crate::canonical::toml_to_json;
+use woodpile_points::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::kind::Registry;
@@ -219,7 +219,7 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
         },
         _ => return Ok(()),
     };
-    let path = crate::layout::contained(root, &reference)
+    let path = woodpile_points::layout::contained(root, &reference)
         .map_err(|reason| definition(file, key, &reason))?;
     let text = woodpile_scene::read_input(&path)
         .map_err(|e| definition(file, key, &format!("{}: cannot read: {e}", path.display())))?;

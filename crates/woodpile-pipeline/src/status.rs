@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use crate::canonical::{changed_paths, code_version};
-use crate::layout::output_path;
+use woodpile_points::canonical::{changed_paths, code_version};
+use woodpile_points::layout::output_path;
 use crate::pipeline::Pipeline;
 use crate::stage::Stage;
 use crate::table::{self, Integrity};

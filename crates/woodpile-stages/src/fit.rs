@@ -160,12 +160,8 @@ impl FitStage {
             });
         }
         let rows = out.len();
-        Ok(Output {
-            frame: rows_frame(&out)?,
-            summary: json!({"models": rows, "rows_used": keep.len(), "failed": failures.len()}),
-            failures,
-            points: None,
-        })
+        let summary = json!({"models": rows, "rows_used": keep.len(), "failed": failures.len()});
+        Ok(Output::table(rows_frame(&out)?, summary).with_failures(failures))
     }
 }
 

@@ -36,7 +36,7 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::{Ends, Fields};
 use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
-use woodpile_pipeline::layout::best_path;
+use woodpile_points::layout::best_path;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, Columns};
 use woodpile_pipeline::Output;
@@ -181,7 +181,6 @@ impl Optimize {
                 return Ok(out.clone());
             }
             let scene = sweep.scene_with(values, Some(self.tolerance))?;
-            woodpile_pipeline::points::count_simulation();
             let out = simulate(&scene.scenario, &mut ())
                 .map_err(|e| fail(format!("refinement scene failed: {e}")))?;
             evaluated.borrow_mut().push((values.to_vec(), out.clone()));
@@ -313,7 +312,7 @@ impl Optimize {
             self.tolerance,
             path.display()
         );
-        woodpile_pipeline::atomic::write(&path, (header + &text).as_bytes())?;
+        woodpile_points::atomic::write(&path, (header + &text).as_bytes())?;
 
         let grid_first = rows
             .first()
@@ -337,7 +336,8 @@ impl Optimize {
                 "best_error_estimate": best.outcome.error_estimate,
                 "best_file": path.file_name().map(|n| n.to_string_lossy().into_owned()),
             }),
-        ))
+        )
+        .with_simulated(simulations_total))
     }
 
     fn frame(

@@ -2,34 +2,9 @@
 //! `sweep` and read back by `reduce`, and the fractions (`R`, `T`, `E_tr`) are what reduce
 //! maximises, optimize and design optimise, and report quotes.
 
-/// The columns of a sweep's table: one row per sample of each point (or one row with the
-/// reason for a point that failed), after the point's axis values under the axes' names.
-pub mod sweep {
-    /// The point's index in the grid.
-    pub const POINT: &str = "point";
-    /// The sample time.
-    pub const TIME: &str = "t";
-    /// The striker's share S (only in sweeps whose scenes have a `[striker]`).
-    pub const STRIKER: &str = "S";
-    /// The dissipated share D (sweeps of scenes with damping).
-    pub const DISSIPATED: &str = "D";
-    /// The total energy (or, for a kinetic series, the kinetic share of the impact energy).
-    pub const ENERGY: &str = "E";
-    /// The method of the reported run.
-    pub const METHOD: &str = "method";
-    /// Its fixed step, if any.
-    pub const DT: &str = "dt";
-    /// Its steps.
-    pub const STEPS: &str = "steps";
-    /// `auto`'s error estimate.
-    pub const ERROR_ESTIMATE: &str = "error_estimate";
-    /// The largest relative energy drift.
-    pub const ENERGY_DRIFT: &str = "energy_drift";
-    /// Why the point failed (null when it did not).
-    pub const FAILURE: &str = "failure";
-    /// The point's cache key.
-    pub const SCENE_KEY: &str = "scene_key";
-}
+/// The columns of a sweep's table, named where the table is made (`woodpile_points::rows`,
+/// shared with Python's `sweep`).
+pub use woodpile_points::rows::sweep;
 
 /// One of the energy fractions, by its column name.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -53,9 +28,9 @@ impl Fraction {
     /// Its column name.
     pub fn column(self) -> &'static str {
         match self {
-            Fraction::Trapped => "E_tr",
-            Fraction::Reflected => "R",
-            Fraction::Transmitted => "T",
+            Fraction::Trapped => sweep::TRAPPED,
+            Fraction::Reflected => sweep::REFLECTED,
+            Fraction::Transmitted => sweep::TRANSMITTED,
         }
     }
 

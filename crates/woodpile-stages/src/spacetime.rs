@@ -135,7 +135,6 @@ impl SpaceTime {
             .map(|(i, (values, scene))| {
                 let model = &scene.scenario.model;
                 let mut field = SpaceTimeField::new(model, 1, 1);
-                woodpile_pipeline::points::count_simulation();
                 let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;
@@ -147,6 +146,7 @@ impl SpaceTime {
             .filter_map(|f| f.3)
             .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
         let (columns, points) = self.columns(&fields, axes);
+        let simulated = fields.len();
         Ok(Output::table(
             columns.into_frame()?,
             json!({
@@ -155,7 +155,8 @@ impl SpaceTime {
                 "tolerance": tolerance,
                 "max_error_estimate": max_error_estimate,
             }),
-        ))
+        )
+        .with_simulated(simulated))
     }
 
     /// The scenes to map, each with its axis values, and the axes: the grid's, or a design
@@ -169,7 +170,7 @@ impl SpaceTime {
                 &sweep.axes,
             ),
             Source::Design(design) => {
-                let path = woodpile_pipeline::layout::best_path(results, design);
+                let path = woodpile_points::layout::best_path(results, design);
                 let scene = woodpile_scene::load(&path)
                     .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
                 if self.sites[0] < scene.first_site || self.sites[1] > scene.last_site {

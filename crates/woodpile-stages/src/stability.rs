@@ -28,6 +28,7 @@
 // Comparisons are written `!(x > 0.0)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 use serde_json::json;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
@@ -140,6 +141,7 @@ impl Stability {
 
     pub(crate) fn run(&self, stage: &str) -> Result<Output> {
         // One reference per value: `auto` a hundred times tighter than the tolerance.
+        let simulated = AtomicUsize::new(0);
         let references: Vec<(woodpile_scene::Scene, f64, f64)> = self
             .values
             .par_iter()
@@ -152,7 +154,6 @@ impl Stability {
                     tolerance_explicit: true,
                     dt: None,
                 };
-                woodpile_pipeline::points::count_simulation();
                 let e_ref = simulate(&reference, &mut ())
                     .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
                     .fractions
@@ -191,7 +192,7 @@ impl Stability {
                 let t_end = scene.scenario.t_end;
                 let dt = t_end / (t_end / requested - 1e-9).ceil().max(1.0);
                 let (status, error, failure) =
-                    classify(&scene.scenario, method, dt, *e_ref, self.tolerance);
+                    classify(&scene.scenario, method, dt, *e_ref, self.tolerance, &simulated);
                 Run {
                     method: method.name(),
                     method_index: m as i64,
@@ -274,7 +275,9 @@ impl Stability {
         .i64("status", runs.iter().map(|r| Some(r.status)).collect())
         .f64("error", runs.iter().map(|r| r.error).collect())
         .str("failure", runs.iter().map(|r| r.failure.clone()).collect());
-        Ok(Output::table(c.into_frame()?, summary))
+        // Each value's reference, and every run that got past choosing its plan.
+        let simulated = references.len() + simulated.into_inner();
+        Ok(Output::table(c.into_frame()?, summary).with_simulated(simulated))
     }
 }
 
@@ -287,6 +290,7 @@ fn classify(
     dt: f64,
     e_ref: f64,
     tolerance: f64,
+    simulated: &AtomicUsize,
 ) -> (i64, Option<f64>, Option<String>) {
     let accuracy = Accuracy {
         tolerance,
@@ -304,7 +308,7 @@ fn classify(
         sample_every: scenario.t_end,
         ..scenario.clone()
     };
-    woodpile_pipeline::points::count_simulation();
+    simulated.fetch_add(1, Ordering::Relaxed);
     match run_with_plan(&one_interval, &plan, &mut (), true) {
         Err(e) => (2, None, Some(e.to_string())),
         Ok(o) if !(o.stats.max_energy_drift <= 1.0) => (

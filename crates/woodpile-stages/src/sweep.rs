@@ -34,20 +34,18 @@ use serde_json::{json, Value};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 
-use woodpile_pipeline::canonical::Key;
+use woodpile_points::canonical::Key;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_pipeline::kind::{Context, Kind, PointGrid, PointsAt};
-use woodpile_pipeline::points::{
-    point_key, PointData, PointResult, PointStats, PointStore, Series,
-};
-use woodpile_pipeline::table::{rows_frame, Cell, Row};
+use woodpile_points::rows::{SweepPoint, SweepShape};
+use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, Series};
+use woodpile_pipeline::table::rows_frame;
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
 
-use crate::schema::{sweep as columns, Fraction};
 
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]
@@ -228,87 +226,28 @@ impl Sweep {
     /// The output rows of the points `indices`: one per sample of each point, or one with the
     /// reason for a point that failed.
     fn table(&self, indices: &[usize], keys: &[Key], results: &[PointResult]) -> Result<DataFrame> {
-        let mut rows = Vec::new();
-        for ((&i, key), result) in indices.iter().zip(keys).zip(results) {
-            let values = self.values(i);
-            let samples = result.as_ref().map_or(1, |p| p.t.len());
-            for k in 0..samples {
-                rows.push(SampleRow {
-                    point: i,
-                    axes: &self.axes,
-                    values: values.clone(),
-                    key,
-                    result,
-                    sample: k,
-                    with_striker: self.with_striker,
-                    with_dissipation: self.with_dissipation,
-                });
-            }
-        }
-        rows_frame(&rows)
+        let values: Vec<Vec<AxisValue>> = indices.iter().map(|&i| self.values(i)).collect();
+        let points: Vec<SweepPoint<'_>> = indices
+            .iter()
+            .zip(&values)
+            .zip(keys.iter().zip(results))
+            .map(|((&index, values), (key, result))| SweepPoint {
+                index,
+                values,
+                key,
+                result,
+            })
+            .collect();
+        rows_frame(&self.shape().rows(&points))
     }
-}
 
-/// One output row: a sample of a point's series, or the one row of a failed point.
-struct SampleRow<'a> {
-    point: usize,
-    axes: &'a [Axis],
-    values: Vec<AxisValue>,
-    key: &'a Key,
-    result: &'a PointResult,
-    sample: usize,
-    with_striker: bool,
-    with_dissipation: bool,
-}
-
-impl Row for SampleRow<'_> {
-    fn cells(&self) -> Vec<(&str, Cell)> {
-        let mut cells = vec![(columns::POINT, Cell::from(self.point as i64))];
-        for (axis, value) in self.axes.iter().zip(&self.values) {
-            let cell = match (axis.is_integer(), *value) {
-                (true, AxisValue::Int(i)) => Cell::from(i),
-                (true, AxisValue::Float(x)) => Cell::from(x as i64),
-                (false, v) => Cell::from(v.as_f64()),
-            };
-            cells.push((axis.name.as_str(), cell));
+    /// What every row of its table shares.
+    fn shape(&self) -> SweepShape<'_> {
+        SweepShape {
+            axes: &self.axes,
+            with_striker: self.with_striker,
+            with_dissipation: self.with_dissipation,
         }
-        let ok = self.result.as_ref().ok();
-        let at = |series: fn(&PointData) -> &Vec<f64>| ok.map(|p| series(p)[self.sample]);
-        cells.extend([
-            (columns::TIME, at(|p| &p.t).into()),
-            (Fraction::Reflected.column(), at(|p| &p.reflected).into()),
-            (
-                Fraction::Transmitted.column(),
-                at(|p| &p.transmitted).into(),
-            ),
-            (Fraction::Trapped.column(), at(|p| &p.trapped).into()),
-        ]);
-        if self.with_striker {
-            let share = ok.and_then(|p| p.striker.as_ref().map(|s| s[self.sample]));
-            cells.push((columns::STRIKER, share.into()));
-        }
-        if self.with_dissipation {
-            // A point whose values dissipate nothing has no D series: it lost nothing.
-            let lost = ok.map(|p| p.dissipated.as_ref().map_or(0.0, |d| d[self.sample]));
-            cells.push((columns::DISSIPATED, lost.into()));
-        }
-        cells.extend([
-            (columns::ENERGY, at(|p| &p.energy).into()),
-            (columns::METHOD, ok.map(|p| p.method.clone()).into()),
-            (columns::DT, ok.and_then(|p| p.dt).into()),
-            (columns::STEPS, ok.map(|p| p.steps as i64).into()),
-            (
-                columns::ERROR_ESTIMATE,
-                ok.and_then(|p| p.error_estimate).into(),
-            ),
-            (
-                columns::ENERGY_DRIFT,
-                ok.and_then(|p| p.energy_drift).into(),
-            ),
-            (columns::FAILURE, self.result.as_ref().err().cloned().into()),
-            (columns::SCENE_KEY, self.key.to_string().into()),
-        ]);
-        cells
     }
 }
 
@@ -346,17 +285,18 @@ impl PointGrid for Sweep {
             .filter(|&i| results[i].is_none() && *first_of.entry(&keys[i]).or_insert(i) == i)
             .collect();
         events.simulating(stage, todo.len(), keys.len() - todo.len());
-        let computed: Vec<(usize, PointResult)> = todo
+        let computed: Vec<(usize, Fetched)> = todo
             .par_iter()
             .map(|&i| {
                 let scene = self.scene_at(indices[i])?;
-                let result = store.get_or_simulate(&keys[i], &scene, self.series)?;
+                let fetched = store.get_or_simulate(&keys[i], &scene, self.series)?;
                 events.point_done();
-                Ok((i, result))
+                Ok((i, fetched))
             })
             .collect::<Result<_>>()?;
-        for (i, result) in computed {
-            results[i] = Some(result);
+        let simulated = computed.iter().filter(|(_, f)| f.simulated).count();
+        for (i, fetched) in computed {
+            results[i] = Some(fetched.result);
         }
         for i in 0..keys.len() {
             if results[i].is_none() {
@@ -364,7 +304,10 @@ impl PointGrid for Sweep {
             }
         }
         let results: Vec<PointResult> = results.into_iter().flatten().collect();
-        let stats = PointStats::of(&results);
+        let stats = PointStats {
+            simulated,
+            ..PointStats::of(&results)
+        };
         if stats.failed > 0 {
             events.warn(&format!(
                 "stage `{stage}`: {} of {} points failed (null rows with the reason in `failure`)",

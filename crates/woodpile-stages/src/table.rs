@@ -26,7 +26,8 @@ use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{matching_rows, missing_column, Match};
-use woodpile_pipeline::{layout, Output};
+use woodpile_pipeline::Output;
+use woodpile_points::layout;
 
 /// A parsed table stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -77,7 +78,7 @@ impl Table {
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let frame = self.select(input).map_err(fail)?;
         let text = csv(&frame).map_err(fail)?;
-        woodpile_pipeline::atomic::write(&csv_path(results, stage), text.as_bytes())?;
+        woodpile_points::atomic::write(&csv_path(results, stage), text.as_bytes())?;
         let summary = json!({
             "rows": frame.height(),
             "columns": frame.get_column_names().iter().map(|c| c.to_string()).collect::<Vec<_>>(),

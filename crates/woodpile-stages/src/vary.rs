@@ -40,7 +40,7 @@ use woodpile_pipeline::grid::{parse_axes, Axis};
 use woodpile_pipeline::kind::{
     wrong_inputs, Context, Inputs, Kind, KindCheck, PointGrid, PointsAt,
 };
-use woodpile_pipeline::points::{PointStats, Series};
+use woodpile_points::{PointStats, Series};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
@@ -104,7 +104,7 @@ impl Vary {
 
     /// The sweep of `design`'s best scene (in `results`), varied.
     fn sweep_of(&self, stage: &str, design: &str, results: &Path) -> Result<Sweep> {
-        let path = woodpile_pipeline::layout::best_path(results, design);
+        let path = woodpile_points::layout::best_path(results, design);
         let text = woodpile_scene::read_input(&path).map_err(|reason| {
             PipelineError::stage(stage, format!("{}: {reason}", path.display()))
         })?;

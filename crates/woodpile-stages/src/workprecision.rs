@@ -172,11 +172,13 @@ impl WorkPrecision {
     pub(crate) fn run(&self, stage: &str) -> Result<Output> {
         let mut rows = Vec::new();
         let mut references = Vec::new();
+        let mut simulated = 0;
         for (index, (name, scene)) in self.scenes.iter().enumerate() {
             let (e_ref, ref_drift) =
                 reference(&scene.scenario, self.reference_tolerance).map_err(|e| {
                     PipelineError::stage(stage, format!("scene `{name}`: reference failed: {e}"))
                 })?;
+            simulated += 1;
             references.push(
                 json!({"scene": index, "name": name, "E_tr": e_ref, "energy_drift": ref_drift}),
             );
@@ -188,7 +190,7 @@ impl WorkPrecision {
                 let mut outcome: Option<std::result::Result<Outcome, String>> = None;
                 for _ in 0..self.repeats {
                     let t0 = Instant::now();
-                    woodpile_pipeline::points::count_simulation();
+                    simulated += 1;
                     let result = measured_run(&scenario).map_err(|e| e.to_string());
                     best = best.min(t0.elapsed().as_secs_f64() * 1e3);
                     let failed = result.is_err();
@@ -219,7 +221,8 @@ impl WorkPrecision {
                 "machine": machine(),
                 "runs": self.scenes.len() * self.settings.len() * self.repeats,
             }),
-        ))
+        )
+        .with_simulated(simulated))
     }
 }
 
@@ -242,7 +245,6 @@ fn reference(
     )
     .map_err(|e| e.to_string())?;
     plan.drift_limit = f64::INFINITY;
-    woodpile_pipeline::points::count_simulation();
     let outcome = run_with_plan(scenario, &plan, &mut (), true).map_err(|e| e.to_string())?;
     let drift = (!scenario.model.is_time_dependent()).then_some(outcome.stats.max_energy_drift);
     Ok((outcome.fractions.trapped, drift))

@@ -11,8 +11,8 @@ use common::{
     load_error, Counter, Project, BEST, REDUCE, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
 };
 use woodpile_pipeline::events::Events;
-use woodpile_pipeline::layout::points_dir;
-use woodpile_pipeline::points::PointStore;
+use woodpile_points::layout::points_dir;
+use woodpile_points::PointStore;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, Pipeline, PipelineError};

@@ -5,7 +5,7 @@
 mod common;
 
 use common::Project;
-use woodpile_pipeline::layout::output_path;
+use woodpile_points::layout::output_path;
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::{table, Pipeline};

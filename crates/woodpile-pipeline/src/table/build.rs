@@ -3,6 +3,9 @@
 
 use polars::prelude::*;
 
+pub use woodpile_points::rows::{Cell, Row};
+use woodpile_points::rows::Column as Typed;
+
 use crate::error::{PipelineError, Result};
 
 /// Columns of a table under construction, in output order: for tables whose columns are
@@ -65,117 +68,22 @@ impl Columns {
     }
 }
 
-/// One cell of an output row.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Cell {
-    /// A float (or null).
-    F64(Option<f64>),
-    /// An integer (or null).
-    I64(Option<i64>),
-    /// A string (or null).
-    Str(Option<String>),
-    /// A list of floats.
-    F64List(Vec<f64>),
-    /// A list of integers.
-    I64List(Vec<i64>),
-}
-
-/// `Cell` from a value and from an optional one (`None` is the null cell), for each scalar
-/// kind.
-macro_rules! cell_from {
-    ($($t:ty => $variant:ident),*) => {$(
-        impl From<$t> for Cell {
-            fn from(x: $t) -> Self {
-                Cell::$variant(Some(x))
-            }
-        }
-        impl From<Option<$t>> for Cell {
-            fn from(x: Option<$t>) -> Self {
-                Cell::$variant(x)
-            }
-        }
-    )*};
-}
-
-cell_from!(f64 => F64, i64 => I64, String => Str);
-
-impl From<&str> for Cell {
-    fn from(x: &str) -> Self {
-        Cell::Str(Some(x.to_string()))
-    }
-}
-
-/// A row of an output table: its cells, each under its column's name, in column order. A
-/// kind describes its rows once, as a type, and [`rows_frame`] makes the table.
-pub trait Row {
-    /// The cells of this row.
-    fn cells(&self) -> Vec<(&str, Cell)>;
-}
-
 /// The table of `rows`: one column per cell name, in the first row's order. Every row must
 /// give the same names with the same kinds of cell (an error names the first that does not).
 pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
-    let bad = |reason: String| PipelineError::stage("table", reason);
-    let Some(first) = rows.first() else {
+    let columns = woodpile_points::rows::columns(rows)
+        .map_err(|reason| PipelineError::stage("table", reason))?;
+    if columns.is_empty() {
         return Ok(DataFrame::empty());
-    };
-    let names: Vec<String> = first.cells().iter().map(|(n, _)| n.to_string()).collect();
-    let mut columns: Vec<Vec<Cell>> = vec![Vec::with_capacity(rows.len()); names.len()];
-    for (r, row) in rows.iter().enumerate() {
-        let cells = row.cells();
-        if cells.len() != names.len() {
-            return Err(bad(format!(
-                "row {r} has {} cells, not {}",
-                cells.len(),
-                names.len()
-            )));
-        }
-        for (k, (name, cell)) in cells.into_iter().enumerate() {
-            if name != names[k] {
-                return Err(bad(format!(
-                    "row {r}: column {k} is `{name}`, not `{}`",
-                    names[k]
-                )));
-            }
-            columns[k].push(cell);
-        }
     }
     let mut out = Columns::new();
-    for (name, cells) in names.iter().zip(columns) {
-        // One kind of value per column: the first cell's.
-        fn unpack<T>(
-            cells: Vec<Cell>,
-            pick: fn(Cell) -> Option<Option<T>>,
-            mismatch: impl Fn() -> PipelineError,
-        ) -> Result<Vec<Option<T>>> {
-            cells
-                .into_iter()
-                .map(|c| pick(c).ok_or_else(&mismatch))
-                .collect()
-        }
-        let mismatch = || bad(format!("column `{name}` mixes kinds of values"));
-        // The closure that takes a cell of one variant apart (`None` for any other).
-        macro_rules! take {
-            ($variant:ident) => {
-                |c| match c {
-                    Cell::$variant(x) => Some(x),
-                    _ => None,
-                }
-            };
-        }
-        // List cells are never null: each is unpacked as present, then unwrapped.
-        match cells.first() {
-            Some(Cell::F64(_)) | None => out.f64(name, unpack(cells, take!(F64), mismatch)?),
-            Some(Cell::I64(_)) => out.i64(name, unpack(cells, take!(I64), mismatch)?),
-            Some(Cell::Str(_)) => out.str(name, unpack(cells, take!(Str), mismatch)?),
-            Some(Cell::F64List(_)) => {
-                let lists = unpack(cells, |c| take!(F64List)(c).map(Some), mismatch)?;
-                out.f64_list(name, lists.into_iter().flatten().collect())
-            }
-            Some(Cell::I64List(_)) => {
-                let lists = unpack(cells, |c| take!(I64List)(c).map(Some), mismatch)?;
-                out.i64_list(name, lists.into_iter().flatten().collect())
-            }
+    for (name, column) in columns {
+        match column {
+            Typed::F64(v) => out.f64(&name, v),
+            Typed::I64(v) => out.i64(&name, v),
+            Typed::Str(v) => out.str(&name, v),
+            Typed::F64List(v) => out.f64_list(&name, v),
+            Typed::I64List(v) => out.i64_list(&name, v),
         };
     }
     out.into_frame()

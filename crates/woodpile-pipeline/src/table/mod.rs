@@ -6,10 +6,10 @@ use std::path::Path;
 
 use polars::prelude::*;
 
-use crate::atomic;
+use woodpile_points::atomic;
 use crate::error::{PipelineError, Result};
 use crate::manifest::{Manifest, METADATA_KEY};
-use crate::regular;
+use woodpile_points::regular;
 
 mod build;
 mod columns;
@@ -34,7 +34,7 @@ pub fn write(path: &Path, mut frame: DataFrame, manifest: &Manifest) -> Result<(
         })?;
     let sealed = seal(&bytes, at);
     bytes[at..at + SEAL_LEN].copy_from_slice(sealed.as_bytes());
-    atomic::write(path, &bytes)
+    Ok(atomic::write(path, &bytes)?)
 }
 
 /// The largest table woodpile reads: a thousand times its largest result. A file beyond it is

@@ -5,7 +5,7 @@ use woodpile_scene::Scene;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
-use woodpile_pipeline::points::{point_key, PointResult, PointStore, Series};
+use woodpile_points::{point_key, PointResult, PointStore, Series};
 
 use super::{Design, Evaluated, Layout, Search};
 use crate::schema::Fraction;
@@ -86,12 +86,14 @@ impl Design {
                             result: Err(reason),
                             score: f64::NEG_INFINITY,
                             key: String::new(),
+                            simulated: false,
                         });
                     }
                 }
                 let scene = self.scene(&layout, tolerance)?;
                 let key = point_key(&scene, Series::Energy);
-                let result = store.get_or_simulate(&key, &scene, Series::Energy)?;
+                let fetched = store.get_or_simulate(&key, &scene, Series::Energy)?;
+                let (result, simulated) = (fetched.result, fetched.simulated);
                 events.point_done();
                 let score = self.score(&result);
                 Ok(Evaluated {
@@ -100,6 +102,7 @@ impl Design {
                     result,
                     score,
                     key: key.to_string(),
+                    simulated,
                 })
             })
             .collect()

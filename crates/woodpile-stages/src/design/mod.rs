@@ -56,8 +56,8 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{Context, Kind, PointsAt};
-use woodpile_pipeline::layout::best_path;
-use woodpile_pipeline::points::{PointResult, PointStore};
+use woodpile_points::layout::best_path;
+use woodpile_points::{PointResult, PointStore};
 use woodpile_pipeline::Output;
 
 use crate::schema::Fraction;
@@ -110,6 +110,8 @@ struct Evaluated {
     result: PointResult,
     score: f64,
     key: String,
+    /// Whether it was simulated now (not read from the point cache).
+    simulated: bool,
 }
 
 /// Where a refinement starts: the search it refines, its genome and its score.
@@ -229,10 +231,12 @@ impl Design {
         }
         rows.extend(self.robustness_around(at, &best)?);
         let (best, verified, best_file) = self.verify_and_write(at, results, &mut rows, best)?;
+        let simulated = rows.iter().filter(|r| r.simulated).count();
         Ok(Output::table(
             self.frame(&rows)?,
             self.summary(&rows, &best, &verified, &best_file),
-        ))
+        )
+        .with_simulated(simulated))
     }
 
     /// Differential evolution a generation at a time, then random search of the same budget
@@ -365,7 +369,7 @@ impl Design {
             self.verify_tolerance,
             best_file.display()
         );
-        woodpile_pipeline::atomic::write(&best_file, (header + &text).as_bytes())?;
+        woodpile_points::atomic::write(&best_file, (header + &text).as_bytes())?;
         Ok((best, verified, best_file))
     }
 

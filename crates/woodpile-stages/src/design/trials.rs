@@ -3,7 +3,7 @@
 use polars::prelude::DataFrame;
 
 use woodpile_pipeline::error::Result;
-use woodpile_pipeline::points::PointData;
+use woodpile_points::PointData;
 use woodpile_pipeline::table::{rows_frame, Cell, Row};
 
 use super::{Design, Evaluated, Search};

@@ -236,7 +236,7 @@ impl Render {
 
     /// The figure files of stage `name` under `figures`.
     pub fn files(figures: &Path, name: &str) -> [PathBuf; 2] {
-        woodpile_pipeline::layout::figure_paths(figures, name)
+        woodpile_points::layout::figure_paths(figures, name)
     }
 
     /// Draws the panels from `inputs` (stage name to its table and manifest) and returns the
@@ -291,8 +291,8 @@ impl Render {
         let [png, svg] = Render::files(figures, stage);
         let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
         let drawn = figure.draw().map_err(drawing)?;
-        woodpile_pipeline::atomic::write(&png, &drawn.png)?;
-        woodpile_pipeline::atomic::write(&svg, drawn.svg.as_bytes())?;
+        woodpile_points::atomic::write(&png, &drawn.png)?;
+        woodpile_points::atomic::write(&svg, drawn.svg.as_bytes())?;
         Ok(Output::table(
             frame,
             json!({

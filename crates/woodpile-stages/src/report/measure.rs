@@ -7,7 +7,7 @@ use std::path::Path;
 use polars::prelude::DataFrame;
 
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::layout::output_path;
+use woodpile_points::layout::output_path;
 use woodpile_pipeline::table::{self, f64_column, matching_rows, str_column};
 
 use super::number::fmt;

@@ -41,7 +41,7 @@ use serde_json::json;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
-use woodpile_pipeline::layout::output_path;
+use woodpile_points::layout::output_path;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{self, rows_frame, Cell, Row};
 use woodpile_pipeline::Output;
@@ -231,7 +231,7 @@ impl Report {
             .ok()
             .flatten();
         let named = previous.is_some_and(|m| m.summary["markdown"] == self.markdown.as_str());
-        let marked = woodpile_pipeline::regular::read(path, 1 << 26)
+        let marked = woodpile_points::regular::read(path, 1 << 26)
             .ok()
             .and_then(|bytes| {
                 let head = &bytes[..bytes.len().min(4096)];
@@ -258,7 +258,7 @@ impl Report {
 
     /// The Markdown file for outputs under `results`.
     pub fn markdown_path(&self, results: &Path) -> PathBuf {
-        woodpile_pipeline::layout::markdown_path(results, &self.markdown)
+        woodpile_points::layout::markdown_path(results, &self.markdown)
     }
 
     pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
@@ -292,7 +292,7 @@ impl Report {
         let text = markdown(stage, self, &evaluated);
         let path = self.markdown_path(results);
         self.check_owned(stage, &path, results)?;
-        woodpile_pipeline::atomic::write(&path, text.as_bytes())?;
+        woodpile_points::atomic::write(&path, text.as_bytes())?;
         let reproduced = evaluated
             .iter()
             .zip(&self.quotes)
@@ -325,18 +325,14 @@ impl Report {
                 }))
             })
             .collect();
-        Ok(Output {
-            frame: rows_frame(&rows)?,
-            summary: json!({
-                "quotes": self.quotes.len(),
-                "reproduced_as_run": reproduced,
-                "reproduced_by_some_convention": by_some,
-                "failed": failures.len(),
-                "markdown": self.markdown,
-            }),
-            points: None,
-            failures,
-        })
+        let summary = json!({
+            "quotes": self.quotes.len(),
+            "reproduced_as_run": reproduced,
+            "reproduced_by_some_convention": by_some,
+            "failed": failures.len(),
+            "markdown": self.markdown,
+        });
+        Ok(Output::table(rows_frame(&rows)?, summary).with_failures(failures))
     }
 }
 

@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use woodpile_stages::KINDS;
 
 use woodpile_pipeline::events::{Events, Silent};
-use woodpile_pipeline::layout::output_path;
+use woodpile_points::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;

@@ -9,7 +9,7 @@ use std::fs;
 use std::io::Write;
 use std::path::Path;
 
-use crate::error::{PipelineError, Result};
+use crate::error::{FileError, Result};
 
 /// Writes `bytes` to `path` atomically, creating parent directories.
 pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
@@ -53,7 +53,7 @@ fn write_impl(
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    fs::create_dir_all(dir).map_err(|e| PipelineError::io(dir, e))?;
+    fs::create_dir_all(dir).map_err(|e| FileError::io(dir, e))?;
     let result = (|| {
         // Dropped on any error before `persist`: the temporary is removed with it.
         let mut tmp = temp_file(path, dir)?;
@@ -71,7 +71,7 @@ fn write_impl(
         }
         tmp.persist(path).map(|_| ()).map_err(|e| e.error)
     })();
-    result.map_err(|e| PipelineError::io(path, e))
+    result.map_err(|e| FileError::io(path, e))
 }
 
 /// A new temporary beside `path` in `dir`, named `.{name}~{host}~{pid}~{random}.tmp`: unique

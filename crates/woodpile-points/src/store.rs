@@ -14,177 +14,23 @@
 use std::path::{Path, PathBuf};
 
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::StepControl;
-use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::run::simulate;
 
 use crate::atomic;
-use crate::canonical::{code_version, scene_json, Key};
-use crate::error::Result;
-use serde_json::json;
+use crate::canonical::Key;
+use crate::error::{FileError, Result};
+use crate::point::{simulate_point_until, PointData, PointResult, Series};
 
 const MAGIC: &[u8; 4] = b"WPPT";
 /// The largest point file read: far beyond a series of the sample budget's length.
 const MAX_POINT_BYTES: u64 = 1 << 30;
 const FORMAT: u8 = 1;
-
-/// What simulating one scene gave: its fraction time series, or why it failed.
-pub type PointResult = std::result::Result<PointData, String>;
-
-/// A successful point: the sampled fractions and the facts that make them trustworthy.
+/// A point as the store gave it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct PointData {
-    /// The method that produced the reported run.
-    pub method: String,
-    /// Its fixed step as taken (the longest), if any.
-    pub dt: Option<f64>,
-    /// Steps of the reported run.
-    pub steps: u64,
-    /// Right-hand-side evaluations of every run made (auto's verification included).
-    pub rhs_evals: u64,
-    /// `auto`'s Richardson error estimate.
-    pub error_estimate: Option<f64>,
-    /// Largest relative energy drift (None where energy is not conserved).
-    pub energy_drift: Option<f64>,
-    /// E(0).
-    pub e_initial: f64,
-    /// E(t_end).
-    pub e_final: f64,
-    /// Sample times.
-    pub t: Vec<f64>,
-    /// R(t).
-    pub reflected: Vec<f64>,
-    /// T(t).
-    pub transmitted: Vec<f64>,
-    /// E_tr(t).
-    pub trapped: Vec<f64>,
-    /// E(t).
-    pub energy: Vec<f64>,
-    /// S(t), the striker's share: only for a scene with a striker, so that a paper point's
-    /// data (and file) is what it was before strikers existed.
-    pub striker: Option<Vec<f64>>,
-    /// D(t), the dissipated share: only for a dissipative scene, for the same reason.
-    pub dissipated: Option<Vec<f64>>,
-}
-
-/// Which energy a sweep's fractions split.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Series {
-    /// Total energy, fractions of E(t) (the paper's Sections IV–V).
-    Energy,
-    /// Kinetic energy divided by the impact energy (the woodpile experiment, paper Fig. 2).
-    Kinetic,
-}
-
-/// Scenes simulated by this process, by every kind (sweeps, designs, optima, maps, surveys):
-/// what a run's summary line reports.
-static SIMULATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
-/// How many scenes this process has simulated so far.
-pub fn simulations() -> u64 {
-    SIMULATIONS.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Counts one simulation (each kind calls it beside each run it makes).
-pub fn count_simulation() {
-    SIMULATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-}
-
-/// Simulates `scene`, recording its fractions at every sample.
-pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
-    let s = &scene.scenario;
-    let mut series = match kind {
-        Series::Energy => FractionSeries::new(&s.model, s.region),
-        Series::Kinetic => {
-            let striker_mass = s.model.site_mass(s.impulse_site);
-            let impact_energy = 0.5 * striker_mass * s.impulse_velocity * s.impulse_velocity;
-            if impact_energy.is_nan() || impact_energy <= 0.0 {
-                return Err(
-                    "a kinetic series is divided by the impact energy, which is zero".into(),
-                );
-            }
-            FractionSeries::kinetic(&s.model, s.region, impact_energy)
-        }
-    };
-    crate::points::count_simulation();
-    let out = simulate(s, &mut series).map_err(|e| e.to_string())?;
-    Ok(PointData {
-        method: out.plan.method.name().to_string(),
-        dt: match out.plan.control {
-            // The step taken (each sample interval cut into equal steps of at most dt).
-            StepControl::Fixed { .. } => Some(out.stats.max_step),
-            StepControl::Adaptive { .. } => None,
-        },
-        steps: out.stats.steps,
-        rhs_evals: out.total_rhs_evals,
-        error_estimate: out.error_estimate,
-        energy_drift: (!s.model.is_time_dependent()).then_some(out.stats.max_energy_drift),
-        e_initial: out.e_initial,
-        e_final: out.e_final,
-        t: series.t,
-        reflected: series.reflected,
-        transmitted: series.transmitted,
-        trapped: series.trapped,
-        striker: s.region.has_striker().then_some(series.striker),
-        dissipated: s.model.is_dissipative().then_some(series.dissipated),
-        energy: series.energy,
-    })
-}
-
-/// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
-/// that energy points keep their keys), the series.
-pub fn point_key(scene: &Scene, series: Series) -> Key {
-    let mut key = json!({"scene": scene_json(scene), "code": code_version()});
-    if series == Series::Kinetic {
-        key["series"] = json!("kinetic");
-    }
-    Key::of(&key)
-}
-
-/// Facts about a set of simulated points that combine exactly across shards (counts, sums of
-/// integers, maxima), so a merged sweep reports what a single run would.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct PointStats {
-    /// Points.
-    pub points: usize,
-    /// Of which failed.
-    pub failed: usize,
-    /// Right-hand-side evaluations of all successful points.
-    pub rhs_evals: u64,
-    /// Largest `auto` error estimate.
-    pub max_error_estimate: Option<f64>,
-    /// Largest relative energy drift.
-    pub max_energy_drift: Option<f64>,
-}
-
-impl PointStats {
-    /// The statistics of `results`.
-    pub fn of(results: &[PointResult]) -> Self {
-        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
-        let max = |f: fn(&PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
-        Self {
-            points: results.len(),
-            failed: results.iter().filter(|r| r.is_err()).count(),
-            rhs_evals: ok().map(|p| p.rhs_evals).sum(),
-            max_error_estimate: max(|p| p.error_estimate),
-            max_energy_drift: max(|p| p.energy_drift),
-        }
-    }
-
-    /// The statistics of the union of two disjoint point sets.
-    pub fn merge(self, other: PointStats) -> PointStats {
-        let max = |a: Option<f64>, b: Option<f64>| match (a, b) {
-            (Some(x), Some(y)) => Some(x.max(y)),
-            (x, y) => x.or(y),
-        };
-        PointStats {
-            points: self.points + other.points,
-            failed: self.failed + other.failed,
-            rhs_evals: self.rhs_evals + other.rhs_evals,
-            max_error_estimate: max(self.max_error_estimate, other.max_error_estimate),
-            max_energy_drift: max(self.max_energy_drift, other.max_energy_drift),
-        }
-    }
+pub struct Fetched {
+    /// Its series, or why it failed.
+    pub result: PointResult,
+    /// Whether it was simulated now (not read from the cache).
+    pub simulated: bool,
 }
 
 /// The directory of point files.
@@ -219,16 +65,40 @@ impl PointStore {
         decode(&bytes, key)
     }
 
-    /// The result of `scene` (whose key is `key`, from [`point_key`]): from the cache, or
-    /// simulated and saved. Every kind that simulates scenes goes through here, so a scene is
-    /// simulated once whichever stage asks for it first.
-    pub fn get_or_simulate(&self, key: &Key, scene: &Scene, series: Series) -> Result<PointResult> {
+    /// The result of `scene` (whose key is `key`, from [`crate::point_key`]): from the cache,
+    /// or simulated and saved. Every kind that simulates scenes goes through here, so a scene
+    /// is simulated once whichever stage asks for it first.
+    pub fn get_or_simulate(&self, key: &Key, scene: &Scene, series: Series) -> Result<Fetched> {
+        let fetched = self.get_or_simulate_until(key, scene, series, &|| false)?;
+        Ok(fetched.unwrap_or(Fetched {
+            result: Err("cancelled".into()),
+            simulated: false,
+        }))
+    }
+
+    /// [`PointStore::get_or_simulate`], stopped once `stop()` says so: `None` then, and
+    /// nothing is saved.
+    pub fn get_or_simulate_until(
+        &self,
+        key: &Key,
+        scene: &Scene,
+        series: Series,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Option<Fetched>> {
         if let Some(cached) = self.load(key) {
-            return Ok(cached);
+            return Ok(Some(Fetched {
+                result: cached,
+                simulated: false,
+            }));
         }
-        let result = simulate_point(scene, series);
+        let Some(result) = simulate_point_until(scene, series, stop) else {
+            return Ok(None);
+        };
         self.save(key, &result)?;
-        Ok(result)
+        Ok(Some(Fetched {
+            result,
+            simulated: true,
+        }))
     }
 
     /// Stores `result` under `key`, atomically. A fan-out folder that is a symbolic link is
@@ -237,7 +107,7 @@ impl PointStore {
         let path = self.path(key);
         if let Some(folder) = path.parent() {
             crate::layout::check_tree_folder(folder)
-                .map_err(|reason| crate::error::PipelineError::refused(folder, reason))?;
+                .map_err(|reason| FileError::refused(folder, reason))?;
         }
         atomic::write_checksummed(&path, &encode(key, result))
     }

@@ -1,0 +1,239 @@
+//! One point: a scene simulated once, its fraction series or why it failed, the key it is
+//! cached under, and the statistics a set of points reports.
+
+use serde_json::json;
+use woodpile_scene::Scene;
+use woodpile_sim::integrate::StepControl;
+use woodpile_sim::observe::FractionSeries;
+use woodpile_sim::integrate::Observer;
+use woodpile_sim::run::{simulate, Outcome, Scenario};
+use woodpile_sim::{Model, SimError};
+
+use crate::canonical::{code_version, scene_json, Key};
+
+/// What simulating one scene gave: its fraction time series, or why it failed.
+pub type PointResult = std::result::Result<PointData, String>;
+
+/// A successful point: the sampled fractions and the facts that make them trustworthy.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointData {
+    /// The method that produced the reported run.
+    pub method: String,
+    /// Its fixed step as taken (the longest), if any.
+    pub dt: Option<f64>,
+    /// Steps of the reported run.
+    pub steps: u64,
+    /// Right-hand-side evaluations of every run made (auto's verification included).
+    pub rhs_evals: u64,
+    /// `auto`'s Richardson error estimate.
+    pub error_estimate: Option<f64>,
+    /// Largest relative energy drift (None where energy is not conserved).
+    pub energy_drift: Option<f64>,
+    /// E(0).
+    pub e_initial: f64,
+    /// E(t_end).
+    pub e_final: f64,
+    /// Sample times.
+    pub t: Vec<f64>,
+    /// R(t).
+    pub reflected: Vec<f64>,
+    /// T(t).
+    pub transmitted: Vec<f64>,
+    /// E_tr(t).
+    pub trapped: Vec<f64>,
+    /// E(t).
+    pub energy: Vec<f64>,
+    /// S(t), the striker's share: only for a scene with a striker, so that a paper point's
+    /// data (and file) is what it was before strikers existed.
+    pub striker: Option<Vec<f64>>,
+    /// D(t), the dissipated share: only for a dissipative scene, for the same reason.
+    pub dissipated: Option<Vec<f64>>,
+}
+
+/// Which energy a sweep's fractions split.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Series {
+    /// Total energy, fractions of E(t) (the paper's Sections IV–V).
+    Energy,
+    /// Kinetic energy divided by the impact energy (the woodpile experiment, paper Fig. 2).
+    Kinetic,
+}
+
+impl Series {
+    /// An empty series of this kind for `scenario`, or why it cannot be recorded.
+    pub fn recorder(self, scenario: &Scenario) -> Result<FractionSeries, String> {
+        let (model, region) = (&scenario.model, scenario.region);
+        match self {
+            Series::Energy => Ok(FractionSeries::new(model, region)),
+            Series::Kinetic => {
+                let impact = scenario.impact_energy();
+                if impact.is_nan() || impact <= 0.0 {
+                    return Err(
+                        "a kinetic series is divided by the impact energy, which is zero".into(),
+                    );
+                }
+                Ok(FractionSeries::kinetic(model, region, impact))
+            }
+        }
+    }
+}
+
+/// Simulates `scene`, recording its fractions at every sample.
+pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
+    simulate_point_until(scene, kind, &|| false).unwrap_or_else(|| Err("cancelled".into()))
+}
+
+/// [`simulate_point`], stopped within a sample interval once `stop()` says so (Ctrl-C in a
+/// Python session): `None` then, since a cancelled run is no result and must not be cached.
+pub fn simulate_point_until(
+    scene: &Scene,
+    kind: Series,
+    stop: &dyn Fn() -> bool,
+) -> Option<PointResult> {
+    let s = &scene.scenario;
+    let series = match kind.recorder(s) {
+        Ok(series) => series,
+        Err(reason) => return Some(Err(reason)),
+    };
+    let mut watched = Stoppable { series, stop };
+    match simulate(s, &mut watched) {
+        Err(SimError::Cancelled { .. }) => None,
+        Err(e) => Some(Err(e.to_string())),
+        Ok(out) => Some(Ok(PointData::of(s, &out, watched.series))),
+    }
+}
+
+/// A fraction recorder that also stops its run once `stop()` says so.
+struct Stoppable<'a> {
+    series: FractionSeries,
+    stop: &'a dyn Fn() -> bool,
+}
+
+impl Observer for Stoppable<'_> {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        self.series.observe(model, t, y);
+    }
+    fn reset(&mut self) {
+        self.series.reset();
+    }
+    fn cancelled(&self) -> bool {
+        (self.stop)()
+    }
+}
+
+impl PointData {
+    /// The point of scenario `s`, whose run gave `out` and recorded `series`.
+    fn of(s: &Scenario, out: &Outcome, series: FractionSeries) -> PointData {
+        PointData {
+            method: out.plan.method.name().to_string(),
+            dt: match out.plan.control {
+                // The step taken (each sample interval cut into equal steps of at most dt).
+                StepControl::Fixed { .. } => Some(out.stats.max_step),
+                StepControl::Adaptive { .. } => None,
+            },
+            steps: out.stats.steps,
+            rhs_evals: out.total_rhs_evals,
+            error_estimate: out.error_estimate,
+            energy_drift: (!s.model.is_time_dependent()).then_some(out.stats.max_energy_drift),
+            e_initial: out.e_initial,
+            e_final: out.e_final,
+            t: series.t,
+            reflected: series.reflected,
+            transmitted: series.transmitted,
+            trapped: series.trapped,
+            striker: s.region.has_striker().then_some(series.striker),
+            dissipated: s.model.is_dissipative().then_some(series.dissipated),
+            energy: series.energy,
+        }
+    }
+
+    /// The point with its last sample only (at t_end): what a table of final values keeps of
+    /// each point, without holding every point's series at once.
+    pub fn last_sample(mut self) -> PointData {
+        let last = |v: &mut Vec<f64>| {
+            let keep = v.len().saturating_sub(1);
+            v.drain(..keep);
+        };
+        for v in [
+            &mut self.t,
+            &mut self.reflected,
+            &mut self.transmitted,
+            &mut self.trapped,
+            &mut self.energy,
+        ] {
+            last(v);
+        }
+        self.striker.iter_mut().chain(&mut self.dissipated).for_each(last);
+        self
+    }
+}
+
+/// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
+/// that energy points keep their keys), the series.
+pub fn point_key(scene: &Scene, series: Series) -> Key {
+    let mut key = json!({"scene": scene_json(scene), "code": code_version()});
+    if series == Series::Kinetic {
+        key["series"] = json!("kinetic");
+    }
+    Key::of(&key)
+}
+
+/// Facts about a set of simulated points that combine exactly across shards (counts, sums of
+/// integers, maxima), so a merged sweep reports what a single run would.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PointStats {
+    /// Points.
+    pub points: usize,
+    /// Of which failed.
+    pub failed: usize,
+    /// Scenes this run simulated (the others came from the cache).
+    #[serde(default)]
+    pub simulated: usize,
+    /// Right-hand-side evaluations of all successful points.
+    pub rhs_evals: u64,
+    /// Largest `auto` error estimate.
+    pub max_error_estimate: Option<f64>,
+    /// Largest relative energy drift.
+    pub max_energy_drift: Option<f64>,
+}
+
+impl PointStats {
+    /// The statistics of `results`.
+    pub fn of(results: &[PointResult]) -> Self {
+        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
+        let max = |f: fn(&PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
+        Self {
+            points: results.len(),
+            failed: results.iter().filter(|r| r.is_err()).count(),
+            simulated: 0,
+            rhs_evals: ok().map(|p| p.rhs_evals).sum(),
+            max_error_estimate: max(|p| p.error_estimate),
+            max_energy_drift: max(|p| p.energy_drift),
+        }
+    }
+
+    /// Only a count of scenes simulated: what a kind that simulates outside a grid (a map, a
+    /// survey, an optimiser) reports.
+    pub fn simulated(count: usize) -> Self {
+        Self {
+            simulated: count,
+            ..Self::default()
+        }
+    }
+
+    /// The statistics of the union of two disjoint point sets.
+    pub fn merge(self, other: PointStats) -> PointStats {
+        let max = |a: Option<f64>, b: Option<f64>| match (a, b) {
+            (Some(x), Some(y)) => Some(x.max(y)),
+            (x, y) => x.or(y),
+        };
+        PointStats {
+            points: self.points + other.points,
+            failed: self.failed + other.failed,
+            simulated: self.simulated + other.simulated,
+            rhs_evals: self.rhs_evals + other.rhs_evals,
+            max_error_estimate: max(self.max_error_estimate, other.max_error_estimate),
+            max_energy_drift: max(self.max_energy_drift, other.max_energy_drift),
+        }
+    }
+}

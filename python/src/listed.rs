@@ -1,0 +1,117 @@
+//! Tables handed to Python: rows (`woodpile_points::rows::Row`) as a dict of NumPy arrays and
+//! lists, and the rows of `simulate_many`, one per scene as `simulate` reports it.
+
+use std::panic::AssertUnwindSafe;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use numpy::IntoPyArray;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use woodpile_points::rows::{columns, Cell, Column, Row};
+use woodpile_scene::Scene;
+use woodpile_sim::run::{simulate, Outcome};
+
+use crate::interrupt::{internal_message, Watch};
+
+/// The table of `rows` as the Python side reads it: `names` (the columns in order), each
+/// column under its name (floats and integers as arrays, a null float as NaN, text and lists
+/// as lists), and `masks`, each integer column's nulls.
+pub(crate) fn table_dict<'py, R: Row>(py: Python<'py>, rows: &[R]) -> PyResult<Bound<'py, PyDict>> {
+    let columns = columns(rows).map_err(pyo3::exceptions::PyRuntimeError::new_err)?;
+    let out = PyDict::new(py);
+    let masks = PyDict::new(py);
+    let mut names = Vec::with_capacity(columns.len());
+    for (name, column) in columns {
+        match column {
+            Column::F64(v) => {
+                let v: Vec<f64> = v.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect();
+                out.set_item(&name, v.into_pyarray(py))?;
+            }
+            Column::I64(v) => {
+                let mask: Vec<bool> = v.iter().map(Option::is_none).collect();
+                let v: Vec<i64> = v.into_iter().map(|x| x.unwrap_or(0)).collect();
+                out.set_item(&name, v.into_pyarray(py))?;
+                masks.set_item(&name, mask.into_pyarray(py))?;
+            }
+            Column::Str(v) => out.set_item(&name, PyList::new(py, v)?)?,
+            Column::F64List(v) => out.set_item(&name, PyList::new(py, v)?)?,
+            Column::I64List(v) => out.set_item(&name, PyList::new(py, v)?)?,
+        }
+        names.push(name);
+    }
+    out.set_item("names", names)?;
+    out.set_item("masks", masks)?;
+    Ok(out)
+}
+
+/// `scene` simulated as `simulate` runs it (stopped once `cancel` is raised), keeping only what
+/// the table reads: a run's final state is a chain's worth of floats, which thousands of scenes
+/// of a long chain would hold at once. A panic in the core is this scene's failure.
+pub(crate) fn simulate_one(scene: &Scene, cancel: &AtomicBool) -> Result<Outcome, String> {
+    if cancel.load(Ordering::Relaxed) {
+        return Err("cancelled".into());
+    }
+    let stop = || cancel.load(Ordering::Relaxed);
+    let run = || {
+        let mut watched = Watch {
+            inner: (),
+            stop: &stop,
+        };
+        let mut outcome = simulate(&scene.scenario, &mut watched).map_err(|e| e.to_string())?;
+        outcome.final_state = Vec::new();
+        Ok(outcome)
+    };
+    std::panic::catch_unwind(AssertUnwindSafe(run))
+        .unwrap_or_else(|panic| Err(internal_message(&panic)))
+}
+
+/// The rows of `simulate_many`: one per scene, in input order; `D` on every row when any scene
+/// declares damping.
+pub(crate) fn outcome_rows(outcomes: &[Result<Outcome, String>], dissipation: bool) -> Vec<OutcomeRow<'_>> {
+    outcomes
+        .iter()
+        .enumerate()
+        .map(|(point, outcome)| OutcomeRow {
+            point,
+            outcome,
+            dissipation,
+        })
+        .collect()
+}
+
+/// One scene's row: its final fractions and how the run went, or why it failed.
+pub(crate) struct OutcomeRow<'a> {
+    point: usize,
+    outcome: &'a Result<Outcome, String>,
+    dissipation: bool,
+}
+
+impl Row for OutcomeRow<'_> {
+    fn cells(&self) -> Vec<(&str, Cell)> {
+        let ok = self.outcome.as_ref().ok();
+        let share = |pick: fn(&Outcome) -> f64| Cell::from(ok.map(pick));
+        let mut cells = vec![
+            ("point", Cell::from(self.point as i64)),
+            ("R", share(|o| o.fractions.reflected)),
+            ("T", share(|o| o.fractions.transmitted)),
+            ("E_tr", share(|o| o.fractions.trapped)),
+        ];
+        if self.dissipation {
+            cells.push(("D", share(|o| o.fractions.dissipated)));
+        }
+        cells.extend([
+            ("E_initial", share(|o| o.e_initial)),
+            ("E_final", share(|o| o.e_final)),
+            ("error_estimate", ok.and_then(|o| o.error_estimate).into()),
+            (
+                "dt",
+                ok.and_then(|o| o.plan.dt().map(|_| o.stats.max_step)).into(),
+            ),
+            ("steps", ok.map(|o| o.stats.steps as i64).into()),
+            ("rhs_evals", ok.map(|o| o.total_rhs_evals as i64).into()),
+            ("method", ok.map(|o| o.plan.method.name().to_string()).into()),
+            ("failure", self.outcome.as_ref().err().cloned().into()),
+        ]);
+        cells
+    }
+}
