@@ -199,7 +199,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-plot", "heat.rs:panel", 130),
     ("woodpile-stages", "render/spec.rs:parse_panel", 112),
     ("woodpile-bench", "main.rs:main", 117),
-    ("woodpile-py", "sweep.rs:columns", 93),
     ("woodpile-stages", "render/draw.rs:draw", 101),
     ("woodpile-stages", "report/markdown.rs:markdown", 99),
     ("woodpile-pipeline", "shard.rs:merge", 99),
