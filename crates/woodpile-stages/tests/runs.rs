@@ -129,6 +129,9 @@ fn overlapping_sweeps_share_points() {
     let forced = p.counted_with(&["wider"], true);
     assert_eq!(*forced.started.lock().unwrap(), vec!["wider".to_string()]);
     assert_eq!(forced.points.load(Ordering::SeqCst), 0);
+    // What each run's steps report as simulated is what it simulated.
+    let simulated = [&first, &second, &forced].map(|c| c.simulated.load(Ordering::SeqCst));
+    assert_eq!(simulated, [6, 3, 0]);
 }
 
 #[test]

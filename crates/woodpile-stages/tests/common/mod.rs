@@ -85,7 +85,9 @@ impl Project {
             results: self.results(),
             figures: self.figures(),
         };
-        run(&self.load(), &options, &events).unwrap();
+        let steps = run(&self.load(), &options, &events).unwrap();
+        let simulated = steps.iter().map(|s| s.simulated).sum();
+        events.simulated.store(simulated, std::sync::atomic::Ordering::SeqCst);
         events
     }
 }
@@ -94,6 +96,8 @@ impl Project {
 #[derive(Default)]
 pub struct Counter {
     pub points: AtomicUsize,
+    /// The scenes the run's steps say they simulated.
+    pub simulated: AtomicUsize,
     pub started: Mutex<Vec<String>>,
     pub warnings: Mutex<Vec<String>>,
 }
