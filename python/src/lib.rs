@@ -5,11 +5,11 @@
 //! the pure-Python `woodpile` package around it.
 
 mod interrupt;
+mod listed;
 mod pool;
 mod scene_input;
 mod series;
 mod simulate;
-mod listed;
 mod sweep;
 
 use pyo3::prelude::*;

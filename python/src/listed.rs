@@ -67,7 +67,10 @@ pub(crate) fn simulate_one(scene: &Scene, cancel: &AtomicBool) -> Result<Outcome
 
 /// The rows of `simulate_many`: one per scene, in input order; `D` on every row when any scene
 /// declares damping.
-pub(crate) fn outcome_rows(outcomes: &[Result<Outcome, String>], dissipation: bool) -> Vec<OutcomeRow<'_>> {
+pub(crate) fn outcome_rows(
+    outcomes: &[Result<Outcome, String>],
+    dissipation: bool,
+) -> Vec<OutcomeRow<'_>> {
     outcomes
         .iter()
         .enumerate()
@@ -105,11 +108,15 @@ impl Row for OutcomeRow<'_> {
             ("error_estimate", ok.and_then(|o| o.error_estimate).into()),
             (
                 "dt",
-                ok.and_then(|o| o.plan.dt().map(|_| o.stats.max_step)).into(),
+                ok.and_then(|o| o.plan.dt().map(|_| o.stats.max_step))
+                    .into(),
             ),
             ("steps", ok.map(|o| o.stats.steps as i64).into()),
             ("rhs_evals", ok.map(|o| o.total_rhs_evals as i64).into()),
-            ("method", ok.map(|o| o.plan.method.name().to_string()).into()),
+            (
+                "method",
+                ok.map(|o| o.plan.method.name().to_string()).into(),
+            ),
             ("failure", self.outcome.as_ref().err().cloned().into()),
         ]);
         cells

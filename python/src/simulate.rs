@@ -16,8 +16,8 @@ use woodpile_sim::SimError;
 use crate::interrupt::{on_this_thread, Watch};
 use crate::scene_input::{shown, Source};
 use crate::series;
-use woodpile_points::Series;
 use crate::{SceneError, SimulationError};
+use woodpile_points::Series;
 
 /// _simulate(scene, fields=False, field_sites=None, series=None) -> dict
 /// --

@@ -7,9 +7,9 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Context};
 use serde_json::{json, Value};
-use woodpile_points::canonical::{code_version, scene_json, Key};
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::{self, Columns};
+use woodpile_points::canonical::{code_version, scene_json, Key};
 use woodpile_scene::report::{simulate_report, unverified_report, wall_note};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use woodpile_points::FileError;
 use woodpile_scene::SceneError;
 
 /// A pipeline failure.
@@ -41,24 +42,11 @@ pub enum PipelineError {
         /// The names that exist, comma separated.
         known: String,
     },
-    /// A file could not be read or written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong: the underlying error (the OS's, polars', ...), kept as the source.
-        #[source]
-        source: BoxError,
-    },
-    /// A path of the results tree that woodpile will not use as it is (a symbolic link or a
-    /// non-regular file where its lock or its own folders go): bad input, not a failed run.
-    #[error("{path}: {reason}")]
-    Refused {
-        /// The path.
-        path: PathBuf,
-        /// Why, and what to do.
-        reason: String,
-    },
+    /// A file could not be read or written, or a path of the results tree that woodpile will
+    /// not use as it is (a symbolic link or a non-regular file where its lock or its own
+    /// folders go: bad input, not a failed run).
+    #[error(transparent)]
+    File(#[from] FileError),
     /// The run finished what it could, but stages failed (or failed in part, or were skipped
     /// because an input failed): each named with its reason.
     #[error("{} failure(s): {}", failures.len(), failures.join("; "))]
@@ -80,18 +68,12 @@ pub enum PipelineError {
 impl PipelineError {
     /// A path of the results tree refused for `reason`.
     pub fn refused(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
-        PipelineError::Refused {
-            path: path.into(),
-            reason: reason.into(),
-        }
+        Self::File(FileError::refused(path, reason))
     }
 
     /// An IO error on `path`, keeping `e` as its source.
     pub fn io(path: impl Into<PathBuf>, e: impl Into<BoxError>) -> Self {
-        Self::Io {
-            path: path.into(),
-            source: e.into(),
-        }
+        Self::File(FileError::io(path, e))
     }
 
     /// A scene embedded in stage `file` under key `prefix` (`scene`, `scene[2]`) that
@@ -121,17 +103,7 @@ impl PipelineError {
     }
 }
 
-impl From<woodpile_points::FileError> for PipelineError {
-    fn from(e: woodpile_points::FileError) -> Self {
-        match e {
-            woodpile_points::FileError::Io { path, source } => Self::Io { path, source },
-            woodpile_points::FileError::Refused { path, reason } => Self::Refused { path, reason },
-        }
-    }
-}
-
-/// Any error, as a source.
-pub type BoxError = Box<dyn std::error::Error + Send + Sync>;
+pub use woodpile_points::error::BoxError;
 
 /// Result alias of this crate.
 pub type Result<T, E = PipelineError> = std::result::Result<T, E>;

@@ -11,13 +11,13 @@ use std::sync::Arc;
 use polars::prelude::DataFrame;
 use serde_json::Value;
 
-use crate::error::Result;
+use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::fields::Fields;
-use woodpile_points::layout::output_path;
 use crate::manifest::Manifest;
-use woodpile_points::{PointStats, PointStore};
 use crate::table;
+use woodpile_points::layout::output_path;
+use woodpile_points::{PointStats, PointStore};
 
 /// A stage kind: its parameters, and what it does with them.
 pub trait Kind: std::fmt::Debug + Send + Sync + Any {
@@ -197,7 +197,7 @@ impl Context<'_> {
     pub fn upstream(&self, name: &str) -> Result<&Stage> {
         match self.upstream.iter().find(|s| s.name == name) {
             Some(stage) => Ok(stage),
-            None => Err(crate::error::PipelineError::stage(
+            None => Err(PipelineError::stage(
                 &self.stage.name,
                 format!("`{name}` is not upstream of this stage"),
             )),
@@ -212,6 +212,65 @@ impl Context<'_> {
     /// The table of input `name` with its manifest.
     pub fn input_with_manifest(&self, name: &str) -> Result<(DataFrame, Manifest)> {
         table::read_with_manifest(&output_path(self.results, name))
+    }
+
+    /// The manifest of input `name`, read without decoding its table (`None`: not a woodpile
+    /// table).
+    pub fn input_manifest(&self, name: &str) -> Result<Option<Manifest>> {
+        table::read_manifest(&output_path(self.results, name))
+    }
+
+    /// Where upstream stage `name` (an optimiser or a design) wrote its best scene.
+    pub fn best_scene(&self, name: &str) -> Result<PathBuf> {
+        self.upstream(name)?;
+        Ok(woodpile_points::layout::best_path(self.results, name))
+    }
+
+    /// Writes `bytes` to `path`, one of the files this stage declares besides its table
+    /// ([`Kind::files`]), atomically. The one door through which a kind writes: a file it did
+    /// not declare is refused (its checksum would not be recorded, so `status` could not see
+    /// it change), and so is a path through a symbolic link below the tree it lies in (a
+    /// `docs -> /elsewhere` folder would take the write outside the project).
+    pub fn write_file(&self, path: &Path, bytes: &[u8]) -> Result<()> {
+        let declared = self
+            .stage
+            .spec
+            .files(self.name(), self.results, self.figures);
+        if !declared.iter().any(|p| p == path) {
+            return Err(PipelineError::stage(
+                self.name(),
+                format!("writes {}, which its kind does not declare", path.display()),
+            ));
+        }
+        if let Some(link) = self.link_on_the_way(path) {
+            return Err(PipelineError::stage(
+                self.name(),
+                format!(
+                    "{}: {} is a symbolic link; a stage writes only inside the project",
+                    path.display(),
+                    link.display()
+                ),
+            ));
+        }
+        Ok(woodpile_points::atomic::write(path, bytes)?)
+    }
+
+    /// The first folder between the tree `path` lies in (the results, the figures, or the
+    /// project around them) and `path` that is a symbolic link.
+    fn link_on_the_way(&self, path: &Path) -> Option<PathBuf> {
+        let project = self.results.parent().unwrap_or_else(|| Path::new(""));
+        let root = [self.results, self.figures, project]
+            .into_iter()
+            .find(|root| path.starts_with(root))?;
+        let inside = path.strip_prefix(root).ok()?.parent()?;
+        let mut folder = root.to_path_buf();
+        for part in inside.components() {
+            folder.push(part);
+            if std::fs::symlink_metadata(&folder).is_ok_and(|m| m.file_type().is_symlink()) {
+                return Some(folder);
+            }
+        }
+        None
     }
 }
 

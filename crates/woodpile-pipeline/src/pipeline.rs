@@ -8,11 +8,11 @@ use std::path::{Path, PathBuf};
 
 use serde_json::json;
 
-use woodpile_points::canonical::{code_version, Key};
 use crate::error::{PipelineError, Result};
 use crate::kind::{Inputs, Registry};
 use crate::stage::{Defaults, Stage};
 use crate::variant::Set;
+use woodpile_points::canonical::{code_version, Key};
 
 /// A loaded, validated pipeline.
 #[derive(Debug, Clone)]

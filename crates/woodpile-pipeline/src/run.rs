@@ -5,19 +5,19 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
-use woodpile_points::atomic;
-use woodpile_points::canonical::code_version;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::kind::{Context, Sharing};
-use woodpile_points::layout::{output_path, points_dir};
 use crate::lock::lock_results;
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
-use woodpile_points::PointStore;
 use crate::stage::Stage;
 use crate::status::{state, State};
 use crate::{sealed_files, table};
+use woodpile_points::atomic;
+use woodpile_points::canonical::code_version;
+use woodpile_points::layout::{output_path, points_dir};
+use woodpile_points::PointStore;
 
 /// How to run.
 #[derive(Debug, Clone, Default)]

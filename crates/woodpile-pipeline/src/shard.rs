@@ -16,13 +16,13 @@ use serde_json::json;
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
 use crate::kind::{PointGrid, PointsAt};
-use woodpile_points::layout::{output_path, parts_dir, points_dir};
 use crate::manifest::Manifest;
 use crate::pipeline::Pipeline;
-use woodpile_points::{PointStats, PointStore};
 use crate::run::manifest_for;
 use crate::stage::Stage;
 use crate::table::{self, f64_column};
+use woodpile_points::layout::{output_path, parts_dir, points_dir};
+use woodpile_points::{PointStats, PointStore};
 
 /// Shard `index` of `count` (0 <= index < count).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -14,10 +14,10 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use woodpile_points::canonical::toml_to_json;
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::kind::Registry;
+use woodpile_points::canonical::toml_to_json;
 
 pub use crate::kind::Stage;
 

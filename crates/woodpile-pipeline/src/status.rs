@@ -3,11 +3,11 @@
 
 use std::path::Path;
 
-use woodpile_points::canonical::{changed_paths, code_version};
-use woodpile_points::layout::output_path;
 use crate::pipeline::Pipeline;
 use crate::stage::Stage;
 use crate::table::{self, Integrity};
+use woodpile_points::canonical::{changed_paths, code_version};
+use woodpile_points::layout::output_path;
 
 /// Freshness of one stage output.
 #[derive(Debug, Clone, PartialEq)]

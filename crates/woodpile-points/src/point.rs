@@ -3,9 +3,9 @@
 
 use serde_json::json;
 use woodpile_scene::Scene;
+use woodpile_sim::integrate::Observer;
 use woodpile_sim::integrate::StepControl;
 use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::integrate::Observer;
 use woodpile_sim::run::{simulate, Outcome, Scenario};
 use woodpile_sim::{Model, SimError};
 
@@ -163,7 +163,10 @@ impl PointData {
         ] {
             last(v);
         }
-        self.striker.iter_mut().chain(&mut self.dissipated).for_each(last);
+        self.striker
+            .iter_mut()
+            .chain(&mut self.dissipated)
+            .for_each(last);
         self
     }
 }

@@ -118,10 +118,13 @@ pub fn columns<R: Row>(rows: &[R]) -> Result<Vec<(String, Column)>, String> {
                 out.len()
             ));
         }
-        for (k, ((name, cell), (column_name, column))) in cells.into_iter().zip(&mut out).enumerate()
+        for (k, ((name, cell), (column_name, column))) in
+            cells.into_iter().zip(&mut out).enumerate()
         {
             if name != column_name {
-                return Err(format!("row {r}: column {k} is `{name}`, not `{column_name}`"));
+                return Err(format!(
+                    "row {r}: column {k} is `{name}`, not `{column_name}`"
+                ));
             }
             column
                 .push(cell)
@@ -248,9 +251,15 @@ impl Row for SweepRow<'_> {
             (sweep::METHOD, ok.map(|p| p.method.clone()).into()),
             (sweep::DT, ok.and_then(|p| p.dt).into()),
             (sweep::STEPS, ok.map(|p| p.steps as i64).into()),
-            (sweep::ERROR_ESTIMATE, ok.and_then(|p| p.error_estimate).into()),
+            (
+                sweep::ERROR_ESTIMATE,
+                ok.and_then(|p| p.error_estimate).into(),
+            ),
             (sweep::ENERGY_DRIFT, ok.and_then(|p| p.energy_drift).into()),
-            (sweep::FAILURE, self.point.result.as_ref().err().cloned().into()),
+            (
+                sweep::FAILURE,
+                self.point.result.as_ref().err().cloned().into(),
+            ),
             (sweep::SCENE_KEY, self.point.key.to_string().into()),
         ]);
         cells

@@ -36,10 +36,10 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::{Ends, Fields};
 use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
-use woodpile_points::layout::best_path;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, Columns};
 use woodpile_pipeline::Output;
+use woodpile_points::layout::best_path;
 
 use crate::schema::Fraction;
 
@@ -128,11 +128,11 @@ impl Optimize {
 
     pub(crate) fn run(
         &self,
-        stage: &str,
+        ctx: &Context<'_>,
         input: &polars::prelude::DataFrame,
         sweep: &Sweep,
-        results: &Path,
     ) -> Result<Output> {
+        let stage = ctx.name();
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let col = |name: &str| f64_column(input, name).map_err(|e| fail(e.to_string()));
         let target = col(self.column.column())?;
@@ -300,7 +300,7 @@ impl Optimize {
             .collect();
         // The best optimum as a scene file.
         let scene = sweep.scene_with(&best.values, Some(self.tolerance))?;
-        let path = best_path(results, stage);
+        let path = best_path(ctx.results, stage);
         let table = sweep
             .table_with(&best.values, Some(self.tolerance))
             .map_err(|e| fail(e.to_string()))?;
@@ -312,7 +312,7 @@ impl Optimize {
             self.tolerance,
             path.display()
         );
-        woodpile_points::atomic::write(&path, (header + &text).as_bytes())?;
+        ctx.write_file(&path, (header + &text).as_bytes())?;
 
         let grid_first = rows
             .first()
@@ -452,7 +452,7 @@ impl Kind for Optimize {
             .ok_or_else(|| {
                 PipelineError::stage(ctx.name(), format!("`{input}` does not read a sweep"))
             })?;
-        self.run(ctx.name(), &frame, sweep, ctx.results)
+        self.run(ctx, &frame, sweep)
     }
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

@@ -23,8 +23,6 @@
 //! Instead of a grid, `design = "stage"` (with `inputs = ["stage"]` and `field.sites`) maps
 //! the best design a `design` stage found, from its `results/<stage>.best.toml`.
 
-use std::path::Path;
-
 use rayon::prelude::*;
 use serde_json::json;
 use woodpile_scene::Scene;
@@ -120,8 +118,9 @@ impl SpaceTime {
     }
 
     /// Simulates the stage's scenes and keeps each one's field on the stage's sites.
-    pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
-        let (scenes, axes) = self.scenes(stage, results)?;
+    pub(crate) fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let stage = ctx.name();
+        let (scenes, axes) = self.scenes(ctx)?;
         // The accuracy asked for (a scene's tolerance, or its fixed step's) and the largest
         // error estimate `auto` reported, for the manifest.
         let tolerance = scenes.first().and_then(|(_, scene)| {
@@ -161,7 +160,8 @@ impl SpaceTime {
 
     /// The scenes to map, each with its axis values, and the axes: the grid's, or a design
     /// stage's best scene (whose field is bounded only now that it is known).
-    fn scenes(&self, stage: &str, results: &Path) -> Result<(Vec<Mapped>, &[Axis])> {
+    fn scenes(&self, ctx: &Context<'_>) -> Result<(Vec<Mapped>, &[Axis])> {
+        let stage = ctx.name();
         Ok(match &self.source {
             Source::Grid(sweep) => (
                 (0..sweep.count())
@@ -170,7 +170,7 @@ impl SpaceTime {
                 &sweep.axes,
             ),
             Source::Design(design) => {
-                let path = woodpile_points::layout::best_path(results, design);
+                let path = ctx.best_scene(design)?;
                 let scene = woodpile_scene::load(&path)
                     .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
                 if self.sites[0] < scene.first_site || self.sites[1] > scene.last_site {
@@ -278,6 +278,6 @@ impl Kind for SpaceTime {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx.name(), ctx.results)
+        self.run(ctx)
     }
 }

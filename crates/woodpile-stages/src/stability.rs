@@ -28,9 +28,9 @@
 // Comparisons are written `!(x > 0.0)` on purpose: a NaN must fail them.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 use serde_json::json;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
 use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
 
@@ -191,8 +191,14 @@ impl Stability {
                 // The step the driver takes: t_end tiled by equal steps no longer than requested.
                 let t_end = scene.scenario.t_end;
                 let dt = t_end / (t_end / requested - 1e-9).ceil().max(1.0);
-                let (status, error, failure) =
-                    classify(&scene.scenario, method, dt, *e_ref, self.tolerance, &simulated);
+                let (status, error, failure) = classify(
+                    &scene.scenario,
+                    method,
+                    dt,
+                    *e_ref,
+                    self.tolerance,
+                    &simulated,
+                );
                 Run {
                     method: method.name(),
                     method_index: m as i64,

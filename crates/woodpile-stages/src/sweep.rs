@@ -34,18 +34,17 @@ use serde_json::{json, Value};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 
-use woodpile_points::canonical::Key;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_pipeline::kind::{Context, Kind, PointGrid, PointsAt};
-use woodpile_points::rows::{SweepPoint, SweepShape};
-use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, Series};
 use woodpile_pipeline::table::rows_frame;
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
-
+use woodpile_points::canonical::Key;
+use woodpile_points::rows::{SweepPoint, SweepShape};
+use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, Series};
 
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]

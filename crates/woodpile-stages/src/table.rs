@@ -74,11 +74,12 @@ impl Table {
         Ok(frame)
     }
 
-    fn run(&self, stage: &str, input: &DataFrame, results: &Path) -> Result<Output> {
+    fn run(&self, ctx: &Context<'_>, input: &DataFrame) -> Result<Output> {
+        let stage = ctx.name();
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let frame = self.select(input).map_err(fail)?;
         let text = csv(&frame).map_err(fail)?;
-        woodpile_points::atomic::write(&csv_path(results, stage), text.as_bytes())?;
+        ctx.write_file(&csv_path(ctx.results, stage), text.as_bytes())?;
         let summary = json!({
             "rows": frame.height(),
             "columns": frame.get_column_names().iter().map(|c| c.to_string()).collect::<Vec<_>>(),
@@ -151,7 +152,7 @@ impl Kind for Table {
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         let input = ctx.input(&ctx.stage.inputs[0])?;
-        self.run(ctx.name(), &input, ctx.results)
+        self.run(ctx, &input)
     }
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

@@ -30,8 +30,6 @@
 //! "design_index"` and `series_label = "design"`).
 //! Points are cached and shared as a sweep's are.
 
-use std::path::Path;
-
 use polars::prelude::{Column, DataFrame};
 use serde_json::json;
 use woodpile_pipeline::error::{PipelineError, Result};
@@ -40,10 +38,10 @@ use woodpile_pipeline::grid::{parse_axes, Axis};
 use woodpile_pipeline::kind::{
     wrong_inputs, Context, Inputs, Kind, KindCheck, PointGrid, PointsAt,
 };
-use woodpile_points::{PointStats, Series};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
+use woodpile_points::{PointStats, Series};
 use woodpile_sim::integrate::MethodChoice;
 
 use crate::sweep::Sweep;
@@ -103,8 +101,9 @@ impl Vary {
     }
 
     /// The sweep of `design`'s best scene (in `results`), varied.
-    fn sweep_of(&self, stage: &str, design: &str, results: &Path) -> Result<Sweep> {
-        let path = woodpile_points::layout::best_path(results, design);
+    fn sweep_of(&self, ctx: &Context<'_>, design: &str) -> Result<Sweep> {
+        let stage = ctx.name();
+        let path = ctx.best_scene(design)?;
         let text = woodpile_scene::read_input(&path).map_err(|reason| {
             PipelineError::stage(stage, format!("{}: {reason}", path.display()))
         })?;
@@ -201,7 +200,7 @@ impl Kind for Vary {
         let mut stats = PointStats::default();
         let mut tolerance = None;
         for (index, design) in ctx.stage.inputs.iter().enumerate() {
-            let sweep = self.sweep_of(ctx.name(), design, ctx.results)?;
+            let sweep = self.sweep_of(ctx, design)?;
             let all: Vec<usize> = (0..sweep.count()).collect();
             let first = sweep.scene_at(0)?.scenario;
             let asked = first.method == MethodChoice::Auto || first.accuracy.tolerance_explicit;

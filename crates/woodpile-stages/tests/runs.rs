@@ -11,11 +11,11 @@ use common::{
     load_error, Counter, Project, BEST, REDUCE, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
 };
 use woodpile_pipeline::events::Events;
-use woodpile_points::layout::points_dir;
-use woodpile_points::PointStore;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, Pipeline, PipelineError};
+use woodpile_points::layout::points_dir;
+use woodpile_points::PointStore;
 use woodpile_stages::KINDS;
 
 #[test]

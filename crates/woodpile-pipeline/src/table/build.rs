@@ -3,8 +3,8 @@
 
 use polars::prelude::*;
 
-pub use woodpile_points::rows::{Cell, Row};
 use woodpile_points::rows::Column as Typed;
+pub use woodpile_points::rows::{Cell, Row};
 
 use crate::error::{PipelineError, Result};
 

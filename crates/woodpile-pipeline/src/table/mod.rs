@@ -6,9 +6,9 @@ use std::path::Path;
 
 use polars::prelude::*;
 
-use woodpile_points::atomic;
 use crate::error::{PipelineError, Result};
 use crate::manifest::{Manifest, METADATA_KEY};
+use woodpile_points::atomic;
 use woodpile_points::regular;
 
 mod build;

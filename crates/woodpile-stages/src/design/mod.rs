@@ -56,9 +56,9 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{Context, Kind, PointsAt};
+use woodpile_pipeline::Output;
 use woodpile_points::layout::best_path;
 use woodpile_points::{PointResult, PointStore};
-use woodpile_pipeline::Output;
 
 use crate::schema::Fraction;
 
@@ -198,13 +198,8 @@ impl Design {
 
     /// The stage: the searches, their refinement, the robustness study around the best design,
     /// then the best design inside the space verified and written as a scene file.
-    pub(crate) fn run(
-        &self,
-        stage: &str,
-        store: &PointStore,
-        results: &Path,
-        events: &dyn Events,
-    ) -> Result<Output> {
+    pub(crate) fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let (stage, store, events) = (ctx.name(), ctx.store, ctx.events);
         let robust: usize = self
             .robustness
             .as_ref()
@@ -230,7 +225,7 @@ impl Design {
             return Err(PipelineError::stage(stage, "every design failed"));
         }
         rows.extend(self.robustness_around(at, &best)?);
-        let (best, verified, best_file) = self.verify_and_write(at, results, &mut rows, best)?;
+        let (best, verified, best_file) = self.verify_and_write(ctx, at, &mut rows, best)?;
         let simulated = rows.iter().filter(|r| r.simulated).count();
         Ok(Output::table(
             self.frame(&rows)?,
@@ -336,8 +331,8 @@ impl Design {
     /// verification's row (also added to `rows`) and the file.
     fn verify_and_write(
         &self,
+        ctx: &Context<'_>,
         at: PointsAt<'_>,
-        results: &Path,
         rows: &mut Vec<Evaluated>,
         searched_best: Evaluated,
     ) -> Result<(Evaluated, Evaluated, std::path::PathBuf)> {
@@ -359,7 +354,7 @@ impl Design {
             .remove(0);
         rows.push(verified.clone());
 
-        let best_file = best_path(results, stage);
+        let best_file = best_path(ctx.results, stage);
         let text = toml::to_string(&self.table(&verified.layout, Some(self.verify_tolerance)))
             .map_err(|e| PipelineError::stage(stage, e.to_string()))?;
         let header = format!(
@@ -369,7 +364,7 @@ impl Design {
             self.verify_tolerance,
             best_file.display()
         );
-        woodpile_points::atomic::write(&best_file, (header + &text).as_bytes())?;
+        ctx.write_file(&best_file, (header + &text).as_bytes())?;
         Ok((best, verified, best_file))
     }
 
@@ -493,7 +488,7 @@ impl Kind for Design {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx.name(), ctx.store, ctx.results, ctx.events)
+        self.run(ctx)
     }
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

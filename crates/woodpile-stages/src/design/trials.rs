@@ -3,8 +3,8 @@
 use polars::prelude::DataFrame;
 
 use woodpile_pipeline::error::Result;
-use woodpile_points::PointData;
 use woodpile_pipeline::table::{rows_frame, Cell, Row};
+use woodpile_points::PointData;
 
 use super::{Design, Evaluated, Search};
 

@@ -243,10 +243,10 @@ impl Render {
     /// plotted numbers, one row per drawn point or cell.
     pub(crate) fn run(
         &self,
-        stage: &str,
+        ctx: &Context<'_>,
         inputs: &HashMap<String, (DataFrame, Manifest)>,
-        figures: &Path,
     ) -> Result<Output> {
+        let stage = ctx.name();
         let fail = |e: PipelineError| PipelineError::stage(stage, e.to_string());
         let quote = |text: &str| quoted(text, inputs).map_err(|r| PipelineError::stage(stage, r));
         let mut panels = Vec::new();
@@ -288,11 +288,11 @@ impl Render {
             shared_colour_bar: self.same_colour_scale,
             panels,
         };
-        let [png, svg] = Render::files(figures, stage);
+        let [png, svg] = Render::files(ctx.figures, stage);
         let drawing = |e: woodpile_plot::PlotError| PipelineError::stage(stage, e.to_string());
         let drawn = figure.draw().map_err(drawing)?;
-        woodpile_points::atomic::write(&png, &drawn.png)?;
-        woodpile_points::atomic::write(&svg, drawn.svg.as_bytes())?;
+        ctx.write_file(&png, &drawn.png)?;
+        ctx.write_file(&svg, drawn.svg.as_bytes())?;
         Ok(Output::table(
             frame,
             json!({
@@ -351,7 +351,7 @@ impl Kind for Render {
             .iter()
             .map(|name| Ok((name.clone(), ctx.input_with_manifest(name)?)))
             .collect::<Result<_>>()?;
-        self.run(ctx.name(), &inputs, ctx.figures)
+        self.run(ctx, &inputs)
     }
 
     fn files(&self, stage: &str, _: &Path, figures: &Path) -> Vec<PathBuf> {

@@ -2,13 +2,12 @@
 //! column, a manifest entry, or a scan along a column for where the paper's number is met.
 
 use std::collections::HashMap;
-use std::path::Path;
 
 use polars::prelude::DataFrame;
 
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_points::layout::output_path;
-use woodpile_pipeline::table::{self, f64_column, matching_rows, str_column};
+use woodpile_pipeline::kind::Context;
+use woodpile_pipeline::table::{f64_column, matching_rows, str_column};
 
 use super::number::fmt;
 use super::{Paper, Read, Source};
@@ -49,14 +48,14 @@ pub(super) struct Scanned {
 
 /// Reads stage outputs once each.
 pub(super) struct Reader<'a> {
-    pub(super) results: &'a Path,
+    pub(super) ctx: &'a Context<'a>,
     pub(super) frames: HashMap<String, DataFrame>,
 }
 
 impl Reader<'_> {
     fn frame(&mut self, stage: &str) -> Result<&DataFrame> {
         if !self.frames.contains_key(stage) {
-            let frame = table::read(&output_path(self.results, stage))?;
+            let frame = self.ctx.input(stage)?;
             self.frames.insert(stage.to_string(), frame);
         }
         Ok(&self.frames[stage])
@@ -66,7 +65,9 @@ impl Reader<'_> {
         let fail = |reason: String| PipelineError::stage(&source.stage, reason);
         let column = match &source.read {
             Read::Manifest(path) => {
-                let manifest = table::read_manifest(&output_path(self.results, &source.stage))?
+                let manifest = self
+                    .ctx
+                    .input_manifest(&source.stage)?
                     .ok_or_else(|| fail("no manifest".into()))?;
                 let value = manifest
                     .lookup(path)

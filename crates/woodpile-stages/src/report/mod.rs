@@ -41,10 +41,10 @@ use serde_json::json;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
-use woodpile_points::layout::output_path;
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{self, rows_frame, Cell, Row};
 use woodpile_pipeline::Output;
+use woodpile_points::layout::output_path;
 
 pub use woodpile_pipeline::table::Match;
 
@@ -201,29 +201,9 @@ impl Report {
     /// Refuses to replace a file at `path` that this stage did not write: a report never
     /// overwrites a hand-written file. Its own are those its previous output's manifest names,
     /// and those that carry its generated mark near the top (what a run killed between the
-    /// Markdown and the table, or a damaged table, leaves: never a stuck stage).
+    /// Markdown and the table, or a damaged table, leaves: never a stuck stage). That the path
+    /// stays inside the project on disk is `Context::write_file`'s check.
     fn check_owned(&self, stage: &str, path: &Path, results: &Path) -> Result<()> {
-        // Inside the tree means inside it on disk too: no folder on the way may be a
-        // symbolic link (`docs -> /elsewhere`).
-        let root = results.parent().unwrap_or_else(|| Path::new(""));
-        let mut folder = root.to_path_buf();
-        for part in Path::new(&self.markdown)
-            .parent()
-            .into_iter()
-            .flat_map(Path::components)
-        {
-            folder.push(part);
-            if std::fs::symlink_metadata(&folder).is_ok_and(|m| m.file_type().is_symlink()) {
-                return Err(PipelineError::stage(
-                    stage,
-                    format!(
-                        "`markdown = \"{}\"`: {} is a symbolic link; a report writes only inside the project",
-                        self.markdown,
-                        folder.display()
-                    ),
-                ));
-            }
-        }
         if std::fs::symlink_metadata(path).is_err() {
             return Ok(());
         }
@@ -261,9 +241,10 @@ impl Report {
         woodpile_points::layout::markdown_path(results, &self.markdown)
     }
 
-    pub(crate) fn run(&self, stage: &str, results: &Path) -> Result<Output> {
+    pub(crate) fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+        let (stage, results) = (ctx.name(), ctx.results);
         let mut reader = Reader {
-            results,
+            ctx,
             frames: HashMap::new(),
         };
         let mut evaluated = Vec::with_capacity(self.quotes.len());
@@ -292,7 +273,7 @@ impl Report {
         let text = markdown(stage, self, &evaluated);
         let path = self.markdown_path(results);
         self.check_owned(stage, &path, results)?;
-        woodpile_points::atomic::write(&path, text.as_bytes())?;
+        ctx.write_file(&path, text.as_bytes())?;
         let reproduced = evaluated
             .iter()
             .zip(&self.quotes)
@@ -395,7 +376,7 @@ impl Kind for Report {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx.name(), ctx.results)
+        self.run(ctx)
     }
 
     fn files(&self, _: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

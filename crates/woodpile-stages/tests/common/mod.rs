@@ -8,11 +8,11 @@ use std::sync::Mutex;
 use woodpile_stages::KINDS;
 
 use woodpile_pipeline::events::{Events, Silent};
-use woodpile_points::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::Pipeline;
+use woodpile_points::layout::output_path;
 
 pub struct Project {
     dir: tempfile::TempDir,
@@ -87,7 +87,9 @@ impl Project {
         };
         let steps = run(&self.load(), &options, &events).unwrap();
         let simulated = steps.iter().map(|s| s.simulated).sum();
-        events.simulated.store(simulated, std::sync::atomic::Ordering::SeqCst);
+        events
+            .simulated
+            .store(simulated, std::sync::atomic::Ordering::SeqCst);
         events
     }
 }

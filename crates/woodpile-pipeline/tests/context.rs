@@ -1,0 +1,123 @@
+//! The engine on its own, with a tiny kind of the test's (`note`: a one-row table and a text
+//! file): `Context` is the one door to the tree, a stage's other files are sealed in its
+//! manifest, and a run reports what it did.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use polars::prelude::{Column, DataFrame};
+use woodpile_pipeline::events::Events;
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::kind::{Context, Kind, Registry};
+use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::status::{state, State};
+use woodpile_pipeline::{Output, Pipeline, PipelineError};
+
+/// `kind = "note"`: writes `text` to `<results>/<folder>/<stage>.txt` (declared), or, with
+/// `stray = "name"`, to `<results>/name`, which it does not declare.
+#[derive(Debug)]
+struct Note {
+    text: String,
+    folder: String,
+    stray: Option<String>,
+}
+
+impl Note {
+    fn path(&self, results: &Path, stage: &str) -> PathBuf {
+        results.join(&self.folder).join(format!("{stage}.txt"))
+    }
+}
+
+impl Kind for Note {
+    fn run(&self, ctx: &Context<'_>) -> woodpile_pipeline::Result<Output> {
+        let path = match &self.stray {
+            None => self.path(ctx.results, ctx.name()),
+            Some(name) => ctx.results.join(name),
+        };
+        ctx.write_file(&path, self.text.as_bytes())?;
+        let frame = DataFrame::new_infer_height(vec![Column::new("n".into(), [1_i64])]).unwrap();
+        Ok(Output::table(frame, serde_json::json!({})))
+    }
+
+    fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
+        vec![self.path(results, stage)]
+    }
+}
+
+static KINDS: &Registry = &[("note", |f: &mut Fields<'_>, _| {
+    Ok(Arc::new(Note {
+        text: f.required("text")?,
+        folder: f.optional("folder")?.unwrap_or_default(),
+        stray: f.optional("stray")?,
+    }))
+})];
+
+struct Silent;
+impl Events for Silent {}
+
+/// A project with one `note` stage whose file holds `body` (TOML keys of the stage).
+fn project(body: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("pipeline")).unwrap();
+    let stage = format!("kind = \"note\"\n{body}\n");
+    std::fs::write(dir.path().join("pipeline/note.toml"), stage).unwrap();
+    dir
+}
+
+fn run_all(dir: &Path) -> woodpile_pipeline::Result<Pipeline> {
+    let pipeline = Pipeline::load(&dir.join("pipeline"), KINDS)?;
+    let options = RunOptions {
+        targets: Vec::new(),
+        force: false,
+        dry_run: false,
+        results: dir.join("results"),
+        figures: dir.join("figures"),
+    };
+    run(&pipeline, &options, &Silent)?;
+    Ok(pipeline)
+}
+
+fn state_of(dir: &Path, pipeline: &Pipeline) -> State {
+    let stage = pipeline.stage("note").unwrap();
+    state(pipeline, &dir.join("results"), &dir.join("figures"), stage)
+}
+
+#[test]
+fn a_declared_file_is_written_and_sealed_in_the_manifest() {
+    let dir = project("text = \"hello\"\nfolder = \"notes\"");
+    let pipeline = run_all(dir.path()).unwrap();
+    let file = dir.path().join("results/notes/note.txt");
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "hello");
+    assert_eq!(state_of(dir.path(), &pipeline), State::Fresh);
+    // The file is part of the stage: changed by hand, the stage is no longer fresh.
+    std::fs::write(&file, "edited").unwrap();
+    let edited = state_of(dir.path(), &pipeline);
+    assert_ne!(edited, State::Fresh, "{edited:?}");
+    run_all(dir.path()).unwrap();
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "hello");
+}
+
+#[test]
+fn a_file_the_kind_does_not_declare_is_refused() {
+    let dir = project("text = \"hello\"\nstray = \"stray.txt\"");
+    let err = run_all(dir.path()).unwrap_err();
+    assert!(matches!(err, PipelineError::Failed { .. }), "{err}");
+    assert!(
+        err.to_string().contains("which its kind does not declare"),
+        "{err}"
+    );
+    assert!(!dir.path().join("results/stray.txt").exists());
+    assert!(!dir.path().join("results/note.parquet").exists());
+}
+
+#[test]
+fn a_folder_on_the_way_that_is_a_link_is_refused() {
+    let dir = project("text = \"hello\"\nfolder = \"notes\"");
+    let elsewhere = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("results")).unwrap();
+    std::os::unix::fs::symlink(elsewhere.path(), dir.path().join("results/notes")).unwrap();
+    let err = run_all(dir.path()).unwrap_err();
+    assert!(err.to_string().contains("is a symbolic link"), "{err}");
+    assert_eq!(std::fs::read_dir(elsewhere.path()).unwrap().count(), 0);
+}
