@@ -139,37 +139,13 @@ impl Stability {
             .map_err(|e| PipelineError::scene(&self.file, "scene", e, &format!(" (at {value})")))
     }
 
+    /// The stage: each value's reference, every (value, method, step) run classified, then
+    /// the summary and the table.
     pub(crate) fn run(&self, stage: &str) -> Result<Output> {
-        // One reference per value: `auto` a hundred times tighter than the tolerance.
-        let simulated = AtomicUsize::new(0);
-        let references: Vec<(woodpile_scene::Scene, f64, f64)> = self
+        let references: Vec<Reference> = self
             .values
             .par_iter()
-            .map(|&v| {
-                let scene = self.scene_at(v)?;
-                let mut reference = scene.scenario.clone();
-                reference.method = MethodChoice::Auto;
-                reference.accuracy = Accuracy {
-                    tolerance: self.tolerance / 100.0,
-                    tolerance_explicit: true,
-                    dt: None,
-                };
-                let e_ref = simulate(&reference, &mut ())
-                    .map_err(|e| PipelineError::stage(stage, format!("reference at {v}: {e}")))?
-                    .fractions
-                    .trapped;
-                let auto_plan = Plan::choose(
-                    &scene.scenario.model,
-                    MethodChoice::Auto,
-                    Accuracy {
-                        tolerance: self.tolerance,
-                        ..reference.accuracy
-                    },
-                )
-                .map_err(|e| PipelineError::stage(stage, format!("auto at {v}: {e}")))?;
-                let auto_dt = auto_first_step(&scene.scenario, &auto_plan);
-                Ok((scene, e_ref, auto_dt))
-            })
+            .map(|&v| self.reference(stage, v))
             .collect::<Result<_>>()?;
         let jobs: Vec<(usize, usize, usize)> = (0..self.values.len())
             .flat_map(|v| {
@@ -177,64 +153,111 @@ impl Stability {
                     .flat_map(move |m| (0..self.steps.len()).map(move |s| (v, m, s)))
             })
             .collect();
+        let simulated = AtomicUsize::new(0);
         let runs: Vec<Run> = jobs
             .par_iter()
-            .map(|&(v, m, s)| {
-                let (scene, e_ref, auto_dt) = &references[v];
-                let method = self.methods[m];
-                let omega = scene.scenario.model.max_linear_omega();
-                let requested = if self.steps_are_dt_omega {
-                    self.steps[s] / omega
-                } else {
-                    self.steps[s]
-                };
-                // The step the driver takes: t_end tiled by equal steps no longer than requested.
-                let t_end = scene.scenario.t_end;
-                let dt = t_end / (t_end / requested - 1e-9).ceil().max(1.0);
-                let (status, error, failure) = classify(
-                    &scene.scenario,
-                    method,
-                    dt,
-                    *e_ref,
-                    self.tolerance,
-                    &simulated,
-                );
-                Run {
-                    method: method.name(),
-                    method_index: m as i64,
-                    value: self.values[v],
-                    dt,
-                    step: self.steps[s],
-                    dt_omega: (omega > 0.0).then_some(dt * omega),
-                    bound: (omega > 0.0).then_some(method.stability_limit() / omega),
-                    auto_dt: *auto_dt,
-                    // The bound and auto's step in the map's own x unit, for the overlay lines.
-                    bound_step: (omega > 0.0).then(|| {
-                        let bound_dt = method.stability_limit() / omega;
-                        if self.steps_are_dt_omega {
-                            bound_dt * omega
-                        } else {
-                            bound_dt
-                        }
-                    }),
-                    auto_step: if self.steps_are_dt_omega {
-                        *auto_dt * omega
-                    } else {
-                        *auto_dt
-                    },
-                    status,
-                    error,
-                    failure,
-                }
-            })
+            .map(|&(v, m, s)| self.classified(&references[v], (v, m, s), &simulated))
             .collect();
+        let summary = self.summary(&runs);
+        // Each value's reference, and every run that got past choosing its plan.
+        let simulated = references.len() + simulated.into_inner();
+        Ok(Output::table(self.table(&runs)?, summary).with_simulated(simulated))
+    }
+
+    /// The scene at `value`, E_tr of `auto` a hundred times tighter than the tolerance, and
+    /// the first step `auto` takes at the tolerance.
+    fn reference(&self, stage: &str, value: f64) -> Result<Reference> {
+        let scene = self.scene_at(value)?;
+        let mut reference = scene.scenario.clone();
+        reference.method = MethodChoice::Auto;
+        reference.accuracy = Accuracy {
+            tolerance: self.tolerance / 100.0,
+            tolerance_explicit: true,
+            dt: None,
+        };
+        let e_ref = simulate(&reference, &mut ())
+            .map_err(|e| PipelineError::stage(stage, format!("reference at {value}: {e}")))?
+            .fractions
+            .trapped;
+        let auto_plan = Plan::choose(
+            &scene.scenario.model,
+            MethodChoice::Auto,
+            Accuracy {
+                tolerance: self.tolerance,
+                ..reference.accuracy
+            },
+        )
+        .map_err(|e| PipelineError::stage(stage, format!("auto at {value}: {e}")))?;
+        let auto_dt = auto_first_step(&scene.scenario, &auto_plan);
+        Ok(Reference {
+            scene,
+            e_ref,
+            auto_dt,
+        })
+    }
+
+    /// Method `m` at step `s` on value `v` (whose reference is `reference`), classified.
+    fn classified(
+        &self,
+        reference: &Reference,
+        (v, m, s): (usize, usize, usize),
+        simulated: &AtomicUsize,
+    ) -> Run {
+        let Reference {
+            scene,
+            e_ref,
+            auto_dt,
+        } = reference;
+        let method = self.methods[m];
+        let omega = scene.scenario.model.max_linear_omega();
+        // A step in the map's own x unit (dt or dt·ω) as a dt, and back.
+        let to_dt = |step: f64| match self.steps_are_dt_omega {
+            true => step / omega,
+            false => step,
+        };
+        let to_step = |dt: f64| match self.steps_are_dt_omega {
+            true => dt * omega,
+            false => dt,
+        };
+        // The step the driver takes: t_end tiled by equal steps no longer than requested.
+        let t_end = scene.scenario.t_end;
+        let dt = t_end / (t_end / to_dt(self.steps[s]) - 1e-9).ceil().max(1.0);
+        let (status, error, failure) = classify(
+            &scene.scenario,
+            method,
+            dt,
+            *e_ref,
+            self.tolerance,
+            simulated,
+        );
+        let bound = (omega > 0.0).then_some(method.stability_limit() / omega);
+        Run {
+            method: method.name(),
+            method_index: m as i64,
+            value: self.values[v],
+            dt,
+            step: self.steps[s],
+            dt_omega: (omega > 0.0).then_some(dt * omega),
+            bound,
+            auto_dt: *auto_dt,
+            // The bound and auto's step in the map's own x unit, for the overlay lines.
+            bound_step: bound.map(to_step),
+            auto_step: to_step(*auto_dt),
+            status,
+            error,
+            failure,
+        }
+    }
+
+    /// The manifest's summary of `runs`.
+    fn summary(&self, runs: &[Run]) -> serde_json::Value {
         let counts = |k: i64| runs.iter().filter(|r| r.status == k).count();
         // `auto` runs its method at `auto_dt` or shorter: none of those steps may be unstable.
         let auto_unstable = runs
             .iter()
             .filter(|r| r.method == AUTO_METHOD.name() && r.status == 2 && r.dt <= r.auto_dt)
             .count();
-        let summary = json!({
+        json!({
             "runs": runs.len(),
             "meet_tolerance": counts(0),
             "miss_tolerance": counts(1),
@@ -242,7 +265,11 @@ impl Stability {
             "unstable_at_or_below_auto_step": auto_unstable,
             "tolerance": self.tolerance,
             "reference": {"method": "auto", "tolerance": self.tolerance / 100.0},
-        });
+        })
+    }
+
+    /// The stage's table: one row per run.
+    fn table(&self, runs: &[Run]) -> Result<polars::prelude::DataFrame> {
         let name = match self.vary {
             Vary::Eps => "eps",
             Vary::P => "p",
@@ -281,10 +308,16 @@ impl Stability {
         .i64("status", runs.iter().map(|r| Some(r.status)).collect())
         .f64("error", runs.iter().map(|r| r.error).collect())
         .str("failure", runs.iter().map(|r| r.failure.clone()).collect());
-        // Each value's reference, and every run that got past choosing its plan.
-        let simulated = references.len() + simulated.into_inner();
-        Ok(Output::table(c.into_frame()?, summary).with_simulated(simulated))
+        c.into_frame()
     }
+}
+
+/// One value's reference: its scene, E_tr at a hundredth of the tolerance, and `auto`'s first
+/// step.
+struct Reference {
+    scene: woodpile_scene::Scene,
+    e_ref: f64,
+    auto_dt: f64,
 }
 
 /// Runs `method` at step `dt` with no drift guard and classifies it: 2 if the state becomes
