@@ -211,9 +211,48 @@ pub fn merge(
     let (stage, sweep) = sweep_of(pipeline, name)?;
     let key = pipeline.key(name).to_string();
     let dir = parts_dir(results, name);
-    let mut current: Vec<(Shard, PathBuf)> = Vec::new();
+    let (mut current, orphans) = parts_of(&dir, &key);
+    let orphan_note = if orphans > 0 {
+        format!(" ({orphans} part(s) of an older definition of the stage are ignored)")
+    } else {
+        String::new()
+    };
+    let fail = |reason: String| PipelineError::stage(name, reason + &orphan_note);
+    if current.is_empty() {
+        return Err(fail(format!(
+            "no parts for the current definition (key {}) in {}: run `woodpile run {name} --shard I/N` for every I first",
+            &key[..12],
+            dir.display()
+        )));
+    }
+    current.sort_by_key(|(s, _)| s.index);
+    check_complete(&current, sweep.count(), name).map_err(fail)?;
+    let mut frame: Option<DataFrame> = None;
+    let mut stats = PointStats::default();
+    for (shard, path) in &current {
+        let (part, part_stats) = read_part(path, shard, &key, sweep.count())?.map_err(fail)?;
+        stats = stats.merge(part_stats);
+        frame = Some(match frame {
+            None => part,
+            Some(f) => f.vstack(&part).map_err(|e| PipelineError::io(path, e))?,
+        });
+    }
+    let Some(frame) = frame else {
+        return Err(fail("no parts".into()));
+    };
+    let frame = in_point_order(frame, sweep.count())
+        .map_err(|reason| PipelineError::stage(name, reason))?;
+    let manifest = manifest_for(pipeline, stage, sweep.summary(&stats)?);
+    table::write(&output_path(results, name), frame, &manifest)?;
+    Ok(current.len())
+}
+
+/// The parts in `dir` made for the definition with key `key`, and how many were made for
+/// another (older) one.
+fn parts_of(dir: &Path, key: &str) -> (Vec<(Shard, PathBuf)>, usize) {
+    let mut current = Vec::new();
     let mut orphans = 0;
-    if let Ok(entries) = std::fs::read_dir(&dir) {
+    if let Ok(entries) = std::fs::read_dir(dir) {
         for entry in entries.flatten() {
             let file = entry.file_name().to_string_lossy().into_owned();
             match parse_part_name(&file) {
@@ -223,82 +262,71 @@ pub fn merge(
             }
         }
     }
-    let orphan_note = if orphans > 0 {
-        format!(" ({orphans} part(s) of an older definition of the stage are ignored)")
-    } else {
-        String::new()
-    };
-    let fail = |reason: String| Err(PipelineError::stage(name, reason + &orphan_note));
-    if current.is_empty() {
-        return fail(format!(
-            "no parts for the current definition (key {}) in {}: run `woodpile run {name} --shard I/N` for every I first",
-            &key[..12],
-            dir.display()
-        ));
-    }
+    (current, orphans)
+}
+
+/// Whether `current` (sorted by index) is one complete set of shards of a sweep of `points`
+/// points, or why not.
+fn check_complete(
+    current: &[(Shard, PathBuf)],
+    points: usize,
+    name: &str,
+) -> std::result::Result<(), String> {
     let mut counts: Vec<usize> = current.iter().map(|(s, _)| s.count).collect();
     counts.sort_unstable();
     counts.dedup();
     if counts.len() > 1 {
-        return fail(format!(
+        return Err(format!(
             "parts were made with different shard counts {counts:?}: re-run them with one N"
         ));
     }
     let n = counts[0];
-    if n > sweep.count() {
-        return fail(format!(
-            "parts were made with {n} shards, more than the sweep's {} points: re-run them with at most one shard per point",
-            sweep.count()
+    if n > points {
+        return Err(format!(
+            "parts were made with {n} shards, more than the sweep's {points} points: re-run them with at most one shard per point"
         ));
     }
-    current.sort_by_key(|(s, _)| s.index);
     let present: std::collections::HashSet<usize> = current.iter().map(|(s, _)| s.index).collect();
     let missing = (0..n).filter(|i| !present.contains(i));
     let examples: Vec<String> = missing.clone().take(5).map(|i| i.to_string()).collect();
-    if !examples.is_empty() {
-        let count = missing.count();
-        let more = if count > examples.len() { ", ..." } else { "" };
-        return fail(format!(
-            "incomplete: {count} of {n} shard(s) missing ({}{more}; run `woodpile run {name} --shard I/{n}` for each)",
-            examples.join(", ")
-        ));
+    if examples.is_empty() {
+        return Ok(());
     }
-    let mut frame: Option<DataFrame> = None;
-    let mut stats = PointStats::default();
-    for (shard, path) in &current {
-        let manifest: Manifest = table::read_manifest(path)?
-            .ok_or_else(|| PipelineError::io(path, "part vanished while merging"))?;
-        if manifest.key != key {
-            return fail(format!(
-                "{} was computed for another definition",
-                path.display()
-            ));
-        }
-        let part_stats: PointStats = serde_json::from_value(manifest.summary["stats"].clone())
-            .map_err(|e| PipelineError::io(path, format!("bad shard statistics: {e}")))?;
-        if part_stats.points != shard.points(sweep.count()).len() {
-            return fail(format!(
-                "{} holds {} points, shard {shard} has {}",
-                path.display(),
-                part_stats.points,
-                shard.points(sweep.count()).len()
-            ));
-        }
-        stats = stats.merge(part_stats);
-        let part = table::read(path)?;
-        frame = Some(match frame {
-            None => part,
-            Some(f) => f.vstack(&part).map_err(|e| PipelineError::io(path, e))?,
-        });
+    let count = missing.count();
+    let more = if count > examples.len() { ", ..." } else { "" };
+    Err(format!(
+        "incomplete: {count} of {n} shard(s) missing ({}{more}; run `woodpile run {name} --shard I/{n}` for each)",
+        examples.join(", ")
+    ))
+}
+
+/// The table and statistics of the part at `path`, checked against the definition's key and
+/// its shard's point count (the inner error: why it does not belong).
+fn read_part(
+    path: &Path,
+    shard: &Shard,
+    key: &str,
+    points: usize,
+) -> Result<std::result::Result<(DataFrame, PointStats), String>> {
+    let manifest: Manifest = table::read_manifest(path)?
+        .ok_or_else(|| PipelineError::io(path, "part vanished while merging"))?;
+    if manifest.key != key {
+        return Ok(Err(format!(
+            "{} was computed for another definition",
+            path.display()
+        )));
     }
-    let Some(frame) = frame else {
-        return fail("no parts".into());
-    };
-    let frame = in_point_order(frame, sweep.count())
-        .map_err(|reason| PipelineError::stage(name, reason))?;
-    let manifest = manifest_for(pipeline, stage, sweep.summary(&stats)?);
-    table::write(&output_path(results, name), frame, &manifest)?;
-    Ok(current.len())
+    let part_stats: PointStats = serde_json::from_value(manifest.summary["stats"].clone())
+        .map_err(|e| PipelineError::io(path, format!("bad shard statistics: {e}")))?;
+    let expected = shard.points(points).len();
+    if part_stats.points != expected {
+        return Ok(Err(format!(
+            "{} holds {} points, shard {shard} has {expected}",
+            path.display(),
+            part_stats.points,
+        )));
+    }
+    Ok(Ok((table::read(path)?, part_stats)))
 }
 
 /// Rows reordered by point (stable, so each point's samples keep their time order); every
