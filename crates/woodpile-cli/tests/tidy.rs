@@ -198,7 +198,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-bench", "main.rs:main", 117),
     ("woodpile-stages", "render/draw.rs:draw", 101),
     ("woodpile-stages", "report/markdown.rs:markdown", 99),
-    ("woodpile-scene", "resolve/defects.rs:physical", 96),
     ("woodpile-plot", "draw.rs:figure", 93),
 ];
 

@@ -123,48 +123,71 @@ fn physical(
     si: &Si,
     site_paper: i64,
 ) -> Result<(f64, f64, FoundSi), Invalid> {
-    let sc = si.scales;
     reject_present(
         key,
         &[("eps", d.eps.is_some()), ("kappa", d.kappa.is_some())],
         "is derived in a [physical] scene: give resonator_mass (kg) and stiffness (N/m^p), or rod",
     )?;
-    let Some(rod) = &d.rod else {
-        if d.resonator_share.is_some() {
-            return Err(invalid(key("resonator_share"), "needs rod = { length }"));
-        }
-        let m = positive(
-            &key("resonator_mass"),
-            d.resonator_mass.ok_or_else(|| {
-                invalid(key("resonator_mass"), "is required in a [physical] scene")
-            })?,
-        )?;
-        let k = non_negative(
-            &key("stiffness"),
-            d.stiffness
-                .ok_or_else(|| invalid(key("stiffness"), "is required in a [physical] scene"))?,
-        )?;
-        let host = positive(&key("mass"), d.mass.unwrap_or(sc.mass_kg))?;
-        let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, p));
-        let host_mass_ratio = sc.mass_ratio(host);
-        let derived = DerivedDefect {
-            site: site_paper,
-            host_mass_ratio,
-            eps,
-            kappa,
-            ..DerivedDefect::default()
-        };
-        return Ok((
-            eps,
-            kappa,
-            FoundSi {
-                host_mass_ratio,
-                host_mass_kg: None,
-                contact_ratio: None,
-                derived,
-            },
-        ));
+    match &d.rod {
+        None => physical_masses(key, d, p, si, site_paper),
+        Some(rod) => physical_rod(key, d, rod, p, si, site_paper),
+    }
+}
+
+/// A defect of a [physical] scene given by its resonator's mass and stiffness.
+fn physical_masses(
+    key: &dyn Fn(&str) -> String,
+    d: &raw::Defect,
+    p: u32,
+    si: &Si,
+    site_paper: i64,
+) -> Result<(f64, f64, FoundSi), Invalid> {
+    let sc = si.scales;
+    if d.resonator_share.is_some() {
+        return Err(invalid(key("resonator_share"), "needs rod = { length }"));
+    }
+    let m = positive(
+        &key("resonator_mass"),
+        d.resonator_mass
+            .ok_or_else(|| invalid(key("resonator_mass"), "is required in a [physical] scene"))?,
+    )?;
+    let k = non_negative(
+        &key("stiffness"),
+        d.stiffness
+            .ok_or_else(|| invalid(key("stiffness"), "is required in a [physical] scene"))?,
+    )?;
+    let host = positive(&key("mass"), d.mass.unwrap_or(sc.mass_kg))?;
+    let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, p));
+    let host_mass_ratio = sc.mass_ratio(host);
+    let derived = DerivedDefect {
+        site: site_paper,
+        host_mass_ratio,
+        eps,
+        kappa,
+        ..DerivedDefect::default()
     };
+    Ok((
+        eps,
+        kappa,
+        FoundSi {
+            host_mass_ratio,
+            host_mass_kg: None,
+            contact_ratio: None,
+            derived,
+        },
+    ))
+}
+
+/// A defect of a [physical] scene whose resonator is its rod's bending mode.
+fn physical_rod(
+    key: &dyn Fn(&str) -> String,
+    d: &raw::Defect,
+    rod: &raw::DefectRod,
+    p: u32,
+    si: &Si,
+    site_paper: i64,
+) -> Result<(f64, f64, FoundSi), Invalid> {
+    let sc = si.scales;
     reject_present(
         key,
         &[
