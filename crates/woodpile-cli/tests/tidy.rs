@@ -194,7 +194,6 @@ const MAX_FUNCTION_LINES: usize = 80;
 const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-plot", "draw.rs:lines_panel", 137),
     ("woodpile-plot", "heat.rs:panel", 130),
-    ("woodpile-stages", "render/spec.rs:parse_panel", 112),
     ("woodpile-bench", "main.rs:main", 117),
     ("woodpile-stages", "render/draw.rs:draw", 101),
     ("woodpile-stages", "report/markdown.rs:markdown", 99),

@@ -129,84 +129,13 @@ pub(super) fn parse_panel(
 ) -> Result<PanelSpec> {
     let filter = f.equality_filter("where")?;
     let panel_label = f.optional::<String>("panel_label")?;
-    let view = View {
-        x: range_key(f, "x_range")?,
-        y: range_key(f, "y_range")?,
-        x_scale: scale_key(f, "x_scale")?,
-        y_scale: scale_key(f, "y_scale")?,
-    };
-    for (key, scale, range) in [
-        ("x_range", view.x_scale, view.x),
-        ("y_range", view.y_scale, view.y),
-    ] {
-        if scale == Scale::Log && range.is_some_and(|(lo, _)| lo <= 0.0) {
-            return Err(f.error(key, "a log axis starts above zero"));
-        }
-    }
-    let panel_title: Option<String>;
+    let view = parse_view(f)?;
     let marks = parse_marks(f)?;
     let lines = f.optional::<toml::Table>("lines")?;
     let heat = f.optional::<toml::Table>("heatmap")?;
-    let plot = match (lines, heat) {
-        (Some(t), None) => {
-            let mut f = f.nested("lines", t);
-            panel_title = f.optional::<String>("panel_title")?;
-            let styles = parse_series_styles(&mut f)?;
-            let (x, panels, x_label, y_label) = shared_axes(&mut f)?;
-            let plot = Plot::Lines {
-                styles,
-                x,
-                y: f.required("y")?,
-                panels,
-                series: f.optional("series")?,
-                series_label: f.optional("series_label")?,
-                x_label,
-                y_label,
-                mark_halving: flag(&mut f, "mark_halving")?,
-            };
-            check_series(&plot, &f)?;
-            f.finish()?;
-            plot
-        }
-        (None, Some(t)) => {
-            let mut f = f.nested("heatmap", t);
-            panel_title = f.optional::<String>("panel_title")?;
-            let mark_max = flag(&mut f, "mark_max")?;
-            let overlays = parse_overlays(&mut f)?;
-            let categories = f.optional::<Vec<String>>("categories")?;
-            let colours = match (f.optional::<String>("colours")?.as_deref(), categories) {
-                (None | Some("sequential"), None) => Colours::Sequential,
-                (Some("diverging"), None) => Colours::Diverging,
-                (None, Some(names)) if !names.is_empty() => Colours::Categories(names),
-                (None, Some(_)) => return Err(f.error("categories", "name at least one")),
-                (Some(_), Some(_)) => {
-                    return Err(f.error("colours", "give `colours` or `categories`, not both"))
-                }
-                (Some(other), None) => {
-                    return Err(f.error(
-                        "colours",
-                        format!("expected \"sequential\" or \"diverging\", got \"{other}\""),
-                    ))
-                }
-            };
-            let z_range = parse_z_range(&mut f, &colours)?;
-            let (x, panels, x_label, y_label) = shared_axes(&mut f)?;
-            let plot = Plot::Heatmap {
-                overlays,
-                colours,
-                z_range,
-                x,
-                y: f.required("y")?,
-                z: f.required("z")?,
-                panels,
-                x_label,
-                y_label,
-                z_label: f.required("z_label")?,
-                mark_max,
-            };
-            f.finish()?;
-            plot
-        }
+    let (plot, panel_title) = match (lines, heat) {
+        (Some(t), None) => parse_lines(f.nested("lines", t))?,
+        (None, Some(t)) => parse_heatmap(f.nested("heatmap", t))?,
         _ => {
             let others = f.keys();
             let reason = if others.is_empty() {
@@ -233,6 +162,88 @@ pub(super) fn parse_panel(
         view,
         plot,
     })
+}
+
+/// A panel's ranges and scales; a log axis must start above zero.
+fn parse_view(f: &mut Fields<'_>) -> Result<View> {
+    let view = View {
+        x: range_key(f, "x_range")?,
+        y: range_key(f, "y_range")?,
+        x_scale: scale_key(f, "x_scale")?,
+        y_scale: scale_key(f, "y_scale")?,
+    };
+    for (key, scale, range) in [
+        ("x_range", view.x_scale, view.x),
+        ("y_range", view.y_scale, view.y),
+    ] {
+        if scale == Scale::Log && range.is_some_and(|(lo, _)| lo <= 0.0) {
+            return Err(f.error(key, "a log axis starts above zero"));
+        }
+    }
+    Ok(view)
+}
+
+/// A panel's `[lines]` table: the plot and the panel's title.
+fn parse_lines(mut f: Fields<'_>) -> Result<(Plot, Option<String>)> {
+    let panel_title = f.optional::<String>("panel_title")?;
+    let styles = parse_series_styles(&mut f)?;
+    let (x, panels, x_label, y_label) = shared_axes(&mut f)?;
+    let plot = Plot::Lines {
+        styles,
+        x,
+        y: f.required("y")?,
+        panels,
+        series: f.optional("series")?,
+        series_label: f.optional("series_label")?,
+        x_label,
+        y_label,
+        mark_halving: flag(&mut f, "mark_halving")?,
+    };
+    check_series(&plot, &f)?;
+    f.finish()?;
+    Ok((plot, panel_title))
+}
+
+/// A panel's `[heatmap]` table: the plot and the panel's title.
+fn parse_heatmap(mut f: Fields<'_>) -> Result<(Plot, Option<String>)> {
+    let panel_title = f.optional::<String>("panel_title")?;
+    let mark_max = flag(&mut f, "mark_max")?;
+    let overlays = parse_overlays(&mut f)?;
+    let colours = parse_colours(&mut f)?;
+    let z_range = parse_z_range(&mut f, &colours)?;
+    let (x, panels, x_label, y_label) = shared_axes(&mut f)?;
+    let plot = Plot::Heatmap {
+        overlays,
+        colours,
+        z_range,
+        x,
+        y: f.required("y")?,
+        z: f.required("z")?,
+        panels,
+        x_label,
+        y_label,
+        z_label: f.required("z_label")?,
+        mark_max,
+    };
+    f.finish()?;
+    Ok((plot, panel_title))
+}
+
+/// A heatmap's colours: `colours = "sequential"` (the default) or `"diverging"`, or named
+/// `categories`.
+fn parse_colours(f: &mut Fields<'_>) -> Result<Colours> {
+    let categories = f.optional::<Vec<String>>("categories")?;
+    match (f.optional::<String>("colours")?.as_deref(), categories) {
+        (None | Some("sequential"), None) => Ok(Colours::Sequential),
+        (Some("diverging"), None) => Ok(Colours::Diverging),
+        (None, Some(names)) if !names.is_empty() => Ok(Colours::Categories(names)),
+        (None, Some(_)) => Err(f.error("categories", "name at least one")),
+        (Some(_), Some(_)) => Err(f.error("colours", "give `colours` or `categories`, not both")),
+        (Some(other), None) => Err(f.error(
+            "colours",
+            format!("expected \"sequential\" or \"diverging\", got \"{other}\""),
+        )),
+    }
 }
 
 /// `x_scale = "linear" | "log"`.
