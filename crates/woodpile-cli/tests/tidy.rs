@@ -196,7 +196,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-plot", "heat.rs:panel", 130),
     ("woodpile-bench", "main.rs:main", 117),
     ("woodpile-stages", "render/draw.rs:draw", 101),
-    ("woodpile-stages", "report/markdown.rs:markdown", 99),
     ("woodpile-plot", "draw.rs:figure", 93),
 ];
 

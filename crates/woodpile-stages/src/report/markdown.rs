@@ -4,7 +4,7 @@
 use super::judge::{difference, reproduces, verdict};
 use super::measure::{Measured, Scanned};
 use super::number::fmt;
-use super::{Paper, Report};
+use super::{Paper, Quote, Report};
 
 /// A measured value as the report shows it: the number, or that it failed.
 fn shown(m: &Measured) -> String {
@@ -67,6 +67,30 @@ pub(super) fn markdown(
         out.push_str(report.preamble.trim());
         out.push_str("\n\n");
     }
+    summary_table(&mut out, report, evaluated);
+    let mut figures: Vec<&str> = Vec::new();
+    for q in &report.quotes {
+        if !figures.contains(&q.figure.as_str()) {
+            figures.push(&q.figure);
+        }
+    }
+    for figure in figures {
+        out.push_str(&format!("\n## {figure}\n"));
+        for (q, (ours, conventions)) in report.quotes.iter().zip(evaluated) {
+            if q.figure == figure {
+                quote_section(&mut out, q, ours, conventions);
+            }
+        }
+    }
+    out
+}
+
+/// The summary: one row per quote, as run, with the conventions that reproduce it.
+fn summary_table(
+    out: &mut String,
+    report: &Report,
+    evaluated: &[(Measured, Vec<(String, Measured)>)],
+) {
     out.push_str("## Summary\n\n");
     out.push_str("| figure | quantity | paper | ours (as run) | difference | reproduced as run | conventions that reproduce it |\n");
     out.push_str("|---|---|---|---|---|---|---|\n");
@@ -92,64 +116,57 @@ pub(super) fn markdown(
             },
         ));
     }
-    let mut figures: Vec<&str> = Vec::new();
-    for q in &report.quotes {
-        if !figures.contains(&q.figure.as_str()) {
-            figures.push(&q.figure);
+}
+
+/// One quote's section: the paper's number, its note, and a row per convention.
+fn quote_section(out: &mut String, q: &Quote, ours: &Measured, conventions: &[(String, Measured)]) {
+    out.push_str(&format!("\n### {}\n\n", q.quantity));
+    let agree = match &q.paper {
+        Paper::Value { agree, .. } => format!(" (reproduced when within ±{})", fmt(*agree)),
+        Paper::Text {
+            range: Some([lo, hi]),
+            ..
+        } => {
+            format!(" (taken as {} to {})", fmt(*lo), fmt(*hi))
         }
+        Paper::Text { range: None, .. } => String::new(),
+    };
+    out.push_str(&format!("Paper: **{}**{agree}.\n\n", paper_text(&q.paper)));
+    if !q.note.is_empty() {
+        out.push_str(q.note.trim());
+        out.push_str("\n\n");
     }
-    for figure in figures {
-        out.push_str(&format!("\n## {figure}\n"));
-        for (q, (ours, conventions)) in report.quotes.iter().zip(evaluated) {
-            if q.figure != figure {
-                continue;
-            }
-            out.push_str(&format!("\n### {}\n\n", q.quantity));
-            let agree = match &q.paper {
-                Paper::Value { agree, .. } => format!(" (reproduced when within ±{})", fmt(*agree)),
-                Paper::Text {
-                    range: Some([lo, hi]),
-                    ..
-                } => {
-                    format!(" (taken as {} to {})", fmt(*lo), fmt(*hi))
-                }
-                Paper::Text { range: None, .. } => String::new(),
-            };
-            out.push_str(&format!("Paper: **{}**{agree}.\n\n", paper_text(&q.paper)));
-            if !q.note.is_empty() {
-                out.push_str(q.note.trim());
-                out.push_str("\n\n");
-            }
-            out.push_str("| convention | value | where | difference | reproduces | scan: within tolerance at | sensitivity |\n");
-            out.push_str("|---|---|---|---|---|---|---|\n");
-            let as_run = format!("as run: {}", q.as_run);
-            for (name, m) in
-                std::iter::once((&as_run, ours)).chain(conventions.iter().map(|(n, m)| (n, m)))
-            {
-                let (diff, _) = difference(&q.paper, m);
-                let (range, slope) = match &m.scan {
-                    Some(s) => (
-                        runs_text(s),
-                        format!("{} per unit {}", fmt(s.slope), s.column),
-                    ),
-                    None => ("–".into(), "–".into()),
-                };
-                out.push_str(&format!(
-                    "| {} | {} | {} | {} | {} | {} | {} |\n",
-                    name,
-                    shown(m),
-                    match (&m.failure, m.location.is_empty()) {
-                        (Some(reason), _) => reason.replace('|', "/"),
-                        (None, true) => "–".into(),
-                        (None, false) => m.location.clone(),
-                    },
-                    diff.map_or("–".into(), fmt),
-                    verdict(&q.paper, m),
-                    range,
-                    slope,
-                ));
-            }
-        }
+    out.push_str("| convention | value | where | difference | reproduces | scan: within tolerance at | sensitivity |\n");
+    out.push_str("|---|---|---|---|---|---|---|\n");
+    let as_run = format!("as run: {}", q.as_run);
+    for (name, m) in std::iter::once((&as_run, ours)).chain(conventions.iter().map(|(n, m)| (n, m)))
+    {
+        convention_row(out, &q.paper, name, m);
     }
-    out
+}
+
+/// A convention's row of a quote's section.
+fn convention_row(out: &mut String, paper: &Paper, name: &str, m: &Measured) {
+    let (diff, _) = difference(paper, m);
+    let (range, slope) = match &m.scan {
+        Some(s) => (
+            runs_text(s),
+            format!("{} per unit {}", fmt(s.slope), s.column),
+        ),
+        None => ("–".into(), "–".into()),
+    };
+    out.push_str(&format!(
+        "| {} | {} | {} | {} | {} | {} | {} |\n",
+        name,
+        shown(m),
+        match (&m.failure, m.location.is_empty()) {
+            (Some(reason), _) => reason.replace('|', "/"),
+            (None, true) => "–".into(),
+            (None, false) => m.location.clone(),
+        },
+        diff.map_or("–".into(), fmt),
+        verdict(paper, m),
+        range,
+        slope,
+    ));
 }
