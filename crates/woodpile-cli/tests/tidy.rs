@@ -195,7 +195,6 @@ const LONGER_FOR_NOW: &[(&str, &str, usize)] = &[
     ("woodpile-plot", "draw.rs:lines_panel", 137),
     ("woodpile-plot", "heat.rs:panel", 130),
     ("woodpile-bench", "main.rs:main", 117),
-    ("woodpile-stages", "render/draw.rs:draw", 101),
     ("woodpile-plot", "draw.rs:figure", 93),
 ];
 

@@ -47,105 +47,87 @@ fn on(values: &[Option<f64>], rows: &[usize]) -> Values {
 impl PanelSpec {
     /// The panels this spec draws from `input`: one, or one per value of `panels`.
     pub(super) fn draw(&self, input: &DataFrame, title: Option<String>) -> Result<Vec<Panel>> {
-        let keep = matching_rows(input, &self.filter)?;
-        let column = |name: &String| -> Result<Values> {
-            let values = f64_column(input, name)?;
-            Ok(keep.iter().map(|&r| values[r]).collect())
-        };
-        // An optional string column (curve or panel names), on the kept rows.
-        let text_column = |name: Option<&String>| -> Result<Option<Vec<Option<String>>>> {
-            let Some(name) = name else { return Ok(None) };
-            let values = str_column(input, name)?;
-            Ok(Some(keep.iter().map(|&r| values[r].clone()).collect()))
+        let kept = Kept {
+            input,
+            rows: matching_rows(input, &self.filter)?,
         };
         let panel_name = match &self.plot {
             Plot::Lines { panels, .. } | Plot::Heatmap { panels, .. } => panels.as_ref(),
         };
         let panel_values = match panel_name {
-            Some(p) => column(p)?,
-            None => vec![Some(0.0); keep.len()],
+            Some(p) => kept.column(p)?,
+            None => vec![Some(0.0); kept.rows.len()],
         };
-        let mut keys: Vec<f64> = panel_values.iter().flatten().copied().collect();
-        keys.sort_by(f64::total_cmp);
-        keys.dedup();
-        if keys.len() > MAX_PANELS {
-            return Err(PipelineError::stage(
-                "render",
-                format!(
-                    "`panels = \"{}\"` makes {} panels, more than the {MAX_PANELS} a figure may have; filter the rows with `where` or choose another column",
-                    panel_name.map_or("", |p| p.as_str()),
-                    keys.len()
-                ),
-            ));
-        }
-        let data = match &self.plot {
+        let keys = panel_keys(&panel_values, panel_name)?;
+        let data = self.data(&kept)?;
+        let labels = kept.text_column(self.panel_label.as_ref())?;
+        let panels = keys
+            .iter()
+            .map(|&key| {
+                let rows: Vec<usize> = (0..kept.rows.len())
+                    .filter(|&r| panel_values[r] == Some(key))
+                    .collect();
+                let title = match &title {
+                    Some(t) => t.clone(),
+                    None => self.panel_title_of(key, &rows, labels.as_deref(), panel_name),
+                };
+                match &data {
+                    Data::Lines(d) => self.line_panel(d, &rows, title),
+                    Data::Heat(d) => self.heat_panel(d, &rows, title),
+                }
+            })
+            .collect();
+        Ok(panels)
+    }
+
+    /// The columns the plot reads, on the kept rows.
+    fn data(&self, kept: &Kept<'_>) -> Result<Data> {
+        Ok(match &self.plot {
             Plot::Lines {
                 x,
                 y,
                 series,
                 series_label,
                 ..
-            } => {
-                let x = column(x)?;
-                let y = y.iter().map(column).collect::<Result<_>>()?;
-                let series = series.as_ref().map(column).transpose()?;
-                Data::Lines(LineData {
-                    x,
-                    y,
-                    series,
-                    labels: text_column(series_label.as_ref())?,
-                })
-            }
+            } => Data::Lines(LineData {
+                x: kept.column(x)?,
+                y: y.iter().map(|c| kept.column(c)).collect::<Result<_>>()?,
+                series: series.as_ref().map(|c| kept.column(c)).transpose()?,
+                labels: kept.text_column(series_label.as_ref())?,
+            }),
             Plot::Heatmap {
                 x, y, z, overlays, ..
             } => Data::Heat(HeatData {
-                x: column(x)?,
-                y: column(y)?,
-                z: column(z)?,
+                x: kept.column(x)?,
+                y: kept.column(y)?,
+                z: kept.column(z)?,
                 overlays: overlays
                     .iter()
-                    .map(|(c, _)| column(c))
+                    .map(|(c, _)| kept.column(c))
                     .collect::<Result<_>>()?,
             }),
-        };
-        let panel_values = &panel_values;
-        let height = keep.len();
-        let rows_of = move |key: f64| -> Vec<usize> {
-            (0..height)
-                .filter(|&r| panel_values[r] == Some(key))
-                .collect()
-        };
-        let panel_labels = text_column(self.panel_label.as_ref())?;
-        let title_of = |key: f64| {
-            if let Some(t) = &title {
-                return t.clone();
-            }
-            let labelled = panel_labels.as_ref().and_then(|labels| {
-                (0..height)
-                    .find(|&r| panel_values[r] == Some(key))
-                    .and_then(|r| labels[r].clone())
-            });
-            let titled = self
-                .panel_title
-                .as_ref()
-                .map(|t| t.replace("{value}", &woodpile_plot::tick(&key)));
-            labelled.or(titled).unwrap_or_else(|| {
-                panel_name
-                    .map(|p| format!("{p} = {}", woodpile_plot::tick(&key)))
-                    .unwrap_or_default()
-            })
-        };
-        let panels = keys
-            .iter()
-            .map(|&key| {
-                let rows = rows_of(key);
-                match &data {
-                    Data::Lines(d) => self.line_panel(d, &rows, title_of(key)),
-                    Data::Heat(d) => self.heat_panel(d, &rows, title_of(key)),
-                }
-            })
-            .collect();
-        Ok(panels)
+        })
+    }
+
+    /// The title of the panel of `key` (whose rows are `rows`): its `panel_label`, else its
+    /// `panel_title` with `{value}`, else `column = value`.
+    fn panel_title_of(
+        &self,
+        key: f64,
+        rows: &[usize],
+        labels: Option<&[Option<String>]>,
+        panel_name: Option<&String>,
+    ) -> String {
+        let labelled = labels.and_then(|labels| rows.first().and_then(|&r| labels[r].clone()));
+        let titled = self
+            .panel_title
+            .as_ref()
+            .map(|t| t.replace("{value}", &woodpile_plot::tick(&key)));
+        labelled.or(titled).unwrap_or_else(|| {
+            panel_name
+                .map(|p| format!("{p} = {}", woodpile_plot::tick(&key)))
+                .unwrap_or_default()
+        })
     }
 
     /// One line panel from `data` on `rows`: a curve per y column, or per value of the series
@@ -298,6 +280,45 @@ fn halving_mark(series: &Series) -> Option<Mark> {
         at: MarkAt::X(x),
         label: format!("{} halves", series.label),
     })
+}
+
+/// The rows of a table that a panel's `where` keeps.
+struct Kept<'a> {
+    input: &'a DataFrame,
+    rows: Vec<usize>,
+}
+
+impl Kept<'_> {
+    /// Column `name` as floats, on the kept rows.
+    fn column(&self, name: &str) -> Result<Values> {
+        let values = f64_column(self.input, name)?;
+        Ok(self.rows.iter().map(|&r| values[r]).collect())
+    }
+
+    /// An optional string column (curve or panel names), on the kept rows.
+    fn text_column(&self, name: Option<&String>) -> Result<Option<Vec<Option<String>>>> {
+        let Some(name) = name else { return Ok(None) };
+        let values = str_column(self.input, name)?;
+        Ok(Some(self.rows.iter().map(|&r| values[r].clone()).collect()))
+    }
+}
+
+/// The panels' values of the `panels` column, in order, at most [`MAX_PANELS`] of them.
+fn panel_keys(panel_values: &[Option<f64>], panel_name: Option<&String>) -> Result<Vec<f64>> {
+    let mut keys: Vec<f64> = panel_values.iter().flatten().copied().collect();
+    keys.sort_by(f64::total_cmp);
+    keys.dedup();
+    if keys.len() > MAX_PANELS {
+        return Err(PipelineError::stage(
+            "render",
+            format!(
+                "`panels = \"{}\"` makes {} panels, more than the {MAX_PANELS} a figure may have; filter the rows with `where` or choose another column",
+                panel_name.map_or("", |p| p.as_str()),
+                keys.len()
+            ),
+        ));
+    }
+    Ok(keys)
 }
 
 #[cfg(test)]

@@ -128,6 +128,9 @@ impl Reader<'_> {
     }
 }
 
+/// One point of a scan: (scan value, value read, row).
+type ScanPoint = (f64, f64, usize);
+
 /// A column of a stage's table as a source reads it: its values, the column that ranks rows
 /// (`max`), the columns that say where a row is (`locate`), and why rows failed upstream.
 struct ColumnRead {
@@ -207,7 +210,7 @@ impl ColumnRead {
         rows: &[usize],
         source: &Source,
         scan_column: &str,
-    ) -> Result<std::result::Result<Vec<(f64, f64, usize)>, String>> {
+    ) -> Result<std::result::Result<Vec<ScanPoint>, String>> {
         let scan_values = f64_column(frame, scan_column)?;
         let mut sorted: Vec<(usize, f64)> = rows
             .iter()
@@ -249,7 +252,7 @@ fn paper_target(paper: &Paper) -> Option<f64> {
 }
 
 /// The runs of consecutive scan values whose value agrees with `paper` (first, last).
-fn runs_within(series: &[(f64, f64, usize)], paper: &Paper) -> Vec<(f64, f64)> {
+fn runs_within(series: &[ScanPoint], paper: &Paper) -> Vec<(f64, f64)> {
     let within = |v: f64| match paper {
         Paper::Value { value, agree } => (v - value).abs() <= *agree,
         Paper::Text {
@@ -273,7 +276,7 @@ fn runs_within(series: &[(f64, f64, usize)], paper: &Paper) -> Vec<(f64, f64)> {
 }
 
 /// |d value / d scan| at point `best` of `series`: the steeper of its two sides.
-fn slope_at(series: &[(f64, f64, usize)], best: usize) -> f64 {
+fn slope_at(series: &[ScanPoint], best: usize) -> f64 {
     let slope_between = |a: usize, b: usize| {
         let ds = series[b].0 - series[a].0;
         if ds > 0.0 {
