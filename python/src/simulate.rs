@@ -117,14 +117,31 @@ fn add_field(
     let width = field.width();
     let first = scene.first_site + *field.sites().start() as i64;
     let rows = field.t.len();
-    let grid = |values: Vec<f64>| {
+    let resonators = scene.scenario.model.resonators();
+    let grid = |values: Vec<f64>, width: usize| {
         Array2::from_shape_vec((rows, width), values)
             .map_err(|e| SimulationError::new_err(format!("field shape: {e}")))
     };
     let sites: Vec<i64> = (first..first + width as i64).collect();
+    let resonator_sites: Vec<i64> = resonators
+        .iter()
+        .map(|r| scene.first_site + r.site as i64)
+        .collect();
     out.set_item("sites", sites.into_pyarray(py))?;
-    out.set_item("velocity", grid(field.velocity)?.into_pyarray(py))?;
-    out.set_item("displacement", grid(field.displacement)?.into_pyarray(py))?;
+    out.set_item("velocity", grid(field.velocity, width)?.into_pyarray(py))?;
+    out.set_item("displacement", grid(field.displacement, width)?.into_pyarray(py))?;
+    out.set_item("energy", grid(field.energy, width)?.into_pyarray(py))?;
+    out.set_item("kinetic", grid(field.kinetic, width)?.into_pyarray(py))?;
+    out.set_item("resonator_sites", resonator_sites.into_pyarray(py))?;
+    let r = resonators.len();
+    out.set_item(
+        "resonator_displacement",
+        grid(field.resonator_displacement, r)?.into_pyarray(py),
+    )?;
+    out.set_item(
+        "resonator_velocity",
+        grid(field.resonator_velocity, r)?.into_pyarray(py),
+    )?;
     out.set_item("t", field.t.into_pyarray(py))?;
     Ok(())
 }

@@ -88,6 +88,24 @@ def test_fields_have_the_shapes_and_dtypes_stated():
     np.testing.assert_array_equal(part.displacement, r.displacement[:, 55:66])
 
 
+def test_fields_carry_site_energies_and_the_resonators():
+    r = woodpile.simulate(STANDARD, fields=True)
+    assert r.energy.shape == r.kinetic.shape == r.velocity.shape
+    # Over the whole chain a sample's site energies are E(t).
+    np.testing.assert_allclose(r.energy.sum(axis=1), r.series.E, rtol=1e-12)
+    assert (r.kinetic <= r.energy + 1e-15).all()
+    assert list(r.resonator_sites) == [0]
+    assert r.resonator_displacement.shape == r.resonator_velocity.shape == (len(r.t), 1)
+    # The kinetic energy of the defect's site includes its resonator's (eps = 3).
+    at = list(r.sites).index(0)
+    v, w = r.velocity[:, at], r.resonator_velocity[:, 0]
+    np.testing.assert_allclose(r.kinetic[:, at], 0.5 * v**2 + 0.5 * 3.0 * w**2, rtol=1e-12)
+    frame = r.field_frame()
+    on_defect = frame[frame.site == 0]
+    np.testing.assert_array_equal(on_defect.resonator_velocity, w)
+    assert frame[frame.site != 0].resonator_displacement.isna().all()
+
+
 def test_fields_agree_with_the_cli_field_table(cli, tmp_path):
     path = tmp_path / "scene.toml"
     path.write_text(woodpile.scene_toml(STANDARD))

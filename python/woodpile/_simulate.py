@@ -35,6 +35,16 @@ class SimulationResult:
         sites: the paper site numbers of the field's columns (int64), or None.
         velocity: site velocities, float64, shape (len(t), len(sites)), or None.
         displacement: site displacements, laid out as ``velocity``, or None.
+        energy: each site's energy (its mass's kinetic energy, half of each of its bonds, its
+            wall or soft end, its resonator's kinetic and spring energy), laid out as
+            ``velocity``; over the whole chain a row sums to E(t). None without a field.
+        kinetic: each site's kinetic energy, its host mass applied and its resonator's
+            included (what the woodpile experiment measures), laid out as ``velocity``.
+        resonator_sites: the paper site of each resonator (int64), or None.
+        resonator_displacement: each resonator's displacement, float64, shape (len(t),
+            len(resonator_sites)), or None.
+        resonator_velocity: each resonator's velocity, laid out as
+            ``resonator_displacement``, or None.
     """
 
     R: float
@@ -69,6 +79,11 @@ class SimulationResult:
     sites: Optional[np.ndarray]
     velocity: Optional[np.ndarray]
     displacement: Optional[np.ndarray]
+    energy: Optional[np.ndarray]
+    kinetic: Optional[np.ndarray]
+    resonator_sites: Optional[np.ndarray]
+    resonator_displacement: Optional[np.ndarray]
+    resonator_velocity: Optional[np.ndarray]
 
     def __init__(self, raw: Dict[str, Any]) -> None:
         self._report: Dict[str, Any] = json.loads(raw["report"])
@@ -83,6 +98,11 @@ class SimulationResult:
         self.sites = raw.get("sites")
         self.velocity = raw.get("velocity")
         self.displacement = raw.get("displacement")
+        self.energy = raw.get("energy")
+        self.kinetic = raw.get("kinetic")
+        self.resonator_sites = raw.get("resonator_sites")
+        self.resonator_displacement = raw.get("resonator_displacement")
+        self.resonator_velocity = raw.get("resonator_velocity")
 
     @property
     def series(self) -> pd.DataFrame:
@@ -99,9 +119,17 @@ class SimulationResult:
         return json.loads(json.dumps(self._report))
 
     def field_frame(self) -> pd.DataFrame:
-        """The field in long form (columns t, site, velocity, displacement), as
-        ``woodpile simulate --field`` writes it; needs ``fields=True`` or ``field_sites``."""
-        if self.velocity is None or self.sites is None or self.displacement is None:
+        """The field in long form (columns t, site, velocity, displacement, energy,
+        kinetic, resonator_displacement, resonator_velocity; the last two NaN on a site
+        without a resonator), as ``woodpile simulate --field`` writes it; needs
+        ``fields=True`` or ``field_sites``."""
+        if (
+            self.velocity is None
+            or self.sites is None
+            or self.displacement is None
+            or self.energy is None
+            or self.kinetic is None
+        ):
             raise ValueError("no field was recorded: call simulate(..., fields=True)")
         n_t, n_s = self.velocity.shape
         return pd.DataFrame(
@@ -110,8 +138,25 @@ class SimulationResult:
                 "site": np.tile(self.sites, n_t),
                 "velocity": self.velocity.ravel(),
                 "displacement": self.displacement.ravel(),
+                "energy": self.energy.ravel(),
+                "kinetic": self.kinetic.ravel(),
+                "resonator_displacement": self._per_site(self.resonator_displacement).ravel(),
+                "resonator_velocity": self._per_site(self.resonator_velocity).ravel(),
             }
         )
+
+    def _per_site(self, values: Optional[np.ndarray]) -> np.ndarray:
+        """A resonator array (time × resonator) on the field's sites (time × site), NaN where
+        a site hosts no resonator."""
+        assert self.sites is not None and self.velocity is not None
+        out = np.full(self.velocity.shape, np.nan)
+        if values is None or self.resonator_sites is None:
+            return out
+        column = {int(site): k for k, site in enumerate(self.sites)}
+        for j, site in enumerate(self.resonator_sites):
+            if int(site) in column:
+                out[:, column[int(site)]] = values[:, j]
+        return out
 
     def __repr__(self) -> str:
         est = "none" if self.error_estimate is None else f"{self.error_estimate:.1e}"
@@ -134,7 +179,8 @@ def simulate(
         scene: a dict with the keys of a scene file (``{"defect": [{"site": 0, "eps":
             10.0}], "run": {"t_end": 150.0}}``), a TOML string, or the path of a scene
             file (``str`` or ``os.PathLike``). Keys left out take the paper's defaults.
-        fields: also record every site's velocity and displacement at every sample.
+        fields: also record every site's velocity, displacement, energy and kinetic energy,
+            and every resonator's displacement and velocity, at every sample.
         field_sites: record only the paper sites ``lo..=hi`` (implies ``fields``).
         series: what ``series`` splits: ``"energy"`` (shares of the total energy) or
             ``"kinetic"`` (kinetic energy over the impact energy, the woodpile experiment's
@@ -144,8 +190,10 @@ def simulate(
         A ``SimulationResult``: ``R``, ``T``, ``E_tr`` (fractions at ``t_end``),
         ``error_estimate`` (``auto``'s verified error bound estimate), ``method``, ``dt``
         and every other key of ``woodpile simulate``'s JSON; ``series`` (a DataFrame of
-        t, R, T, E_tr, E); with a field, ``t``, ``sites``, ``velocity`` and
-        ``displacement`` (float64 arrays of shape (time, site)).
+        t, R, T, E_tr, E); with a field, ``t``, ``sites``, ``velocity``, ``displacement``,
+        ``energy`` and ``kinetic`` (float64 arrays of shape (time, site)), and
+        ``resonator_sites``, ``resonator_displacement`` and ``resonator_velocity`` (shape
+        (time, resonator)).
 
     Raises:
         SceneError: the scene is invalid (a ``ValueError``; the message names the file or

@@ -238,6 +238,7 @@ fn write_field(
     let width = field.width();
     let rows = field.t.len() * width;
     let first = scene.first_site + *field.sites().start() as i64;
+    let all = |values: &[f64]| values.iter().map(|v| Some(*v)).collect();
     let mut columns = Columns::new();
     columns
         .f64(
@@ -254,15 +255,37 @@ fn write_field(
                 .map(|i| Some(first + (i % width) as i64))
                 .collect(),
         )
+        .f64("velocity", all(&field.velocity))
+        .f64("displacement", all(&field.displacement))
+        .f64("energy", all(&field.energy))
+        .f64("kinetic", all(&field.kinetic))
         .f64(
-            "velocity",
-            field.velocity.iter().map(|v| Some(*v)).collect(),
+            "resonator_displacement",
+            per_site(scene, field, &field.resonator_displacement),
         )
         .f64(
-            "displacement",
-            field.displacement.iter().map(|u| Some(*u)).collect(),
+            "resonator_velocity",
+            per_site(scene, field, &field.resonator_velocity),
         );
     let frame = columns.into_frame().map_err(Failure::simulation)?;
     let sites = json!([first, first + width as i64 - 1]);
     table::write(path, frame, &manifest("field", file, scene, out, sites)).map_err(Failure::input)
+}
+
+/// A resonator column (time × resonator) in the field's long form (time × site): each site's
+/// resonator, null where a site has none (a site hosts at most one).
+fn per_site(scene: &Scene, field: &SiteField, values: &[f64]) -> Vec<Option<f64>> {
+    let resonators = scene.scenario.model.resonators();
+    let mut on_site: Vec<Option<usize>> = vec![None; field.width()];
+    for (j, r) in resonators.iter().enumerate() {
+        if let Some(k) = r.site.checked_sub(*field.sites().start()) {
+            if k < on_site.len() {
+                on_site[k] = Some(j);
+            }
+        }
+    }
+    let count = resonators.len();
+    (0..field.t.len())
+        .flat_map(|i| on_site.iter().map(move |j| j.map(|j| values[i * count + j])))
+        .collect()
 }

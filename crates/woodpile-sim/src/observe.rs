@@ -5,8 +5,9 @@
 //! - [`FractionSeries::kinetic`]: kinetic-energy fractions normalised by the impact energy, as
 //!   the woodpile experiment measures them (paper Fig. 2 c, f).
 //! - [`SpaceTimeField`]: a decimated site-by-time velocity map (paper Figs. 3, 8, 10).
-//! - [`SiteField`]: displacements and velocities of a range of sites at every sample, in full
-//!   precision (one scene's field for analysis, `woodpile simulate --field`, Python's `fields`).
+//! - [`SiteField`]: displacements, velocities and energies of a range of sites, and every
+//!   resonator's displacement and velocity, at every sample, in full precision (one scene's
+//!   field for analysis, `woodpile simulate --field`, Python's `fields`).
 
 use crate::energy::{energy_density, kinetic_density, Fractions, Region};
 use crate::integrate::{intervals, Observer};
@@ -181,10 +182,11 @@ impl Observer for SpaceTimeField {
     }
 }
 
-/// Displacements u_n(t) and velocities u_n'(t) of the sites `first..=last` (internal
-/// indices) at every sample, as f64, row-major (time × site): what a user analyses, where
-/// [`SpaceTimeField`] is what a figure draws. Each sample appends one row to two flat
-/// vectors, so the arrays can be handed on whole, without a copy per sample.
+/// Displacements u_n(t), velocities u_n'(t), energies and kinetic energies of the sites
+/// `first..=last` (internal indices), and every resonator's displacement w_j(t) and velocity
+/// w_j'(t), at every sample, as f64, row-major (time × site, time × resonator): what a user
+/// analyses, where [`SpaceTimeField`] is what a figure draws. Each sample appends one row to
+/// each flat vector, so the arrays can be handed on whole, without a copy per sample.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SiteField {
     first: usize,
@@ -195,6 +197,20 @@ pub struct SiteField {
     pub displacement: Vec<f64>,
     /// Velocities, laid out as `displacement`.
     pub velocity: Vec<f64>,
+    /// Each site's energy e_n (its mass's kinetic energy, half of each of its bonds, its wall
+    /// or soft end, and its resonator's kinetic and spring energy), laid out as `displacement`:
+    /// over the whole chain they sum to E(t).
+    pub energy: Vec<f64>,
+    /// Each site's kinetic energy, its host mass applied and its resonator's included: what
+    /// the woodpile experiment measures. Laid out as `displacement`.
+    pub kinetic: Vec<f64>,
+    /// Every resonator's displacement: `resonator_displacement[i * R + j]` is resonator `j`
+    /// (in the model's order) at `t[i]`.
+    pub resonator_displacement: Vec<f64>,
+    /// Every resonator's velocity, laid out as `resonator_displacement`.
+    pub resonator_velocity: Vec<f64>,
+    /// Scratch: one sample's per-site density over the whole chain.
+    density: Vec<f64>,
 }
 
 impl SiteField {
@@ -208,6 +224,11 @@ impl SiteField {
             t: Vec::new(),
             displacement: Vec::new(),
             velocity: Vec::new(),
+            energy: Vec::new(),
+            kinetic: Vec::new(),
+            resonator_displacement: Vec::new(),
+            resonator_velocity: Vec::new(),
+            density: vec![0.0; model.n_sites()],
         }
     }
 
@@ -224,11 +245,13 @@ impl SiteField {
     /// Refuses, before the run, a field of more than [`MAX_FIELD_VALUES`] values per array:
     /// `width` sites at every sample of `scenario`. The reason names the sizes.
     pub fn check_size(scenario: &Scenario, width: usize) -> Result<(), String> {
+        // The resonator arrays are as wide as the chain has resonators.
+        let width = width.max(scenario.model.resonators().len());
         let samples = intervals(scenario.t_end, scenario.sample_every) + 1;
         let values = samples.saturating_mul(width as u64);
         if values > MAX_FIELD_VALUES {
             return Err(format!(
-                "a field of {width} sites at {samples} samples is {values} values per array, more than the {MAX_FIELD_VALUES} it may have; keep fewer sites or sample less often"
+                "a field {width} columns wide (sites or resonators) at {samples} samples is {values} values per array, more than the {MAX_FIELD_VALUES} it may have; keep fewer sites or sample less often"
             ));
         }
         Ok(())
@@ -241,16 +264,35 @@ pub const MAX_FIELD_VALUES: u64 = 20_000_000;
 
 impl Observer for SiteField {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
-        let (q, v) = y.split_at(model.n_dof());
+        let (n_sites, n_dof) = (model.n_sites(), model.n_dof());
+        let (q, v) = y.split_at(n_dof);
         self.t.push(t);
         self.displacement.extend_from_slice(&q[self.sites()]);
         self.velocity.extend_from_slice(&v[self.sites()]);
+        self.resonator_displacement
+            .extend_from_slice(&q[n_sites..n_dof]);
+        self.resonator_velocity
+            .extend_from_slice(&v[n_sites..n_dof]);
+        energy_density(model, t, y, &mut self.density);
+        self.energy
+            .extend_from_slice(&self.density[self.first..=self.last]);
+        kinetic_density(model, y, &mut self.density);
+        self.kinetic
+            .extend_from_slice(&self.density[self.first..=self.last]);
     }
 
     fn reset(&mut self) {
-        self.t.clear();
-        self.displacement.clear();
-        self.velocity.clear();
+        for v in [
+            &mut self.t,
+            &mut self.displacement,
+            &mut self.velocity,
+            &mut self.energy,
+            &mut self.kinetic,
+            &mut self.resonator_displacement,
+            &mut self.resonator_velocity,
+        ] {
+            v.clear();
+        }
     }
 }
 
@@ -354,6 +396,65 @@ mod tests {
         assert_eq!(
             field.velocity[..11].iter().filter(|v| **v != 0.0).count(),
             1
+        );
+    }
+
+    /// Over the whole chain the site energies sum to E(t) and the kinetic energies to the
+    /// chain's kinetic energy; the resonator columns are the state's resonator entries, and
+    /// the field's last row is the final state.
+    #[test]
+    fn site_energies_sum_to_the_total_and_resonators_are_recorded() {
+        let s = scene();
+        let n = s.model.n_sites();
+        let mut both = (
+            SiteField::new(&s.model, 0, n - 1),
+            FractionSeries::new(&s.model, s.region),
+        );
+        let out = simulate(&s, &mut both).unwrap();
+        let (field, series) = both;
+        let samples = field.t.len();
+        assert_eq!(field.energy.len(), samples * n);
+        assert_eq!(field.resonator_displacement.len(), samples);
+        for (i, row) in field.energy.chunks(n).enumerate() {
+            let total: f64 = row.iter().sum();
+            assert!(
+                (total - series.energy[i]).abs() <= 1e-12 * series.energy[i],
+                "{i}"
+            );
+        }
+        for (i, (kinetic, energy)) in field
+            .kinetic
+            .chunks(n)
+            .zip(field.energy.chunks(n))
+            .enumerate()
+        {
+            let (u, v) = (
+                &field.displacement[i * n..(i + 1) * n],
+                &field.velocity[i * n..(i + 1) * n],
+            );
+            let w = field.resonator_velocity[i];
+            let expected: f64 = v.iter().map(|v| 0.5 * v * v).sum::<f64>() + 0.5 * 3.0 * w * w;
+            let sum: f64 = kinetic.iter().sum();
+            assert!(
+                (sum - expected).abs() <= 1e-12 * expected.max(1e-300),
+                "{i}"
+            );
+            assert!(kinetic.iter().zip(energy).all(|(k, e)| *k <= *e + 1e-15));
+            assert_eq!(u.len(), n);
+        }
+        let nd = s.model.n_dof();
+        assert_eq!(
+            field.resonator_displacement[samples - 1],
+            out.final_state[n]
+        );
+        assert_eq!(
+            field.resonator_velocity[samples - 1],
+            out.final_state[nd + n]
+        );
+        // At t = 0 only the impulse site moves, and the resonator is at rest.
+        assert_eq!(
+            (field.resonator_displacement[0], field.resonator_velocity[0]),
+            (0.0, 0.0)
         );
     }
 
