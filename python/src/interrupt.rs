@@ -15,7 +15,7 @@
 
 use std::cell::{Cell, RefCell};
 use std::panic::AssertUnwindSafe;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use pyo3::prelude::*;
@@ -28,9 +28,19 @@ use crate::SimulationError;
 /// plus one sample interval of the slowest running scene.
 const POLL: Duration = Duration::from_millis(50);
 
+/// What the thread holding the GIL calls every [`POLL`] while work runs, and once when it is
+/// done: a progress report. An error it returns stops the work and is raised, as a signal is.
+pub(crate) type Poll<'a> = &'a (dyn Fn(Python<'_>) -> PyResult<()> + Sync);
+
+/// A [`Poll`] that reports nothing.
+pub(crate) fn quiet(_: Python<'_>) -> PyResult<()> {
+    Ok(())
+}
+
 /// Runs `work` on this thread with the GIL released. `work` gets a stop check to poll (at
 /// every sample): it is true once Python has a pending signal, whose exception is then raised.
-pub(crate) fn on_this_thread<T, F>(py: Python<'_>, work: F) -> PyResult<T>
+/// `poll` runs whenever the stop check takes the GIL, and once at the end.
+pub(crate) fn on_this_thread<T, F>(py: Python<'_>, poll: Poll<'_>, work: F) -> PyResult<T>
 where
     T: Send,
     F: FnOnce(&dyn Fn() -> bool) -> T + Send,
@@ -47,7 +57,7 @@ where
                 return false;
             }
             next_check.set(now + POLL);
-            match Python::attach(|py| py.check_signals()) {
+            match Python::attach(|py| py.check_signals().and_then(|()| poll(py))) {
                 Ok(()) => false,
                 Err(e) => {
                     *signal.borrow_mut() = Some(e);
@@ -61,7 +71,9 @@ where
     if let Some(signal) = signal {
         return Err(signal);
     }
-    result.map_err(|panic| internal_error(&panic))
+    let result = result.map_err(|panic| internal_error(&panic))?;
+    poll(py)?;
+    Ok(result)
 }
 
 /// Runs `work` on a worker thread with the GIL released, raising the pending signal's
@@ -71,7 +83,7 @@ where
     T: Send,
     F: FnOnce(&AtomicBool) -> T + Send,
 {
-    match interruptible_keeping(py, work)? {
+    match interruptible_keeping(py, &quiet, work)? {
         (_, Some(signal)) => Err(signal),
         (value, None) => Ok(value),
     }
@@ -79,7 +91,12 @@ where
 
 /// [`interruptible`], keeping what the work returned after it was stopped: the work's value
 /// and the signal's exception, if one arrived (a sweep's finished points survive Ctrl-C).
-pub(crate) fn interruptible_keeping<T, F>(py: Python<'_>, work: F) -> PyResult<(T, Option<PyErr>)>
+/// `poll` runs every [`POLL`] while the work runs, and once when it is done.
+pub(crate) fn interruptible_keeping<T, F>(
+    py: Python<'_>,
+    poll: Poll<'_>,
+    work: F,
+) -> PyResult<(T, Option<PyErr>)>
 where
     T: Send,
     F: FnOnce(&AtomicBool) -> T + Send,
@@ -98,10 +115,15 @@ where
         while !done.load(Ordering::Acquire) {
             py.detach(|| std::thread::park_timeout(POLL));
             if interrupted.is_none() {
-                if let Err(signal) = py.check_signals() {
+                if let Err(signal) = py.check_signals().and_then(|()| poll(py)) {
                     cancel.store(true, Ordering::Relaxed);
                     interrupted = Some(signal);
                 }
+            }
+        }
+        if interrupted.is_none() {
+            if let Err(e) = poll(py) {
+                interrupted = Some(e);
             }
         }
         match (py.detach(|| worker.join()), interrupted) {
@@ -133,7 +155,7 @@ pub(crate) fn internal_message(panic: &Box<dyn std::any::Any + Send>) -> String 
 #[pyfunction]
 #[pyo3(name = "_panic_in_worker")]
 pub(crate) fn panic_in_worker(py: Python<'_>) -> PyResult<()> {
-    let here = on_this_thread(py, |_| -> () {
+    let here = on_this_thread(py, &quiet, |_| -> () {
         panic!("deliberate panic on the calling thread")
     });
     let worker = interruptible(py, |_| -> () {
@@ -151,20 +173,46 @@ fn panic_message(panic: &Box<dyn std::any::Any + Send>) -> String {
         .unwrap_or_else(|| "panic".into())
 }
 
-/// An observer that also stops its run when `stop()` says so.
+/// An observer that also stops its run when `stop()` says so, and, with a `clock`, says
+/// where the run is.
 pub(crate) struct Watch<'a, O, C: Fn() -> bool + ?Sized> {
     pub(crate) inner: O,
     pub(crate) stop: &'a C,
+    pub(crate) clock: Option<&'a Clock>,
 }
 
 impl<O: Observer, C: Fn() -> bool + ?Sized> Observer for Watch<'_, O, C> {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
         self.inner.observe(model, t, y);
+        if let Some(clock) = self.clock {
+            clock.t.store(t.to_bits(), Ordering::Relaxed);
+        }
     }
     fn reset(&mut self) {
         self.inner.reset();
+        if let Some(clock) = self.clock {
+            clock.runs.fetch_add(1, Ordering::Relaxed);
+        }
     }
     fn cancelled(&self) -> bool {
         (self.stop)() || self.inner.cancelled()
+    }
+}
+
+/// Where one scene's run is, for its progress line: the time of its last sample, and how
+/// many runs `auto`'s ladder has started (each repeats the observation from t = 0).
+#[derive(Debug, Default)]
+pub(crate) struct Clock {
+    t: AtomicU64,
+    runs: AtomicUsize,
+}
+
+impl Clock {
+    /// (run, t): the run under way (1 for the first) and its last sample's time.
+    pub(crate) fn read(&self) -> (usize, f64) {
+        (
+            self.runs.load(Ordering::Relaxed) + 1,
+            f64::from_bits(self.t.load(Ordering::Relaxed)),
+        )
     }
 }

@@ -56,6 +56,7 @@ pub(crate) fn simulate_one(scene: &Scene, cancel: &AtomicBool) -> Result<Outcome
         let mut watched = Watch {
             inner: (),
             stop: &stop,
+            clock: None,
         };
         let mut outcome = simulate(&scene.scenario, &mut watched).map_err(|e| e.to_string())?;
         outcome.final_state = Vec::new();

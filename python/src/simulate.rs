@@ -13,7 +13,7 @@ use woodpile_sim::observe::SiteField;
 use woodpile_sim::run::simulate as run;
 use woodpile_sim::SimError;
 
-use crate::interrupt::{on_this_thread, Watch};
+use crate::interrupt::{on_this_thread, Clock, Watch};
 use crate::scene_input::{shown, Source};
 use crate::series;
 use crate::{SceneError, SimulationError};
@@ -26,13 +26,14 @@ use woodpile_points::Series;
 /// `series` (t, R, T, E_tr, E arrays, S with a striker, D with damping) and, when a field is asked for, `t`, `sites`,
 /// `velocity` and `displacement`.
 #[pyfunction]
-#[pyo3(signature = (scene, fields = false, field_sites = None, series = None))]
+#[pyo3(signature = (scene, fields = false, field_sites = None, series = None, progress = None))]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     fields: bool,
     field_sites: Option<(i64, i64)>,
     series: Option<&Bound<'py, PyAny>>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = match series {
         Some(value) => series::parse(value, false)?.unwrap_or(Series::Energy),
@@ -54,7 +55,17 @@ pub(crate) fn simulate<'py>(
         SiteField::check_size(s, last - first + 1)
             .map_err(|reason| SceneError::new_err(format!("{label}: field: {reason}")))?;
     }
-    let (outcome, wall_s, series, field) = on_this_thread(py, |stop| {
+    // `progress(run, t, t_end)`: the run of `auto`'s ladder under way and its last sample.
+    let clock = Clock::default();
+    let t_end = s.t_end;
+    let poll = |py: Python<'_>| -> PyResult<()> {
+        let Some(callback) = &progress else {
+            return Ok(());
+        };
+        let (run, t) = clock.read();
+        callback.call1(py, (run, t, t_end)).map(|_| ())
+    };
+    let (outcome, wall_s, series, field) = on_this_thread(py, &poll, |stop| {
         let series = recorder;
         let started = Instant::now();
         match sites {
@@ -63,6 +74,7 @@ pub(crate) fn simulate<'py>(
                 let mut watched = Watch {
                     inner: (series, field),
                     stop,
+                    clock: Some(&clock),
                 };
                 let outcome = run(s, &mut watched);
                 let (series, field) = watched.inner;
@@ -72,6 +84,7 @@ pub(crate) fn simulate<'py>(
                 let mut watched = Watch {
                     inner: series,
                     stop,
+                    clock: Some(&clock),
                 };
                 let outcome = run(s, &mut watched);
                 (outcome, started.elapsed(), watched.inner, None)

@@ -6,7 +6,7 @@
 
 use std::panic::AssertUnwindSafe;
 use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -18,13 +18,13 @@ use woodpile_scene::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
 
-use crate::interrupt::{internal_message, interruptible, interruptible_keeping};
+use crate::interrupt::{internal_message, interruptible_keeping};
 use crate::listed::{outcome_rows, table_dict};
 use crate::scene_input::{self, shown, Source};
 use crate::series;
 use crate::SceneError;
 
-/// _sweep(scene, axes, series=None, cache=None) -> dict
+/// _sweep(scene, axes, series=None, cache=None, progress=None) -> dict
 /// --
 ///
 /// The native call behind `woodpile.sweep`: the sweep stage's table, as `names` (the columns
@@ -33,13 +33,14 @@ use crate::SceneError;
 /// written to that point store. Ctrl-C raises `KeyboardInterrupt` whose `partial` holds the
 /// table of the points finished so far.
 #[pyfunction]
-#[pyo3(signature = (scene, axes, series = None, cache = None))]
+#[pyo3(signature = (scene, axes, series = None, cache = None, progress = None))]
 pub(crate) fn sweep<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     axes: &Bound<'py, PyDict>,
     series: Option<&Bound<'py, PyAny>>,
     cache: Option<PathBuf>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = match series {
         Some(value) => series::parse(value, true)?,
@@ -64,13 +65,14 @@ pub(crate) fn sweep<'py>(
         series: kind.unwrap_or(Series::Energy),
         every_sample: kind.is_some(),
         store: store.as_ref(),
+        done: AtomicUsize::new(0),
     };
     let shape = SweepShape {
         axes: &grid.axes,
         with_striker: first.scenario.region.has_striker(),
         with_dissipation: grid.template.declares_dissipation(),
     };
-    run.table(py, count, shape)
+    run.table(py, count, shape, progress.as_ref())
 }
 
 /// The point store in `dir`, refused (as the pipeline refuses its own) when it is a symbolic
@@ -158,6 +160,8 @@ struct Run<'a> {
     /// Every sample of each point, or its last one only.
     every_sample: bool,
     store: Option<&'a PointStore>,
+    /// Points finished so far, for the progress line.
+    done: AtomicUsize,
 }
 
 impl Run<'_> {
@@ -169,8 +173,10 @@ impl Run<'_> {
         py: Python<'py>,
         count: usize,
         shape: SweepShape<'_>,
+        progress: Option<&Py<PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let (points, signal) = interruptible_keeping(py, |cancel| {
+        let poll = |py: Python<'_>| points_done(py, progress, &self.done, count);
+        let (points, signal) = interruptible_keeping(py, &poll, |cancel| {
             crate::pool::run_parallel(|| {
                 (0..count)
                     .into_par_iter()
@@ -252,11 +258,29 @@ impl Run<'_> {
             true => r,
             false => r.map(|p| p.last_sample()),
         });
+        if result.is_some() {
+            self.done.fetch_add(1, Ordering::Relaxed);
+        }
         Ok(result.map(|r| (key, r)))
     }
 }
 
-/// _simulate_many(scenes) -> dict
+/// Calls `progress(done, total)`, if given.
+fn points_done(
+    py: Python<'_>,
+    progress: Option<&Py<PyAny>>,
+    done: &AtomicUsize,
+    total: usize,
+) -> PyResult<()> {
+    match progress {
+        Some(callback) => callback
+            .call1(py, (done.load(Ordering::Relaxed), total))
+            .map(|_| ()),
+        None => Ok(()),
+    }
+}
+
+/// _simulate_many(scenes, progress=None) -> dict
 /// --
 ///
 /// The native call behind `woodpile.simulate_many`: every scene of the list (dicts, TOML
@@ -264,9 +288,11 @@ impl Run<'_> {
 /// order, as `_sweep` returns its points. A scene that fails to simulate is a row with its
 /// reason; one that is invalid is a `SceneError` naming its index.
 #[pyfunction]
+#[pyo3(signature = (scenes, progress = None))]
 pub(crate) fn simulate_many<'py>(
     py: Python<'py>,
     scenes: &Bound<'py, PyAny>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut list = Vec::new();
     for (index, item) in scenes.try_iter()?.enumerate() {
@@ -276,14 +302,23 @@ pub(crate) fn simulate_many<'py>(
             .map_err(|e| SceneError::new_err(format!("scenes[{index}]: {}", e.value(py))))?;
         list.push(scene);
     }
-    let outcomes = interruptible(py, |cancel| {
+    let done = AtomicUsize::new(0);
+    let poll = |py: Python<'_>| points_done(py, progress.as_ref(), &done, list.len());
+    let (outcomes, signal) = interruptible_keeping(py, &poll, |cancel| {
         crate::pool::run_parallel(|| {
             list.par_iter()
-                .map(|scene| crate::listed::simulate_one(scene, cancel))
+                .map(|scene| {
+                    let outcome = crate::listed::simulate_one(scene, cancel);
+                    done.fetch_add(1, Ordering::Relaxed);
+                    outcome
+                })
                 .collect::<Vec<_>>()
         })
-    })?
-    .map_err(PyValueError::new_err)?;
+    })?;
+    if let Some(signal) = signal {
+        return Err(signal);
+    }
+    let outcomes = outcomes.map_err(PyValueError::new_err)?;
     let dissipation = list.iter().any(|s| s.scenario.model.is_dissipative());
     table_dict(py, &outcome_rows(&outcomes, dissipation))
 }

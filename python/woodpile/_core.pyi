@@ -1,7 +1,7 @@
 """Type stubs of the native module (``woodpile._core``); use the ``woodpile`` package's API."""
 
 import os
-from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 Scene = Union[Dict[str, Any], str, "os.PathLike[str]"]
 
@@ -15,14 +15,18 @@ def simulate(
     fields: bool = False,
     field_sites: Optional[Tuple[int, int]] = None,
     series: str = "energy",
+    progress: Optional[Callable[[int, float, float], None]] = None,
 ) -> Dict[str, Any]: ...
 def sweep(
     scene: Scene,
     axes: Mapping[str, Any],
     series: Union[bool, str] = False,
     cache: Optional[str] = None,
+    progress: Optional[Callable[[int, int], None]] = None,
 ) -> Dict[str, Any]: ...
-def simulate_many(scenes: Sequence[Scene]) -> Dict[str, Any]: ...
+def simulate_many(
+    scenes: Sequence[Scene], progress: Optional[Callable[[int, int], None]] = None
+) -> Dict[str, Any]: ...
 def scene_toml(scene: Scene) -> str: ...
 
 def table_integrity(data: bytes) -> str:

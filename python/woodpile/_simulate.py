@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
+from ._progress import Progress
 
 Scene = Union[Dict[str, Any], str, "os.PathLike[str]"]
 
@@ -172,6 +173,7 @@ def simulate(
     fields: bool = False,
     field_sites: Optional[Tuple[int, int]] = None,
     series: str = "energy",
+    progress: Optional[bool] = None,
 ) -> SimulationResult:
     """Simulate one scene and return its fractions, series and (optionally) field.
 
@@ -185,6 +187,9 @@ def simulate(
         series: what ``series`` splits: ``"energy"`` (shares of the total energy) or
             ``"kinetic"`` (kinetic energy over the impact energy, the woodpile experiment's
             measure, paper Fig. 2).
+        progress: a line on stderr with the run of ``auto``'s ladder under way and its time:
+            ``True`` always, ``False`` never, ``None`` (the default) in a terminal or a
+            notebook once the run has taken two seconds.
 
     Returns:
         A ``SimulationResult``: ``R``, ``T``, ``E_tr`` (fractions at ``t_end``),
@@ -203,7 +208,12 @@ def simulate(
 
     The GIL is released while the scene runs, so other Python threads go on.
     """
-    result = SimulationResult(_core.simulate(scene, fields, field_sites, series))
+    bar = Progress("simulate", progress)
+    try:
+        raw = _core.simulate(scene, fields, field_sites, series, bar.run)
+    finally:
+        bar.close()
+    result = SimulationResult(raw)
     reached = result.end_reached_at
     if reached is not None and reached < result.t_end:
         warnings.warn(

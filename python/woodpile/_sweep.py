@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
+from ._progress import Progress
 from ._simulate import Scene
 
 Axis = Union[Sequence[float], Sequence[int], "np.ndarray", Mapping[str, float]]
@@ -20,6 +21,7 @@ def sweep(
     *,
     series: Union[bool, str] = False,
     cache: Optional[Union[str, "os.PathLike[str]"]] = None,
+    progress: Optional[bool] = None,
 ) -> pd.DataFrame:
     """Simulate every point of a grid of scenes, on all cores, and return one table.
 
@@ -42,6 +44,9 @@ def sweep(
             your own): points found there are read, not simulated, and every point simulated
             is stored there the moment it finishes, so a sweep stopped by Ctrl-C or a crash
             resumes with only the missing points to run.
+        progress: a line on stderr with the points done, the rate and the time left:
+            ``True`` always, ``False`` never, ``None`` (the default) in a terminal or a
+            notebook once the sweep has run two seconds.
 
     Returns:
         A DataFrame with a sweep stage's columns: ``point``, the axes (integer axes as
@@ -61,22 +66,26 @@ def sweep(
     The GIL is released while the sweep runs.
     """
     path = None if cache is None else os.fspath(cache)
+    bar = Progress("sweep", progress)
     try:
-        return _frame(_core.sweep(scene, dict(axes), series, path))
+        return _frame(_core.sweep(scene, dict(axes), series, path, bar.points))
     except KeyboardInterrupt as stopped:
         partial = getattr(stopped, "partial", None)
         if isinstance(partial, dict):
             stopped.partial = _frame(partial)
         raise
+    finally:
+        bar.close()
 
 
-def simulate_many(scenes: Sequence[Scene]) -> pd.DataFrame:
+def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -> pd.DataFrame:
     """Simulate any list of scenes on all cores, with the GIL released: the points an
     optimiser picks rather than a grid (SciPy's ``differential_evolution`` with
     ``vectorized=True`` hands over a population at once).
 
     Args:
         scenes: dicts with the keys of a scene file, TOML strings or paths, in any mix.
+        progress: a progress line on stderr, as ``sweep``'s.
 
     Returns:
         A DataFrame with one row per scene, in input order: ``point`` (the scene's index),
@@ -89,7 +98,11 @@ def simulate_many(scenes: Sequence[Scene]) -> pd.DataFrame:
         SceneError: a scene is invalid (the message names its index, ``scenes[i]``).
         KeyboardInterrupt: Ctrl-C stops the runs within about a second.
     """
-    return _frame(_core.simulate_many(list(scenes)))
+    bar = Progress("simulate_many", progress)
+    try:
+        return _frame(_core.simulate_many(list(scenes), bar.points))
+    finally:
+        bar.close()
 
 
 #: Integer columns that are null where a point failed: pandas' nullable integers.
