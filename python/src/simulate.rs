@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use woodpile_scene::report::{simulate_report, unverified_report};
 use woodpile_scene::Scene;
-use woodpile_sim::observe::SiteField;
+use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::run::simulate as run;
 use woodpile_sim::SimError;
 
@@ -95,6 +95,19 @@ pub(crate) fn simulate<'py>(
     let report = simulate_report(&scene, &outcome, wall_s.as_secs_f64());
     let out = PyDict::new(py);
     out.set_item("report", report.to_string())?;
+    out.set_item("series", series_columns(py, &scene, series)?)?;
+    if let Some(field) = field {
+        add_field(py, &out, &scene, field)?;
+    }
+    Ok(out)
+}
+
+/// The recorded series as arrays: t, R, T, E_tr, S (with a striker), D (with damping), E.
+fn series_columns<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    series: FractionSeries,
+) -> PyResult<Bound<'py, PyDict>> {
     let columns = PyDict::new(py);
     columns.set_item("t", series.t.into_pyarray(py))?;
     columns.set_item("R", series.reflected.into_pyarray(py))?;
@@ -107,11 +120,7 @@ pub(crate) fn simulate<'py>(
         columns.set_item("D", series.dissipated.into_pyarray(py))?;
     }
     columns.set_item("E", series.energy.into_pyarray(py))?;
-    out.set_item("series", columns)?;
-    if let Some(field) = field {
-        add_field(py, &out, &scene, field)?;
-    }
-    Ok(out)
+    Ok(columns)
 }
 
 /// Paper sites `(lo, hi)` as internal indices, or a `SceneError` naming the chain's range.
@@ -142,7 +151,10 @@ fn add_field(
         .collect();
     out.set_item("sites", sites.into_pyarray(py))?;
     out.set_item("velocity", grid(field.velocity, width)?.into_pyarray(py))?;
-    out.set_item("displacement", grid(field.displacement, width)?.into_pyarray(py))?;
+    out.set_item(
+        "displacement",
+        grid(field.displacement, width)?.into_pyarray(py),
+    )?;
     out.set_item("energy", grid(field.energy, width)?.into_pyarray(py))?;
     out.set_item("kinetic", grid(field.kinetic, width)?.into_pyarray(py))?;
     out.set_item("resonator_sites", resonator_sites.into_pyarray(py))?;

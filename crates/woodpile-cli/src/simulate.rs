@@ -286,6 +286,10 @@ fn per_site(scene: &Scene, field: &SiteField, values: &[f64]) -> Vec<Option<f64>
     }
     let count = resonators.len();
     (0..field.t.len())
-        .flat_map(|i| on_site.iter().map(move |j| j.map(|j| values[i * count + j])))
+        .flat_map(|i| {
+            on_site
+                .iter()
+                .map(move |j| j.map(|j| values[i * count + j]))
+        })
         .collect()
 }
