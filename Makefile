@@ -6,7 +6,7 @@ SCRATCH := scratch/check
 # Wall times (work-precision stages) belong to the machine that measured them: not compared.
 CHECK_TOL := --abs 1e-9 --rel 1e-9 --tol wall_ms=inf --tol log10_wall_ms=inf
 
-.PHONY: help build install audit test rust-test python python-test python-bench docs figures stage status check read-check bench unused-cost work-precision lint old-cpu-test slurm-test
+.PHONY: help build install audit test rust-test python python-test wheel wheel-test python-bench docs figures stage status check read-check bench unused-cost work-precision lint old-cpu-test slurm-test
 
 help: ## List the targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk 'BEGIN {FS = ":.*## "} {printf "  make %-11s %s\n", $$1, $$2}'
@@ -29,6 +29,30 @@ python-test: python build ## The Python package's tests and the quickstart noteb
 	$(PY) -m pip install --quiet --disable-pip-version-check pytest matplotlib nbclient nbformat ipykernel
 	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) -m pytest -q -p no:cacheprovider python/tests
 	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) scripts/run_notebook.py examples/quickstart.ipynb
+
+# The wheel: the native module and the `woodpile` command in one abi3 wheel, installable with
+# no Rust toolchain. Tested in its own venv, with cargo off the PATH.
+WHEEL_VENV := .wheel-venv
+NO_CARGO_PATH = $(shell python3 -c 'import os; print(os.pathsep.join(d for d in os.environ["PATH"].split(os.pathsep) if not os.path.exists(os.path.join(d, "cargo"))))')
+
+wheel: build ## Build dist/woodpile-*.whl: the native module and the woodpile command (abi3, Python >= 3.9)
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check "maturin>=1.9,<2"
+	rm -rf dist python/woodpile/bin
+	mkdir -p python/woodpile/bin
+	cp $(WOODPILE) python/woodpile/bin/woodpile
+	strip python/woodpile/bin/woodpile 2>/dev/null || true
+	$(VENV)/bin/maturin build --release --strip --out dist -m python/Cargo.toml; status=$$?; rm -rf python/woodpile/bin; exit $$status
+
+wheel-test: wheel ## Install the wheel into a fresh venv with no cargo on the PATH; its woodpile command, the Python tests and the notebook there
+	rm -rf $(WHEEL_VENV)
+	python3 -m venv $(WHEEL_VENV)
+	$(WHEEL_VENV)/bin/pip install --quiet --disable-pip-version-check "$$(ls dist/woodpile-*.whl)[notebook]" pytest nbclient nbformat
+	env -u WOODPILE_BIN WOODPILE_TEST_INSTALLED=1 PATH="$(abspath $(WHEEL_VENV))/bin:$(NO_CARGO_PATH)" sh -ec '\
+	  if command -v cargo; then echo "cargo is still on the PATH" >&2; exit 1; fi; \
+	  woodpile --version; \
+	  python -m pytest -q -p no:cacheprovider python/tests; \
+	  python scripts/run_notebook.py examples/quickstart.ipynb'
 
 python-bench: python build ## woodpile.simulate and woodpile.sweep against the Rust calls (docs/performance.md)
 	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) python/benches/bench.py

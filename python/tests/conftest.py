@@ -13,9 +13,10 @@ REPO = Path(__file__).resolve().parents[2]
 SCENES = sorted((REPO / "scenes").glob("*.toml"))
 
 # The package never searches build folders; its tests use this clone's release build when no
-# command is named (`make python-test` names it).
+# command is named (`make python-test` names it), except when they test an installed wheel
+# (`make wheel-test`), whose own command they must find.
 _BUILT = REPO / "target" / "release" / "woodpile"
-if _BUILT.is_file():
+if _BUILT.is_file() and not os.environ.get("WOODPILE_TEST_INSTALLED"):
     os.environ.setdefault("WOODPILE_BIN", str(_BUILT))
 
 

@@ -1,5 +1,7 @@
 """`woodpile.Pipeline` on a small project in a temporary folder."""
 
+import os
+
 import pytest
 
 import woodpile
@@ -98,6 +100,54 @@ def test_the_command_is_never_taken_from_a_build_folder(monkeypatch, tmp_path):
             _pipeline.find_woodpile()
     monkeypatch.setenv("WOODPILE_BIN", "/opt/woodpile")
     assert _pipeline.find_woodpile() == "/opt/woodpile"
+
+
+def test_the_woodpile_script_forwards_to_the_command_and_is_never_taken_for_it(
+    monkeypatch, tmp_path, woodpile_bin
+):
+    """The package's `woodpile` script runs the real command; looking the command up on the
+    PATH passes the script over."""
+    import subprocess
+    import sys
+
+    from woodpile import _pipeline
+
+    script, real = tmp_path / "venv-bin", tmp_path / "cargo-bin"
+    script.mkdir()
+    real.mkdir()
+    (script / "woodpile").write_text(
+        "#!/usr/bin/env python3\nfrom woodpile._cli import main\nmain()\n"
+    )
+    (real / "woodpile").write_text("#!/bin/sh\necho real \"$@\"\n")
+    for f in (script / "woodpile", real / "woodpile"):
+        f.chmod(0o755)
+    monkeypatch.delenv("WOODPILE_BIN", raising=False)
+    monkeypatch.setattr(_pipeline, "_packaged_binary", lambda: tmp_path / "absent")
+    monkeypatch.setenv("PATH", f"{script}:{real}")
+    assert _pipeline.find_woodpile() == str(real / "woodpile")
+    monkeypatch.setenv("PATH", str(script))
+    with pytest.raises(FileNotFoundError, match="make wheel"):
+        _pipeline.find_woodpile()
+    # The script itself: `woodpile --version` through it is the command's.
+    out = subprocess.run(
+        [sys.executable, "-m", "woodpile._cli", "--version"],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "WOODPILE_BIN": woodpile_bin},
+        check=True,
+    )
+    assert out.stdout.startswith("woodpile ")
+
+
+@pytest.mark.skipif(
+    not os.environ.get("WOODPILE_TEST_INSTALLED"), reason="tests an installed wheel (make wheel-test)"
+)
+def test_an_installed_wheel_drives_the_command_it_carries():
+    from woodpile import _pipeline
+
+    packaged = _pipeline._packaged_binary()
+    assert packaged.is_file() and os.access(packaged, os.X_OK)
+    assert _pipeline.find_woodpile() == str(packaged)
 
 
 def test_read_refuses_a_table_without_a_seal(small_pipeline):

@@ -13,7 +13,6 @@ from __future__ import annotations
 import io
 import json
 import os
-import shutil
 import subprocess
 import sys
 import threading
@@ -37,19 +36,34 @@ def _packaged_binary() -> Path:
 
 def find_woodpile() -> str:
     """The path of the ``woodpile`` command this package drives: ``$WOODPILE_BIN``, else the
-    one installed with the package, else ``woodpile`` on the PATH."""
+    one installed with the package (a wheel carries it), else ``woodpile`` on the PATH (the
+    package's own ``woodpile`` script, which only forwards here, is passed over)."""
     explicit = os.environ.get("WOODPILE_BIN")
     if explicit:
         return explicit
     packaged = _packaged_binary()
     if packaged.is_file() and os.access(packaged, os.X_OK):
         return str(packaged)
-    on_path = shutil.which("woodpile")
-    if on_path:
-        return on_path
+    for folder in os.environ.get("PATH", "").split(os.pathsep):
+        candidate = Path(folder or ".") / "woodpile"
+        if candidate.is_file() and os.access(candidate, os.X_OK) and not _forwards(candidate):
+            return str(candidate)
     raise FileNotFoundError(
-        "the woodpile command was not found: set WOODPILE_BIN to its path, or run `make install` in a clone to put it on the PATH"
+        "the woodpile command was not found: install the woodpile wheel (`make wheel` builds "
+        "it; it carries the command), set WOODPILE_BIN to its path, or run `make install` in "
+        "a clone to put it on the PATH"
     )
+
+
+def _forwards(path: Path) -> bool:
+    """Whether ``path`` is this package's ``woodpile`` script (a few lines of Python that
+    forward to the real command), not the command itself."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(1024)
+    except OSError:
+        return False
+    return head.startswith(b"#!") and b"woodpile._cli" in head
 
 
 class Pipeline:
