@@ -8,6 +8,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use woodpile_scene::report::{simulate_report, unverified_report};
+use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::run::simulate as run;
@@ -26,7 +27,7 @@ use woodpile_points::Series;
 /// `series` (t, R, T, E_tr, E arrays, S with a striker, D with damping) and, when a field is asked for, `t`, `sites`,
 /// `velocity` and `displacement`.
 #[pyfunction]
-#[pyo3(signature = (scene, fields = false, field_sites = None, series = None, progress = None))]
+#[pyo3(signature = (scene, fields = false, field_sites = None, series = None, progress = None, units = "scaled"))]
 pub(crate) fn simulate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -34,6 +35,7 @@ pub(crate) fn simulate<'py>(
     field_sites: Option<(i64, i64)>,
     series: Option<&Bound<'py, PyAny>>,
     progress: Option<Py<PyAny>>,
+    units: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = match series {
         Some(value) => series::parse(value, false)?.unwrap_or(Series::Energy),
@@ -42,6 +44,9 @@ pub(crate) fn simulate<'py>(
     let source = Source::of(scene)?;
     let label = shown(&source.label());
     let scene = source.scene()?;
+    let si = Units::parse(units)
+        .and_then(|units| SiFactors::of(&scene, units))
+        .map_err(|reason| SceneError::new_err(format!("{label}: units: {reason}")))?;
     let recorder = kind
         .recorder(&scene.scenario)
         .map_err(|reason| SceneError::new_err(format!("{label}: series: {reason}")))?;
@@ -92,7 +97,15 @@ pub(crate) fn simulate<'py>(
         }
     })?;
     let outcome = outcome.map_err(|e| failure(py, &scene, &label, e))?;
-    let report = simulate_report(&scene, &outcome, wall_s.as_secs_f64());
+    let mut report = simulate_report(&scene, &outcome, wall_s.as_secs_f64());
+    let (mut series, mut field) = (series, field);
+    if let Some(si) = si {
+        si.report(&mut report);
+        si.series(&mut series, kind == Series::Kinetic);
+        if let Some(field) = field.as_mut() {
+            si.field(field);
+        }
+    }
     let out = PyDict::new(py);
     out.set_item("report", report.to_string())?;
     out.set_item("series", series_columns(py, &scene, series)?)?;

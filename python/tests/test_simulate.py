@@ -206,3 +206,33 @@ def test_a_wave_reaching_an_end_before_t_end_warns():
     with pytest.warns(woodpile.EndReachedWarning, match="reached an end of the chain"):
         r = woodpile.simulate(short)
     assert 10.0 < r.end_reached_at < 60.0
+
+
+def test_si_outputs_of_a_physical_scene():
+    path = REPO / "scenes" / "woodpile_experiment.toml"
+    scaled = woodpile.simulate(path, fields=True)
+    si = woodpile.simulate(path, fields=True, units="SI")
+    assert (scaled.units, si.units) == ("scaled", "SI")
+    mass, velocity = 0.866e-3, 1.98  # the scene's [physical] mass (kg) and velocity (m/s)
+    time_s, length_m = si.physical["time_scale_s"], si.physical["length_scale_m"]
+    energy_j = mass * velocity**2
+    assert si.t_end == scaled.t_end * time_s
+    np.testing.assert_array_equal(si.t, scaled.t * time_s)
+    np.testing.assert_array_equal(si.series.E, scaled.series.E * energy_j)
+    assert si.E_initial == scaled.E_initial * energy_j
+    np.testing.assert_array_equal(si.displacement, scaled.displacement * length_m)
+    np.testing.assert_array_equal(si.velocity, scaled.velocity * velocity)
+    np.testing.assert_array_equal(si.energy, scaled.energy * energy_j)
+    # The struck rod's kinetic energy at t = 0 is the impact's: M V^2 / 2 joules.
+    assert si.kinetic[0].max() == pytest.approx(0.5 * mass * velocity**2, rel=1e-12)
+    # Shares have no unit.
+    assert (si.R, si.T, si.E_tr) == (scaled.R, scaled.T, scaled.E_tr)
+    np.testing.assert_array_equal(si.series.R, scaled.series.R)
+
+
+def test_si_outputs_need_a_physical_scene():
+    with pytest.raises(woodpile.SceneError, match="units: SI outputs need a \\[physical\\] scene"):
+        woodpile.simulate(STANDARD, units="SI")
+    with pytest.raises(woodpile.SceneError, match="units: expected"):
+        woodpile.simulate(STANDARD, units="metric")
+    assert woodpile.simulate(STANDARD).units is None

@@ -16,6 +16,7 @@ def simulate(
     field_sites: Optional[Tuple[int, int]] = None,
     series: str = "energy",
     progress: Optional[Callable[[int, float, float], None]] = None,
+    units: str = "scaled",
 ) -> Dict[str, Any]: ...
 def sweep(
     scene: Scene,

@@ -74,6 +74,7 @@ class SimulationResult:
     wall_s: float
     version: str
     physical: Optional[Dict[str, Any]]
+    units: Optional[str]
     end_reached_at: Optional[float]
 
     t: np.ndarray
@@ -91,6 +92,7 @@ class SimulationResult:
         for key, value in self._report.items():
             setattr(self, key, value)
         self.physical = self._report.get("physical")
+        self.units = self._report.get("units")
         self.S = self._report.get("S")
         self.D = self._report.get("D")
         self._series_columns: Dict[str, np.ndarray] = raw["series"]
@@ -174,6 +176,7 @@ def simulate(
     field_sites: Optional[Tuple[int, int]] = None,
     series: str = "energy",
     progress: Optional[bool] = None,
+    units: str = "scaled",
 ) -> SimulationResult:
     """Simulate one scene and return its fractions, series and (optionally) field.
 
@@ -190,6 +193,11 @@ def simulate(
         progress: a line on stderr with the run of ``auto``'s ladder under way and its time:
             ``True`` always, ``False`` never, ``None`` (the default) in a terminal or a
             notebook once the run has taken two seconds.
+        units: ``"scaled"`` (the model's units, the default) or ``"SI"`` for a ``[physical]``
+            scene: times in s (``t``, ``t_end``, ``dt``, ``end_reached_at``), displacements in
+            m, velocities in m/s and energies in J (``E_initial``, ``E_final``, the series'
+            ``E`` unless it is a kinetic share, the field's ``energy`` and ``kinetic``). The
+            shares have no unit. ``result.units`` says which, for a ``[physical]`` scene.
 
     Returns:
         A ``SimulationResult``: ``R``, ``T``, ``E_tr`` (fractions at ``t_end``),
@@ -210,7 +218,7 @@ def simulate(
     """
     bar = Progress("simulate", progress)
     try:
-        raw = _core.simulate(scene, fields, field_sites, series, bar.run)
+        raw = _core.simulate(scene, fields, field_sites, series, bar.run, units)
     finally:
         bar.close()
     result = SimulationResult(raw)

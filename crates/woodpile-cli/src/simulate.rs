@@ -11,9 +11,10 @@ use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::{self, Columns};
 use woodpile_points::canonical::{code_version, scene_json, Key};
 use woodpile_scene::report::{simulate_report, unverified_report, wall_note};
+use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
-use woodpile_sim::run::{simulate, Outcome};
+use woodpile_sim::run::simulate;
 use woodpile_sim::SimError;
 
 use crate::Failure;
@@ -43,6 +44,11 @@ pub(crate) struct Args {
         allow_hyphen_values = true
     )]
     sites: Option<String>,
+    /// Give times in s, displacements in m, velocities in m/s and energies in J, in the JSON
+    /// object and the --series and --field tables (a `[physical]` scene only; shares have no
+    /// unit).
+    #[arg(long)]
+    si: bool,
 }
 
 pub(crate) fn run(args: &Args) -> Result<(), Failure> {
@@ -50,6 +56,9 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     check_outputs(args).map_err(Failure::input)?;
     let s = &scene.scenario;
     let sites = field_sites(&scene, args.sites.as_deref()).map_err(Failure::input)?;
+    let units = if args.si { Units::Si } else { Units::Scaled };
+    let si = SiFactors::of(&scene, units)
+        .map_err(|reason| Failure::input(anyhow!("--si: {}: {reason}", args.scene.display())))?;
     if args.field.is_some() {
         SiteField::check_size(s, sites.1 - sites.0 + 1)
             .map_err(|reason| Failure::input(anyhow!("--field: {reason}")))?;
@@ -80,16 +89,21 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         .with_context(|| format!("{}: simulation failed", args.scene.display()))
         .map_err(Failure::simulation)?;
     let wall_s = started.elapsed().as_secs_f64();
-    let report = simulate_report(&scene, &outcome, wall_s);
+    let mut report = simulate_report(&scene, &outcome, wall_s);
     if let Some(note) = wall_note(&scene, &outcome) {
         eprintln!("note: {}: {note}", args.scene.display());
     }
-    let (series, field) = observers;
+    let (mut series, mut field) = observers;
+    if let Some(si) = si {
+        si.report(&mut report);
+        si.series(&mut series, false);
+        si.field(&mut field);
+    }
     if let Some(path) = &args.series {
-        write_series(path, &args.scene, &scene, &outcome, &series)?;
+        write_series(path, &args.scene, &scene, &report, &series)?;
     }
     if let Some(path) = &args.field {
-        write_field(path, &args.scene, &scene, &outcome, &field)?;
+        write_field(path, &args.scene, &scene, &report, &field)?;
     }
     let text = crate::reports::json_text(&report, args.pretty);
     say!("{}", text.map_err(Failure::simulation)?);
@@ -175,9 +189,15 @@ fn field_sites(scene: &Scene, spec: Option<&str>) -> anyhow::Result<(usize, usiz
 
 /// A table's manifest: what was simulated (the resolved scene, which the key hashes) and what
 /// came of it (the JSON report, without its wall time, so the same scene writes the same bytes).
-fn manifest(what: &str, file: &Path, scene: &Scene, out: &Outcome, extra: Value) -> Manifest {
-    let params = json!({"scene": scene_json(scene), "table": what, "extra": extra});
-    let mut summary = simulate_report(scene, out, 0.0);
+/// The manifest of a `--series` or `--field` table: its key from the scene, the table and its
+/// units (SI tables only, so scaled ones keep their keys), its summary the run's JSON object
+/// without its wall time.
+fn manifest(what: &str, file: &Path, scene: &Scene, report: &Value, extra: Value) -> Manifest {
+    let mut params = json!({"scene": scene_json(scene), "table": what, "extra": extra});
+    if report["units"] == Units::Si.name() {
+        params["units"] = json!(Units::Si.name());
+    }
+    let mut summary = report.clone();
     if let Value::Object(map) = &mut summary {
         map.remove("wall_s");
     }
@@ -202,7 +222,7 @@ fn write_series(
     path: &Path,
     file: &Path,
     scene: &Scene,
-    out: &Outcome,
+    report: &Value,
     series: &FractionSeries,
 ) -> Result<(), Failure> {
     let some = |v: &[f64]| v.iter().map(|x| Some(*x)).collect::<Vec<_>>();
@@ -223,7 +243,7 @@ fn write_series(
     table::write(
         path,
         frame,
-        &manifest("series", file, scene, out, Value::Null),
+        &manifest("series", file, scene, report, Value::Null),
     )
     .map_err(Failure::input)
 }
@@ -232,7 +252,7 @@ fn write_field(
     path: &Path,
     file: &Path,
     scene: &Scene,
-    out: &Outcome,
+    report: &Value,
     field: &SiteField,
 ) -> Result<(), Failure> {
     let width = field.width();
@@ -269,7 +289,8 @@ fn write_field(
         );
     let frame = columns.into_frame().map_err(Failure::simulation)?;
     let sites = json!([first, first + width as i64 - 1]);
-    table::write(path, frame, &manifest("field", file, scene, out, sites)).map_err(Failure::input)
+    table::write(path, frame, &manifest("field", file, scene, report, sites))
+        .map_err(Failure::input)
 }
 
 /// A resonator column (time × resonator) in the field's long form (time × site): each site's

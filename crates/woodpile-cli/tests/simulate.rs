@@ -124,6 +124,77 @@ fn physical_scene_reports_derived_parameters() {
     assert!(v["physical"]["time_scale_s"].as_f64().unwrap() > 0.0);
 }
 
+/// `--si` gives a physical scene's times in s and energies in J, in the JSON object and in the
+/// series table, and says so; shares keep their values; a dimensionless scene is refused.
+#[test]
+fn si_outputs_of_a_physical_scene() {
+    let text = "[chain]\nn = 20\nboundary = \"free\"\n[impulse]\nsite = -19\n[physical]\ncontact = 2.47e9\nmass = 0.866e-3\nvelocity = 1.98\n[run]\nt_end = 10.0\nmethod = \"rk4\"\ndt = 0.01\n";
+    let path = scene_file(text);
+    let dir = path.parent().unwrap().to_path_buf();
+    let series = |name: &str| {
+        dir.join(format!(
+            "{name}-{}.parquet",
+            COUNTER.fetch_add(1, Ordering::SeqCst)
+        ))
+    };
+    let (scaled_table, si_table) = (series("scaled"), series("si"));
+    let run = |extra: &[&str], table: &Path| {
+        let out = simulate_command(&path)
+            .args(extra)
+            .arg("--series")
+            .arg(table)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let scaled = run(&[], &scaled_table);
+    let si = run(&["--si"], &si_table);
+    assert_eq!(
+        (scaled["units"].as_str(), si["units"].as_str()),
+        (Some("scaled"), Some("SI"))
+    );
+    let time_s = si["physical"]["time_scale_s"].as_f64().unwrap();
+    let energy_j = 0.866e-3 * 1.98 * 1.98;
+    // serde_json reads floats to within an ulp, not always exactly: compare so.
+    let close = |a: f64, b: f64| (a - b).abs() <= 4.0 * f64::EPSILON * b.abs();
+    assert!(close(si["t_end"].as_f64().unwrap(), 10.0 * time_s));
+    let e = |v: &serde_json::Value| v["E_initial"].as_f64().unwrap();
+    assert!(close(e(&si), e(&scaled) * energy_j));
+    assert!(
+        (e(&si) - 0.5 * energy_j).abs() <= 1e-12 * energy_j,
+        "the impact's M V^2 / 2"
+    );
+    assert_eq!(si["R"], scaled["R"]);
+    let (a, b) = (
+        woodpile_pipeline::table::read(&scaled_table).unwrap(),
+        woodpile_pipeline::table::read(&si_table).unwrap(),
+    );
+    let column = |f, c: &str| woodpile_pipeline::table::f64_column(f, c).unwrap();
+    let t_scaled: Vec<f64> = column(&a, "t")
+        .into_iter()
+        .flatten()
+        .map(|t| t * time_s)
+        .collect();
+    let t_si: Vec<f64> = column(&b, "t").into_iter().flatten().collect();
+    assert_eq!(t_si.len(), t_scaled.len());
+    assert!(t_si.iter().zip(&t_scaled).all(|(a, b)| close(*a, *b)));
+    assert_eq!(column(&b, "R"), column(&a, "R"));
+
+    let (plain, _) = simulate("[run]\nt_end = 10.0\n");
+    assert!(plain.status.success());
+    let out = simulate_command(&scene_file("[run]\nt_end = 10.0\n"))
+        .arg("--si")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--si:"));
+}
+
 /// Each bad scene exits 2 with a message naming the file, the key and the reason.
 #[test]
 fn bad_scenes_exit_nonzero_with_a_clear_message() {

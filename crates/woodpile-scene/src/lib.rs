@@ -12,6 +12,7 @@ pub mod report;
 mod resolve;
 pub mod template;
 pub mod threads;
+pub mod units_out;
 
 pub use resolve::{DerivedDefect, Physical, Scene, DEFAULT_RESONATOR_SHARE};
 

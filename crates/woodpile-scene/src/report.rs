@@ -61,6 +61,8 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         for (name, value) in &p.derived {
             report["physical"][name] = json!(value);
         }
+        // The model's scaled units, until `units_out::SiFactors::report` converts them.
+        report["units"] = json!(crate::units_out::Units::Scaled.name());
     }
     report
 }
