@@ -1,7 +1,7 @@
 //! `simulate`: one scene, its JSON report (the CLI's), its fraction series and optionally its
 //! field, as NumPy arrays that take over the simulator's vectors (no copy per sample).
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
@@ -11,7 +11,7 @@ use woodpile_scene::report::{simulate_report, unverified_report};
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
-use woodpile_sim::run::simulate as run;
+use woodpile_sim::run::{simulate as run, Outcome, Scenario};
 use woodpile_sim::SimError;
 
 use crate::interrupt::{on_this_thread, Clock, Watch};
@@ -71,30 +71,7 @@ pub(crate) fn simulate<'py>(
         callback.call1(py, (run, t, t_end)).map(|_| ())
     };
     let (outcome, wall_s, series, field) = on_this_thread(py, &poll, |stop| {
-        let series = recorder;
-        let started = Instant::now();
-        match sites {
-            Some((first, last)) => {
-                let field = SiteField::new(&s.model, first, last);
-                let mut watched = Watch {
-                    inner: (series, field),
-                    stop,
-                    clock: Some(&clock),
-                };
-                let outcome = run(s, &mut watched);
-                let (series, field) = watched.inner;
-                (outcome, started.elapsed(), series, Some(field))
-            }
-            None => {
-                let mut watched = Watch {
-                    inner: series,
-                    stop,
-                    clock: Some(&clock),
-                };
-                let outcome = run(s, &mut watched);
-                (outcome, started.elapsed(), watched.inner, None)
-            }
-        }
+        run_recorded(s, recorder, sites, stop, &clock)
     })?;
     let outcome = outcome.map_err(|e| failure(py, &scene, &label, e))?;
     let mut report = simulate_report(&scene, &outcome, wall_s.as_secs_f64());
@@ -113,6 +90,45 @@ pub(crate) fn simulate<'py>(
         add_field(py, &out, &scene, field)?;
     }
     Ok(out)
+}
+
+/// A run of `s` recording `series` and, for `sites`, a field: its outcome, wall time, series
+/// and field. `stop` ends it early; `clock` says where it is.
+fn run_recorded(
+    s: &Scenario,
+    series: FractionSeries,
+    sites: Option<(usize, usize)>,
+    stop: &dyn Fn() -> bool,
+    clock: &Clock,
+) -> (
+    Result<Outcome, SimError>,
+    Duration,
+    FractionSeries,
+    Option<SiteField>,
+) {
+    let started = Instant::now();
+    match sites {
+        Some((first, last)) => {
+            let field = SiteField::new(&s.model, first, last);
+            let mut watched = Watch {
+                inner: (series, field),
+                stop,
+                clock: Some(clock),
+            };
+            let outcome = run(s, &mut watched);
+            let (series, field) = watched.inner;
+            (outcome, started.elapsed(), series, Some(field))
+        }
+        None => {
+            let mut watched = Watch {
+                inner: series,
+                stop,
+                clock: Some(clock),
+            };
+            let outcome = run(s, &mut watched);
+            (outcome, started.elapsed(), watched.inner, None)
+        }
+    }
 }
 
 /// The recorded series as arrays: t, R, T, E_tr, S (with a striker), D (with damping), E.
