@@ -148,10 +148,14 @@ fn verified<O: Observer + ?Sized>(
 ) -> Result<Outcome, SimError> {
     let mut ladder = Ladder::start(scenario, plan, observer)?;
     let mut why = Refusal::NoRunKeptEnergy;
-    for _ in 0..=MAX_HALVINGS {
-        match ladder.rung()? {
+    for halvings_left in (0..=MAX_HALVINGS).rev() {
+        match ladder.rung(halvings_left)? {
             Rung::Accept(outcome) => return Ok(*outcome),
             Rung::Refine(reason) => why = reason,
+            Rung::GiveUp(reason) => {
+                why = reason;
+                break;
+            }
         }
     }
     // After a refusal the finest run is the next rung's coarse one.
@@ -184,6 +188,8 @@ enum Rung {
     Accept(Box<Outcome>),
     /// Not verified at this step, for this reason: halve it.
     Refine(Refusal),
+    /// Not verified, and no step the ladder has left can be: refuse now, for this reason.
+    GiveUp(Refusal),
 }
 
 /// Why a rung did not accept: the reason a refusal reports for the finest step tried.
@@ -215,6 +221,15 @@ enum Refusal {
         accept: f64,
         tol: f64,
     },
+    /// The estimate is so far above what it must meet that the halvings left cannot bring it
+    /// there, even falling as fast as an accepted pair's changes may.
+    OutOfReach {
+        estimate: f64,
+        accept: f64,
+        tol: f64,
+        halvings_left: u32,
+        factor: f64,
+    },
 }
 
 impl std::fmt::Display for Refusal {
@@ -238,6 +253,10 @@ impl std::fmt::Display for Refusal {
             Refusal::OffLadder { estimate, accept, tol } => write!(
                 f,
                 "the pair agreed, but a run at 1.5 times the step differs by an estimated {estimate:.2e}, above the {accept:.1e} it must meet (tolerance {tol:.1e}): the error jumps with the step"
+            ),
+            Refusal::OutOfReach { estimate, accept, tol, halvings_left, factor } => write!(
+                f,
+                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e}), and the {halvings_left} halving(s) left could not bring it there even if it fell {factor:.0} times per halving, the most an accepted pair's change may fall: refused at once rather than after them"
             ),
         }
     }
@@ -299,9 +318,10 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
         })
     }
 
-    /// One rung: the run at dt against the one at 2 dt. A refusal halves the step for the
-    /// next rung; a scene error (not a blow-up) ends the ladder.
-    fn rung(&mut self) -> Result<Rung, SimError> {
+    /// One rung: the run at dt against the one at 2 dt, with `halvings_left` rungs after it.
+    /// A refusal halves the step for the next rung, or gives up when no rung left can accept;
+    /// a scene error (not a blow-up) ends the ladder.
+    fn rung(&mut self, halvings_left: u32) -> Result<Rung, SimError> {
         let (scenario, tol) = (self.scenario, self.tol);
         self.observer.reset();
         let fine = match run_plan(scenario, &self.guarded.with_dt(self.dt), self.observer) {
@@ -378,7 +398,38 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
         self.previous_change = change;
         self.coarse = Some(fine);
         self.dt *= 0.5;
-        Ok(Rung::Refine(why))
+        Ok(match self.out_of_reach(&why, halvings_left) {
+            Some(hopeless) => Rung::GiveUp(hopeless),
+            None => Rung::Refine(why),
+        })
+    }
+
+    /// A refusal on the estimate alone that the `halvings_left` rungs cannot overturn: it
+    /// would stay above `accept` even falling by 2^(p+1) per halving (p the method's formal
+    /// order), the most the asymptotic check lets an accepted pair's change fall. A long run
+    /// whose fractions scatter between steps is then refused at once, not after every rung,
+    /// each costing twice the one before.
+    fn out_of_reach(&self, why: &Refusal, halvings_left: u32) -> Option<Refusal> {
+        let Refusal::Estimate {
+            estimate,
+            accept,
+            tol,
+        } = *why
+        else {
+            return None;
+        };
+        if halvings_left == 0 {
+            return None; // The ladder ends here anyway, for this reason.
+        }
+        let factor = 2f64.powi(self.plan.method.order() as i32 + 1);
+        let best = estimate / factor.powi(halvings_left as i32);
+        (best > accept).then_some(Refusal::OutOfReach {
+            estimate,
+            accept,
+            tol,
+            halvings_left,
+            factor,
+        })
     }
 
     /// Whether an accepted pair must also agree with a run off its ladder, at 1.5 dt: with a
