@@ -7,7 +7,7 @@ use numpy::ndarray::Array2;
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use woodpile_scene::report::{simulate_report, unverified_report};
+use woodpile_scene::report::{cost_note, simulate_report, unverified_report};
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
@@ -59,6 +59,9 @@ pub(crate) fn simulate<'py>(
     if let Some((first, last)) = sites {
         SiteField::check_size(s, last - first + 1)
             .map_err(|reason| SceneError::new_err(format!("{label}: field: {reason}")))?;
+    }
+    if let Some(note) = cost_note(&scene) {
+        warn_long_run(py, &format!("{label}: {note}"))?;
     }
     // `progress(run, t, t_end)`: the run of `auto`'s ladder under way and its last sample.
     let clock = Clock::default();
@@ -129,6 +132,14 @@ fn run_recorded(
             (outcome, started.elapsed(), watched.inner, None)
         }
     }
+}
+
+/// Warns `woodpile.LongRunWarning` with `message`, from the caller's line.
+fn warn_long_run(py: Python<'_>, message: &str) -> PyResult<()> {
+    let category = py.import("woodpile._simulate")?.getattr("LongRunWarning")?;
+    let message = std::ffi::CString::new(message)
+        .map_err(|e| SimulationError::new_err(format!("warning text: {e}")))?;
+    PyErr::warn(py, &category, &message, 2)
 }
 
 /// The recorded series as arrays: t, R, T, E_tr, S (with a striker), D (with damping), E.

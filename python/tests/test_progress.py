@@ -53,3 +53,18 @@ def test_a_callback_that_fails_stops_the_run(monkeypatch):
         assert "progress broke" in str(e)
     else:
         raise AssertionError("the callback's error was swallowed")
+
+
+def test_a_long_run_is_announced_before_it_starts():
+    """`auto` forecasts its first rung before it runs: a long one warns `LongRunWarning`
+    first (the run is then stopped by its progress callback, at its first poll)."""
+    import pytest
+
+    scene = {"chain": {"n": 5000}, "run": {"t_end": 5000.0, "tolerance": 1e-8}}
+
+    def stop(*_):
+        raise RuntimeError("stopped by the test")
+
+    with pytest.warns(woodpile.LongRunWarning, match="first rung"):
+        with pytest.raises(RuntimeError, match="stopped by the test"):
+            woodpile._core.simulate(scene, False, None, None, stop)

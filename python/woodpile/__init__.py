@@ -13,11 +13,12 @@ scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile 
 
 from ._core import SceneError, SimulationError, __version__, scene_toml
 from ._pipeline import Pipeline, new_study
-from ._simulate import EndReachedWarning, SimulationResult, simulate
+from ._simulate import EndReachedWarning, LongRunWarning, SimulationResult, simulate
 from ._sweep import simulate_many, sweep
 
 __all__ = [
     "EndReachedWarning",
+    "LongRunWarning",
     "Pipeline",
     "SceneError",
     "SimulationError",

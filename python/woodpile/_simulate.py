@@ -233,6 +233,11 @@ def simulate(
     return result
 
 
+class LongRunWarning(UserWarning):
+    """``simulate`` forecasts, before it starts, that ``auto`` will run long: the message
+    says how long its first rung should take and how long every halving would."""
+
+
 class EndReachedWarning(UserWarning):
     """A run's wave reached an end of the chain before ``t_end`` (``end_reached_at``): its
     R and T include what that end sent back."""

@@ -10,7 +10,7 @@ use serde_json::{json, Value};
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::{self, Columns};
 use woodpile_points::canonical::{code_version, scene_json, Key};
-use woodpile_scene::report::{simulate_report, unverified_report, wall_note};
+use woodpile_scene::report::{cost_note, simulate_report, unverified_report, wall_note};
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
@@ -67,6 +67,9 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
         FractionSeries::new(&s.model, s.region),
         SiteField::new(&s.model, sites.0, sites.1),
     );
+    if let Some(note) = cost_note(&scene) {
+        eprintln!("note: {}: {note}", args.scene.display());
+    }
     let started = Instant::now();
     let outcome = if args.series.is_some() || args.field.is_some() {
         simulate(s, &mut observers)

@@ -4,7 +4,7 @@
 
 use serde_json::{json, Value};
 use woodpile_sim::integrate::MethodChoice;
-use woodpile_sim::run::Outcome;
+use woodpile_sim::run::{budget, Outcome};
 
 use crate::Scene;
 
@@ -75,6 +75,32 @@ pub fn wall_note(scene: &Scene, out: &Outcome) -> Option<String> {
     Some(format!(
         "the wave reached an end of the chain at t = {reached}, before t_end = {t_end}: R and T include what that end sent back (a longer chain, or an earlier t_end, keeps them apart)"
     ))
+}
+
+/// The note for a run `auto` forecasts to be long ([`budget::LONG_RUN_S`] for its first rung),
+/// said before it starts, with what it will cost if the tolerance needs every halving.
+pub fn cost_note(scene: &Scene) -> Option<String> {
+    let f = budget::forecast(&scene.scenario)?;
+    (f.first_rung_s > budget::LONG_RUN_S).then(|| {
+        format!(
+            "auto's first rung is two runs of about {:.2e} and {:.2e} steps over {} sites and resonators (step {:.2e}): roughly {} on a 2026 laptop core, and up to {} if the tolerance needs every halving; a looser tolerance or a shorter t_end is faster",
+            f.steps,
+            f.steps / 2.0,
+            f.sites,
+            f.dt,
+            duration(f.first_rung_s),
+            duration(f.whole_ladder_s),
+        )
+    })
+}
+
+/// `12 s`, `7 min`, `3.2 h`.
+fn duration(seconds: f64) -> String {
+    match seconds {
+        s if s < 120.0 => format!("{s:.0} s"),
+        s if s < 7200.0 => format!("{:.0} min", s / 60.0),
+        s => format!("{:.1} h", s / 3600.0),
+    }
 }
 
 /// What a refused `auto` keeps of its finest run, marked unverified: the fractions at `t_end`

@@ -155,3 +155,27 @@ fn dt_needs_a_fixed_step_method() {
     )
     .is_ok());
 }
+
+/// `auto` announces a run it forecasts long, before it starts, and says nothing of a short one
+/// or of a named method's.
+#[test]
+fn long_runs_are_forecast_before_they_start() {
+    let long = woodpile_scene::parse(
+        "[chain]\nn = 5000\n[run]\nt_end = 5000.0\ntolerance = 1e-8\n",
+        std::path::Path::new("long.toml"),
+    )
+    .unwrap();
+    let note = woodpile_scene::report::cost_note(&long).expect("a note");
+    assert!(note.contains("first rung") && note.contains("every halving"), "{note}");
+    let short = woodpile_scene::parse("[run]\nt_end = 100.0\n", std::path::Path::new("s.toml"))
+        .unwrap();
+    assert_eq!(woodpile_scene::report::cost_note(&short), None);
+    let named = woodpile_scene::parse(
+        "[chain]\nn = 5000\n[run]\nt_end = 5000.0\nmethod = \"rk4\"\ndt = 0.01\n",
+        std::path::Path::new("named.toml"),
+    )
+    .unwrap();
+    assert_eq!(woodpile_scene::report::cost_note(&named), None);
+    let f = woodpile_sim::run::budget::forecast(&long.scenario).unwrap();
+    assert!(f.whole_ladder_s > 100.0 * f.first_rung_s);
+}

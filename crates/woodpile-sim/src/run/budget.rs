@@ -12,6 +12,55 @@ use crate::error::{OverBudget, StepSetBy};
 use crate::integrate::{intervals, MethodChoice, Plan, MAX_STEPS};
 use crate::SimError;
 
+/// Seconds one step of one site costs `auto` on a chain whose moving window spans it, as
+/// measured on the development machine (2 cores, 2026; `rkn6-contact`, five force evaluations
+/// a step): the 401-site chain with three nonlinear resonators over t = 1500 took 33 s for
+/// 3.6e9 site-steps. A narrower window (a short run on a long chain) costs less, so forecasts
+/// made with it are upper bounds, within a factor of a few of any recent machine.
+pub const SECONDS_PER_SITE_STEP: f64 = 9e-9;
+
+/// `auto`'s first-rung runs cost less than this, in the forecast, without a word: longer ones
+/// are announced before they start.
+pub const LONG_RUN_S: f64 = 10.0;
+
+/// What `auto` will spend, forecast before it starts from its first step and the chain's size.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Forecast {
+    /// The first rung's step.
+    pub dt: f64,
+    /// Steps of the first rung's fine run.
+    pub steps: f64,
+    /// Sites and resonators the steps move.
+    pub sites: usize,
+    /// Seconds of the first rung (its runs at dt and 2 dt), at [`SECONDS_PER_SITE_STEP`].
+    pub first_rung_s: f64,
+    /// Seconds of the whole ladder, should every halving be needed (each rung costs twice the
+    /// one before).
+    pub whole_ladder_s: f64,
+}
+
+/// `auto`'s forecast for `scenario` (`None` for a named method: it runs once, as asked).
+pub fn forecast(scenario: &Scenario) -> Option<Forecast> {
+    if scenario.method != MethodChoice::Auto {
+        return None;
+    }
+    let plan = Plan::choose(&scenario.model, scenario.method, scenario.accuracy).ok()?;
+    let dt = auto_first_step(scenario, &plan);
+    let steps = (scenario.t_end / dt).max(intervals(scenario.t_end, scenario.sample_every) as f64);
+    let sites = scenario.model.n_dof();
+    let rung = 1.5 * steps * sites as f64 * SECONDS_PER_SITE_STEP;
+    let rungs = f64::from(super::MAX_HALVINGS + 1);
+    Some(Forecast {
+        dt,
+        steps,
+        sites,
+        first_rung_s: rung,
+        // The coarse run once, then fine runs at dt, dt/2, ...: 0.5 + (2^rungs - 1) first-rung
+        // fine runs of the first rung's 1.5.
+        whole_ladder_s: rung / 1.5 * (0.5 + 2f64.powf(rungs) - 1.0),
+    })
+}
+
 /// Most samples one run may record: each sample keeps five numbers per observer, so a
 /// million samples are 40 MB, far beyond any figure's resolution.
 pub const MAX_SAMPLES: u64 = 1_000_000;
