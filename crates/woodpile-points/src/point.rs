@@ -33,6 +33,8 @@ pub struct PointData {
     pub e_initial: f64,
     /// E(t_end).
     pub e_final: f64,
+    /// When the wave first reached an end of the chain (None: it never did before t_end).
+    pub end_reached_at: Option<f64>,
     /// Sample times.
     pub t: Vec<f64>,
     /// R(t).
@@ -137,6 +139,7 @@ impl PointData {
             energy_drift: (!s.model.is_time_dependent()).then_some(out.stats.max_energy_drift),
             e_initial: out.e_initial,
             e_final: out.e_final,
+            end_reached_at: out.stats.end_reached_at,
             t: series.t,
             reflected: series.reflected,
             transmitted: series.transmitted,

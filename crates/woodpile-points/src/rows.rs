@@ -163,6 +163,8 @@ pub mod sweep {
     pub const ERROR_ESTIMATE: &str = "error_estimate";
     /// The largest relative energy drift.
     pub const ENERGY_DRIFT: &str = "energy_drift";
+    /// When the wave first reached an end of the chain (null: not before t_end).
+    pub const END_REACHED_AT: &str = "end_reached_at";
     /// Why the point failed (null when it did not).
     pub const FAILURE: &str = "failure";
     /// The point's cache key.
@@ -256,6 +258,7 @@ impl Row for SweepRow<'_> {
                 ok.and_then(|p| p.error_estimate).into(),
             ),
             (sweep::ENERGY_DRIFT, ok.and_then(|p| p.energy_drift).into()),
+            (sweep::END_REACHED_AT, ok.and_then(|p| p.end_reached_at).into()),
             (
                 sweep::FAILURE,
                 self.point.result.as_ref().err().cloned().into(),

@@ -7,7 +7,7 @@
 //! simply recomputed, never trusted.
 //!
 //! The format is private to this module (the stage outputs are the public parquet): magic
-//! `WPPT`, a format byte, the 64-hex key, the outcome, then the checksum. Floats are stored as
+//! `WPPT`, a format byte (2), the 64-hex key, the outcome, then the checksum. Floats are stored as
 //! their exact bits. A point's series are five columns (t, R, T, E_tr, E), or six with a
 //! striker's S: the length tells which, so points without a striker keep their bytes.
 
@@ -23,7 +23,9 @@ use crate::point::{simulate_point_until, PointData, PointResult, Series};
 const MAGIC: &[u8; 4] = b"WPPT";
 /// The largest point file read: far beyond a series of the sample budget's length.
 const MAX_POINT_BYTES: u64 = 1 << 30;
-const FORMAT: u8 = 1;
+/// 2 since sweep tables have `end_reached_at`: a point of format 1 lacks it, and reads as
+/// absent (it is simulated again), so that a table never depends on how old its cache is.
+const FORMAT: u8 = 2;
 /// A point as the store gave it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fetched {
@@ -145,6 +147,7 @@ fn encode(key: &Key, result: &PointResult) -> Vec<u8> {
             w.extend_from_slice(&p.rhs_evals.to_le_bytes());
             put_f64(&mut w, p.e_initial);
             put_f64(&mut w, p.e_final);
+            put_f64(&mut w, p.end_reached_at.unwrap_or(f64::NAN));
             w.extend_from_slice(&(p.t.len() as u64).to_le_bytes());
             let columns = [&p.t, &p.reflected, &p.transmitted, &p.trapped, &p.energy];
             let put_column = |w: &mut Vec<u8>, column: &[f64]| {
@@ -200,6 +203,7 @@ fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
                 (optional(r.f64()?), optional(r.f64()?), optional(r.f64()?));
             let (steps, rhs_evals) = (r.u64()?, r.u64()?);
             let (e_initial, e_final) = (r.f64()?, r.f64()?);
+            let end_reached_at = optional(r.f64()?);
             let n = usize::try_from(r.u64()?).ok()?;
             // Five columns, then S untagged (a striker's point as it always was), or tagged
             // optional columns (S and D with damping), which never add up to six columns.
@@ -228,6 +232,7 @@ fn decode(bytes: &[u8], key: &Key) -> Option<PointResult> {
                 energy_drift,
                 e_initial,
                 e_final,
+                end_reached_at,
                 t,
                 reflected,
                 transmitted,
@@ -281,6 +286,7 @@ mod tests {
             energy_drift: None,
             e_initial: 0.5,
             e_final: 0.5000000001,
+            end_reached_at: Some(12.5),
             t: vec![0.0, 1.0],
             reflected: vec![0.0, 0.1],
             transmitted: vec![0.0, 0.2],
@@ -315,6 +321,24 @@ mod tests {
                 assert_eq!(store.load(&key), None, "byte {byte} bit {bit}");
             }
         }
+    }
+
+    /// A point of the format before `end_reached_at`, intact under its own checksum, reads as
+    /// absent: it is simulated again rather than give its table a null the fresh run would
+    /// not.
+    #[test]
+    fn a_point_of_an_older_format_reads_as_absent() {
+        let (_dir, store, key) = store_with_sample("old");
+        let bytes = std::fs::read(store.path(&key)).unwrap();
+        let resealed = |body: &[u8]| {
+            let mut out = body.to_vec();
+            out.extend_from_slice(blake3::hash(body).as_bytes());
+            out
+        };
+        let mut body = bytes[..bytes.len() - 32].to_vec();
+        assert_eq!(decode(&resealed(&body), &key), Some(Ok(sample())));
+        body[4] = 1;
+        assert_eq!(decode(&resealed(&body), &key), None);
     }
 
     #[test]

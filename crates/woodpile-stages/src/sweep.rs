@@ -17,7 +17,9 @@
 //! An optional `series = "kinetic"` records kinetic-energy shares divided by the impact energy
 //! (what the woodpile experiment measures, paper Fig. 2 c, f) instead of total-energy fractions;
 //! the columns keep their names (`R`, `T`, `E_tr`, `E`). Scenes with a `[striker]` add the
-//! striker's share `S` after `E_tr` (R + T + E_tr + S = 1).
+//! striker's share `S` after `E_tr` (R + T + E_tr + S = 1). Every row says `end_reached_at`,
+//! when the point's wave first reached an end of the chain (null: not before `t_end`): from
+//! then on its R and T include what that end sent back.
 //!
 //! Points are cached one by one in the [`PointStore`] under the key of their resolved scene,
 //! so a sweep resumes after a kill and sweeps that share scenes share the work. Points are
