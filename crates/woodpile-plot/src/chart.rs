@@ -76,8 +76,10 @@ pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
     };
     let xticks = keep_minor(sx.ticks(x0, x1, ((w as f64 / style.pt(48.0)) as usize).clamp(3, 8)));
     let yticks = keep_minor(sy.ticks(y0, y1, ((h as f64 / style.pt(28.0)) as usize).clamp(3, 8)));
+    let right = right_margin(area, &xticks.0, (x0, x1, sx), style);
     let mut chart = ChartBuilder::on(area)
         .margin(style.pt(4.0) as u32)
+        .margin_right(right)
         .x_label_area_size(style.font(2.9) as u32)
         .y_label_area_size(style.font(4.4) as u32)
         .build_cartesian_2d(Ticked::new(x0, x1, xticks), Ticked::new(y0, y1, yticks))
@@ -102,6 +104,29 @@ pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
         mesh.draw().map_err(text)?;
     }
     Ok(chart)
+}
+
+/// The chart's right margin: the usual 4 pt, or, when the last x tick sits at the right end of
+/// the axis, room for the half of its label (centred on the tick) that lies past it, so that
+/// "100" is not cut to "10".
+fn right_margin<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    ticks: &[f64],
+    (x0, x1, sx): (f64, f64, Scale),
+    style: &Style,
+) -> u32 {
+    let usual = style.pt(4.0);
+    let Some(&last) = ticks.last() else {
+        return usual as u32;
+    };
+    let (w, _) = area.dim_in_pixel();
+    // How far short of the right end the tick is, in pixels (the plot is most of the area).
+    let short = (x1 - last) / (x1 - x0) * (w as f64 - usual - style.font(4.4));
+    let font = TextStyle::from((FONT, style.font(1.0)).into_font());
+    let half = area
+        .estimate_text_size(&sx.label(last), &font)
+        .map_or(0.0, |(tw, _)| 0.5 * tw as f64);
+    (half - short + style.pt(1.0)).max(usual) as u32
 }
 
 /// The plotting rectangle of `chart` in backend pixels.
