@@ -26,7 +26,7 @@ python: ## Install the Python package into .venv, as the README says (pip instal
 	$(PY) -m pip install --quiet --disable-pip-version-check ./python
 
 python-test: python build ## The Python package's tests and the quickstart notebook, in .venv (Pipeline drives this clone's woodpile)
-	$(PY) -m pip install --quiet --disable-pip-version-check pytest matplotlib nbclient nbformat ipykernel
+	$(PY) -m pip install --quiet --disable-pip-version-check pytest matplotlib nbclient nbformat ipykernel scipy
 	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) -m pytest -q -p no:cacheprovider python/tests
 	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) scripts/run_notebook.py examples/quickstart.ipynb
 
