@@ -8,6 +8,8 @@ docs/performance.md). Run from the repository root after `pip install ./python`:
    inside the core around the simulation): the Python overhead, as the median call's ratio.
 2. `woodpile.sweep` of the F7 coarse grid (pipeline/f7/f7_coarse_sweep.toml, series kept)
    against `woodpile run f7_coarse_sweep` into an empty results folder.
+3. `woodpile.simulate_many` of a grid's points as a list of scenes against `woodpile.sweep`
+   of the same grid (final values, no series kept): the list's own cost, in one process.
 The simulate rows are the median of `--repeat` calls, each against its own Rust time; the
 sweep rows the best of two runs each.
 """
@@ -73,6 +75,33 @@ def bench_sweep(repeat):
     return rust, python
 
 
+def bench_many(repeat):
+    """`simulate_many` of the F6 grid's scenes, listed, against `sweep` of the grid."""
+    stage = tomllib.loads((REPO / "pipeline" / "f6" / "f6_sweep.toml").read_text())
+    grid = woodpile.sweep(stage["scene"], stage["axes"], progress=False)
+    names = sorted(stage["axes"])
+    scenes = [
+        woodpile.scene_toml(_filled(stage["scene"], {n: row[n] for n in names}))
+        for _, row in grid.iterrows()
+    ]
+    swept, _ = best(repeat, lambda: woodpile.sweep(stage["scene"], stage["axes"], progress=False))
+    listed, many = best(repeat, lambda: woodpile.simulate_many(scenes, progress=False))
+    assert many.E_tr.tolist() == grid.E_tr.tolist()
+    return len(scenes), swept, listed
+
+
+def _filled(template, values):
+    """`template` with each "$name" string replaced by its value."""
+    if isinstance(template, dict):
+        return {k: _filled(v, values) for k, v in template.items()}
+    if isinstance(template, list):
+        return [_filled(v, values) for v in template]
+    if isinstance(template, str) and template.startswith("$"):
+        value = values[template[1:]]
+        return int(value) if float(value).is_integer() and "." not in str(value) else float(value)
+    return template
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--repeat", type=int, default=21)
@@ -86,6 +115,8 @@ def main():
     if not args.skip_sweep:
         rust, python = bench_sweep(2)
         print(f"| `sweep` of F7 coarse (10,000 scenes, series) vs `woodpile run` | {rust:.2f} s | {python:.2f} s | {python / rust:.3f} |")
+        count, swept, listed = bench_many(3)
+        print(f"| `simulate_many` of F6's {count} scenes, listed, vs `sweep` of its grid | {swept:.2f} s (`sweep`) | {listed:.2f} s | {listed / swept:.3f} |")
     sys.stdout.flush()
 
 

@@ -540,3 +540,33 @@ fn a_refused_run_keeps_its_finest_run_marked_unverified() {
     assert!((sum - 1.0).abs() < 1e-9, "{sum}");
     assert!(kept["error_estimate"].as_f64().unwrap() > 1e-13 * 6.25e-2);
 }
+
+/// A tolerance the ladder cannot reach is refused at the rung that shows it, not after all
+/// seven: three cubic resonators over t = 400 scatter E_tr by percents between steps, and the
+/// refusal comes at the fourth rung (dt = first step / 8), keeping that rung's run.
+#[test]
+fn an_out_of_reach_tolerance_is_refused_at_once() {
+    let defects: String = [(0, 0.2, 2.0), (1, 0.3, 5.0), (2, 0.1, 3.0)]
+        .iter()
+        .map(|(site, eps, kappa)| {
+            format!("[[defect]]\nsite = {site}\neps = {eps}\nkappa = {kappa}\np = 3\n")
+        })
+        .collect();
+    let text = format!("[chain]\nn = 100\n{defects}[run]\nt_end = 400.0\ntolerance = 1e-8\n");
+    let (out, _) = simulate(&text);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("halving(s) left could not bring it there"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("refused at once"), "{stderr}");
+    let kept: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let finest = kept["unverified"]["dt"].as_f64().unwrap();
+    // auto's first step here is the tolerance's 0.0215 (rkn6-contact at 1e-8): the fourth
+    // rung's is an eighth of it, the last one's a sixty-fourth.
+    assert!(
+        (finest - 0.0215 / 8.0).abs() < 0.0215 / 64.0,
+        "refused at dt = {finest}"
+    );
+}

@@ -258,7 +258,10 @@ impl Row for SweepRow<'_> {
                 ok.and_then(|p| p.error_estimate).into(),
             ),
             (sweep::ENERGY_DRIFT, ok.and_then(|p| p.energy_drift).into()),
-            (sweep::END_REACHED_AT, ok.and_then(|p| p.end_reached_at).into()),
+            (
+                sweep::END_REACHED_AT,
+                ok.and_then(|p| p.end_reached_at).into(),
+            ),
             (
                 sweep::FAILURE,
                 self.point.result.as_ref().err().cloned().into(),

@@ -166,9 +166,12 @@ fn long_runs_are_forecast_before_they_start() {
     )
     .unwrap();
     let note = woodpile_scene::report::cost_note(&long).expect("a note");
-    assert!(note.contains("first rung") && note.contains("every halving"), "{note}");
-    let short = woodpile_scene::parse("[run]\nt_end = 100.0\n", std::path::Path::new("s.toml"))
-        .unwrap();
+    assert!(
+        note.contains("first rung") && note.contains("every halving"),
+        "{note}"
+    );
+    let short =
+        woodpile_scene::parse("[run]\nt_end = 100.0\n", std::path::Path::new("s.toml")).unwrap();
     assert_eq!(woodpile_scene::report::cost_note(&short), None);
     let named = woodpile_scene::parse(
         "[chain]\nn = 5000\n[run]\nt_end = 5000.0\nmethod = \"rk4\"\ndt = 0.01\n",
