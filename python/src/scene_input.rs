@@ -240,6 +240,6 @@ pub(crate) fn scene_toml(scene: &Bound<'_, PyAny>) -> PyResult<String> {
 }
 
 /// The label's display form, for messages built outside this module.
-pub(crate) fn shown(label: &Path) -> String {
+pub(crate) fn label_text(label: &Path) -> String {
     label.display().to_string()
 }

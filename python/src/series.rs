@@ -3,21 +3,21 @@
 //! woodpile experiment's measure, paper Fig. 2).
 
 use pyo3::prelude::*;
-use woodpile_points::Series;
+use woodpile_points::Shares;
 
 use crate::SceneError;
 
-/// The [`Series`] a `series` argument asks for: `"energy"` or `"kinetic"`; with `switch`, also
+/// The [`Shares`] a `series` argument asks for: `"energy"` or `"kinetic"`; with `switch`, also
 /// `True` (energy) and `False` (none).
-pub(crate) fn parse(value: &Bound<'_, PyAny>, switch: bool) -> PyResult<Option<Series>> {
+pub(crate) fn parse(value: &Bound<'_, PyAny>, switch: bool) -> PyResult<Option<Shares>> {
     if switch {
         if let Ok(on) = value.extract::<bool>() {
-            return Ok(on.then_some(Series::Energy));
+            return Ok(on.then_some(Shares::Energy));
         }
     }
     match value.extract::<String>().as_deref() {
-        Ok("energy") => Ok(Some(Series::Energy)),
-        Ok("kinetic") => Ok(Some(Series::Kinetic)),
+        Ok("energy") => Ok(Some(Shares::Energy)),
+        Ok("kinetic") => Ok(Some(Shares::Kinetic)),
         _ => {
             let allowed = match switch {
                 true => "True, False, \"energy\" or \"kinetic\"",

@@ -15,10 +15,10 @@ use woodpile_sim::run::{simulate as run, Outcome, Scenario};
 use woodpile_sim::SimError;
 
 use crate::interrupt::{on_this_thread, Clock, Watch};
-use crate::scene_input::{shown, Source};
+use crate::scene_input::{label_text, Source};
 use crate::series;
 use crate::{SceneError, SimulationError};
-use woodpile_points::Series;
+use woodpile_points::Shares;
 
 /// _simulate(scene, fields=False, field_sites=None, series=None) -> dict
 /// --
@@ -38,11 +38,11 @@ pub(crate) fn simulate<'py>(
     units: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = match series {
-        Some(value) => series::parse(value, false)?.unwrap_or(Series::Energy),
-        None => Series::Energy,
+        Some(value) => series::parse(value, false)?.unwrap_or(Shares::Energy),
+        None => Shares::Energy,
     };
     let source = Source::of(scene)?;
-    let label = shown(&source.label());
+    let label = label_text(&source.label());
     let scene = source.scene()?;
     let si = Units::parse(units)
         .and_then(|units| SiFactors::of(&scene, units))
@@ -81,7 +81,7 @@ pub(crate) fn simulate<'py>(
     let (mut series, mut field) = (series, field);
     if let Some(si) = si {
         si.report(&mut report);
-        si.series(&mut series, kind == Series::Kinetic);
+        si.series(&mut series, kind == Shares::Kinetic);
         if let Some(field) = field.as_mut() {
             si.field(field);
         }

@@ -13,14 +13,14 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use woodpile_points::rows::{SweepPoint, SweepShape};
-use woodpile_points::{point_key, Key, PointResult, PointStore, Series};
+use woodpile_points::{point_key, Key, PointResult, PointStore, Shares};
 use woodpile_scene::grid::{parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
 
 use crate::interrupt::{internal_message, interruptible_keeping};
 use crate::listed::{outcome_rows, table_dict};
-use crate::scene_input::{self, shown, Source};
+use crate::scene_input::{self, label_text, Source};
 use crate::series;
 use crate::SceneError;
 
@@ -62,7 +62,7 @@ pub(crate) fn sweep<'py>(
     };
     let run = Run {
         grid: &grid,
-        series: kind.unwrap_or(Series::Energy),
+        series: kind.unwrap_or(Shares::Energy),
         every_sample: kind.is_some(),
         store: store.as_ref(),
         done: AtomicUsize::new(0),
@@ -94,7 +94,7 @@ impl Grid {
     /// The grid of template `scene` (a dict, a TOML string or a path) over `axes`.
     fn of(scene: &Bound<'_, PyAny>, axes: &Bound<'_, PyDict>) -> PyResult<Grid> {
         let source = Source::of(scene)?;
-        let label = shown(&source.label());
+        let label = label_text(&source.label());
         let template = source.table()?;
         let axes = parse_axes(scene_input::table(axes, "axes")?).map_err(|(key, reason)| {
             let key = if key.is_empty() {
@@ -156,7 +156,7 @@ enum Unmade {
 /// A sweep being run.
 struct Run<'a> {
     grid: &'a Grid,
-    series: Series,
+    series: Shares,
     /// Every sample of each point, or its last one only.
     every_sample: bool,
     store: Option<&'a PointStore>,

@@ -41,7 +41,7 @@ pub struct PlotError {
 
 /// One curve of a line panel.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Series {
+pub struct Trace {
     /// Legend label.
     pub label: String,
     /// Points in drawing order; a non-finite y breaks the line.
@@ -60,7 +60,7 @@ pub struct LinePanel {
     /// y-axis label, with units.
     pub y_label: String,
     /// The curves.
-    pub series: Vec<Series>,
+    pub series: Vec<Trace>,
     /// Straight lines marking a position.
     pub marks: Vec<Mark>,
     /// The visible ranges.
@@ -87,7 +87,7 @@ pub struct HeatPanel {
     /// A marked point (e.g. the maximum) and its label.
     pub marker: Option<(f64, f64, String)>,
     /// Lines drawn over the map (e.g. a stability bound), each with a legend entry.
-    pub overlays: Vec<Series>,
+    pub overlays: Vec<Trace>,
     /// How values become colours.
     pub colours: Colours,
     /// The value range the colours span; `None`: the data's own (symmetric about zero for
@@ -319,7 +319,7 @@ mod tests {
                     title: "L = 0".into(),
                     x_label: "ε".into(),
                     y_label: "fraction".into(),
-                    series: vec![Series {
+                    series: vec![Trace {
                         label: "E_tr".into(),
                         points: vec![(0.0, 0.1), (1.0, 0.3), (2.0, f64::NAN), (3.0, 0.2)],
                         style: SeriesStyle::default(),
@@ -339,7 +339,7 @@ mod tests {
                     ys: vec![1.0, 2.0, 3.0],
                     z: vec![Some(0.1), Some(0.2), None, Some(0.4), Some(0.5), Some(0.6)],
                     marker: Some((2.0, 3.0, "max".into())),
-                    overlays: vec![Series {
+                    overlays: vec![Trace {
                         label: "bound".into(),
                         points: vec![(1.5, 0.5), (1.5, 3.5)],
                         style: SeriesStyle::default(),

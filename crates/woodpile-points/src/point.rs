@@ -54,20 +54,20 @@ pub struct PointData {
 
 /// Which energy a sweep's fractions split.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Series {
+pub enum Shares {
     /// Total energy, fractions of E(t) (the paper's Sections IV–V).
     Energy,
     /// Kinetic energy divided by the impact energy (the woodpile experiment, paper Fig. 2).
     Kinetic,
 }
 
-impl Series {
+impl Shares {
     /// An empty series of this kind for `scenario`, or why it cannot be recorded.
     pub fn recorder(self, scenario: &Scenario) -> Result<FractionSeries, String> {
         let (model, region) = (&scenario.model, scenario.region);
         match self {
-            Series::Energy => Ok(FractionSeries::new(model, region)),
-            Series::Kinetic => {
+            Shares::Energy => Ok(FractionSeries::new(model, region)),
+            Shares::Kinetic => {
                 let impact = scenario.impact_energy();
                 if impact.is_nan() || impact <= 0.0 {
                     return Err(
@@ -81,7 +81,7 @@ impl Series {
 }
 
 /// Simulates `scene`, recording its fractions at every sample.
-pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
+pub fn simulate_point(scene: &Scene, kind: Shares) -> PointResult {
     simulate_point_until(scene, kind, &|| false).unwrap_or_else(|| Err("cancelled".into()))
 }
 
@@ -89,7 +89,7 @@ pub fn simulate_point(scene: &Scene, kind: Series) -> PointResult {
 /// Python session): `None` then, since a cancelled run is no result and must not be cached.
 pub fn simulate_point_until(
     scene: &Scene,
-    kind: Series,
+    kind: Shares,
     stop: &dyn Fn() -> bool,
 ) -> Option<PointResult> {
     let s = &scene.scenario;
@@ -176,9 +176,9 @@ impl PointData {
 
 /// A point's cache key: its resolved scene, the code version and, for kinetic series only (so
 /// that energy points keep their keys), the series.
-pub fn point_key(scene: &Scene, series: Series) -> Key {
+pub fn point_key(scene: &Scene, series: Shares) -> Key {
     let mut key = json!({"scene": scene_json(scene), "code": code_version()});
-    if series == Series::Kinetic {
+    if series == Shares::Kinetic {
         key["series"] = json!("kinetic");
     }
     Key::of(&key)

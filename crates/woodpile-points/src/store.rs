@@ -18,7 +18,7 @@ use woodpile_scene::Scene;
 use crate::atomic;
 use crate::canonical::Key;
 use crate::error::{FileError, Result};
-use crate::point::{simulate_point_until, PointData, PointResult, Series};
+use crate::point::{simulate_point_until, PointData, PointResult, Shares};
 
 const MAGIC: &[u8; 4] = b"WPPT";
 /// The largest point file read: far beyond a series of the sample budget's length.
@@ -70,7 +70,7 @@ impl PointStore {
     /// The result of `scene` (whose key is `key`, from [`crate::point_key`]): from the cache,
     /// or simulated and saved. Every kind that simulates scenes goes through here, so a scene
     /// is simulated once whichever stage asks for it first.
-    pub fn get_or_simulate(&self, key: &Key, scene: &Scene, series: Series) -> Result<Fetched> {
+    pub fn get_or_simulate(&self, key: &Key, scene: &Scene, series: Shares) -> Result<Fetched> {
         let fetched = self.get_or_simulate_until(key, scene, series, &|| false)?;
         Ok(fetched.unwrap_or(Fetched {
             result: Err("cancelled".into()),
@@ -84,7 +84,7 @@ impl PointStore {
         &self,
         key: &Key,
         scene: &Scene,
-        series: Series,
+        series: Shares,
         stop: &dyn Fn() -> bool,
     ) -> Result<Option<Fetched>> {
         if let Some(cached) = self.load(key) {

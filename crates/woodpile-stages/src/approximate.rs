@@ -66,7 +66,12 @@ impl Approximate {
         })
     }
 
-    pub(crate) fn run(&self, stage: &str, fits: &DataFrame, data: &DataFrame) -> Result<Output> {
+    pub(crate) fn compute(
+        &self,
+        stage: &str,
+        fits: &DataFrame,
+        data: &DataFrame,
+    ) -> Result<Output> {
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let t1 = fitted(fits, &self.transmission).map_err(&fail)?;
         let r = fitted(fits, &self.reflection).map_err(&fail)?;
@@ -181,6 +186,6 @@ impl Kind for Approximate {
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         let fits = ctx.input(&ctx.stage.inputs[0])?;
         let data = ctx.input(&ctx.stage.inputs[1])?;
-        self.run(ctx.name(), &fits, &data)
+        self.compute(ctx.name(), &fits, &data)
     }
 }

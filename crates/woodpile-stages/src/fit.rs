@@ -117,7 +117,7 @@ impl FitStage {
         Ok(FitStage { x, filter, models })
     }
 
-    pub(crate) fn run(&self, stage: &str, input: &DataFrame) -> Result<Output> {
+    pub(crate) fn compute(&self, stage: &str, input: &DataFrame) -> Result<Output> {
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let column = |name: &str| f64_column(input, name).map_err(|e| fail(e.to_string()));
         let keep = matching_rows(input, &self.filter)
@@ -231,6 +231,6 @@ impl Kind for FitStage {
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         let frame = ctx.input(&ctx.stage.inputs[0])?;
-        self.run(ctx.name(), &frame)
+        self.compute(ctx.name(), &frame)
     }
 }

@@ -128,7 +128,7 @@ impl Optimize {
 
     /// The stage: the best grid rows ranked, each refined by Nelder–Mead inside the box, the
     /// best optimum written as a scene file, then the table and its summary.
-    pub(crate) fn run(
+    pub(crate) fn compute(
         &self,
         ctx: &Context<'_>,
         input: &polars::prelude::DataFrame,
@@ -545,7 +545,7 @@ impl Kind for Optimize {
             .ok_or_else(|| {
                 PipelineError::stage(ctx.name(), format!("`{input}` does not read a sweep"))
             })?;
-        self.run(ctx, &frame, sweep)
+        self.compute(ctx, &frame, sweep)
     }
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

@@ -85,7 +85,7 @@ impl Reduce {
     }
 
     /// Reduces the sweep table `input`, whose grid axes are `axes`.
-    pub(crate) fn run(
+    pub(crate) fn compute(
         &self,
         stage: &str,
         input: &polars::prelude::DataFrame,
@@ -372,7 +372,7 @@ impl Kind for Reduce {
             .get::<Sweep>()
             .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?
             .axes;
-        let mut output = self.run(ctx.name(), &frame, axes)?;
+        let mut output = self.compute(ctx.name(), &frame, axes)?;
         // The sweep's scene, grid and tolerance, so the table explains itself without its input.
         let params = &upstream.params;
         output.summary["input"] = json!({

@@ -118,7 +118,7 @@ impl SpaceTime {
     }
 
     /// Simulates the stage's scenes and keeps each one's field on the stage's sites.
-    pub(crate) fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+    pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {
         let stage = ctx.name();
         let (scenes, axes) = self.scenes(ctx)?;
         // The accuracy asked for (a scene's tolerance, or its fixed step's) and the largest
@@ -278,6 +278,6 @@ impl Kind for SpaceTime {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx)
+        self.compute(ctx)
     }
 }

@@ -141,7 +141,7 @@ impl Stability {
 
     /// The stage: each value's reference, every (value, method, step) run classified, then
     /// the summary and the table.
-    pub(crate) fn run(&self, stage: &str) -> Result<Output> {
+    pub(crate) fn compute(&self, stage: &str) -> Result<Output> {
         let references: Vec<Reference> = self
             .values
             .par_iter()
@@ -390,6 +390,6 @@ impl Kind for Stability {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx.name())
+        self.compute(ctx.name())
     }
 }

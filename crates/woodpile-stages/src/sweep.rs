@@ -46,7 +46,7 @@ use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
 use woodpile_points::canonical::Key;
 use woodpile_points::rows::{SweepPoint, SweepShape};
-use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, Series};
+use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, Shares};
 
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]
@@ -54,7 +54,7 @@ pub struct Sweep {
     /// The grid axes, sorted by name (the last varies fastest).
     pub axes: Vec<Axis>,
     /// Which energy the recorded fractions split.
-    pub series: Series,
+    pub series: Shares,
     template: Template,
     file: PathBuf,
     /// Whether its scenes have a striker: the table then has the striker's share `S`.
@@ -71,8 +71,8 @@ impl Sweep {
         };
         let series = fields.choice(
             "series",
-            &[("energy", Series::Energy), ("kinetic", Series::Kinetic)],
-            Some(Series::Energy),
+            &[("energy", Shares::Energy), ("kinetic", Shares::Kinetic)],
+            Some(Shares::Energy),
         )?;
         let scene: toml::Table = fields.required("scene")?;
         Sweep::over(axes, series, scene, fields.file())
@@ -83,7 +83,7 @@ impl Sweep {
     /// (its last point's scene is the largest).
     pub fn over(
         axes: Vec<Axis>,
-        series: Series,
+        series: Shares,
         scene: toml::Table,
         file: &std::path::Path,
     ) -> Result<Sweep> {
@@ -208,7 +208,7 @@ impl Sweep {
     }
 
     /// Simulates what `store` lacks and assembles the whole output.
-    pub(crate) fn run(
+    pub(crate) fn compute(
         &self,
         stage: &str,
         store: &PointStore,
@@ -339,7 +339,7 @@ impl PointGrid for Sweep {
             "t_end": first.t_end,
             "sample_every": first.sample_every,
             "physical_point_0": physical,
-            "series": match self.series { Series::Energy => "energy", Series::Kinetic => "kinetic" },
+            "series": match self.series { Shares::Energy => "energy", Shares::Kinetic => "kinetic" },
             "rhs_evals": stats.rhs_evals,
             "max_error_estimate": stats.max_error_estimate,
             "max_energy_drift": stats.max_energy_drift,
@@ -353,7 +353,7 @@ impl Kind for Sweep {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx.name(), ctx.store, ctx.events)
+        self.compute(ctx.name(), ctx.store, ctx.events)
     }
 
     fn points(&self) -> Option<&dyn PointGrid> {

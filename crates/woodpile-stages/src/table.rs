@@ -74,7 +74,7 @@ impl Table {
         Ok(frame)
     }
 
-    fn run(&self, ctx: &Context<'_>, input: &DataFrame) -> Result<Output> {
+    fn compute(&self, ctx: &Context<'_>, input: &DataFrame) -> Result<Output> {
         let stage = ctx.name();
         let fail = |reason: String| PipelineError::stage(stage, reason);
         let frame = self.select(input).map_err(fail)?;
@@ -152,7 +152,7 @@ impl Kind for Table {
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         let input = ctx.input(&ctx.stage.inputs[0])?;
-        self.run(ctx, &input)
+        self.compute(ctx, &input)
     }
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

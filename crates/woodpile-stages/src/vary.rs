@@ -41,7 +41,7 @@ use woodpile_pipeline::kind::{
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
-use woodpile_points::{PointStats, Series};
+use woodpile_points::{PointStats, Shares};
 use woodpile_sim::integrate::MethodChoice;
 
 use crate::sweep::Sweep;
@@ -128,7 +128,7 @@ impl Vary {
                 )
             })?;
         }
-        Sweep::over(self.axes.clone(), Series::Energy, scene, &self.file).map_err(|e| {
+        Sweep::over(self.axes.clone(), Shares::Energy, scene, &self.file).map_err(|e| {
             PipelineError::stage(stage, format!("`{design}`'s best scene, varied: {e}"))
         })
     }

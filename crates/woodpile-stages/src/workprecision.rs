@@ -169,7 +169,7 @@ impl WorkPrecision {
         })
     }
 
-    pub(crate) fn run(&self, stage: &str) -> Result<Output> {
+    pub(crate) fn compute(&self, stage: &str) -> Result<Output> {
         let mut rows = Vec::new();
         let mut references = Vec::new();
         let mut simulated = 0;
@@ -335,6 +335,6 @@ impl Kind for WorkPrecision {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx.name())
+        self.compute(ctx.name())
     }
 }

@@ -5,7 +5,7 @@ use woodpile_sim::model::{Boundary, End};
 use woodpile_sim::ContactLaw;
 
 use super::check::{
-    invalid, non_negative, number, positive, positive_pattern, required, shown, Invalid,
+    invalid, non_negative, number, number_text, positive, positive_pattern, required, Invalid,
 };
 use super::physical::Si;
 use crate::raw;
@@ -276,7 +276,7 @@ pub(crate) fn contact_law(
         Some(alpha) if !(1.0..=5.0).contains(&alpha) => {
             return Err(invalid(
                 "chain.exponent",
-                format!("must be a number from 1 to 5, got {}", shown(alpha)),
+                format!("must be a number from 1 to 5, got {}", number_text(alpha)),
             ))
         }
         Some(alpha) if si.is_some() && alpha != 1.5 => {

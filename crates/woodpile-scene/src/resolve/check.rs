@@ -10,7 +10,7 @@ pub(crate) fn invalid(key: impl Into<String>, reason: impl Into<String>) -> Inva
 
 /// `x` for a message: as written for everyday sizes, in scientific notation when very small or
 /// large (`1e-308`, not a 300-digit decimal).
-pub(crate) fn shown(x: f64) -> String {
+pub(crate) fn number_text(x: f64) -> String {
     if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
         format!("{x}")
     } else {
@@ -27,7 +27,7 @@ pub(crate) fn velocity(key: &str, v: f64) -> Result<f64, Invalid> {
     } else {
         Err(invalid(
             key,
-            format!("{} cannot carry an impact: its energy, v², is not a number double precision holds (use |v| from 1e-150 to 1e150)", shown(v)),
+            format!("{} cannot carry an impact: its energy, v², is not a number double precision holds (use |v| from 1e-150 to 1e150)", number_text(v)),
         ))
     }
 }
@@ -38,7 +38,7 @@ pub(crate) fn finite(key: &str, x: f64) -> Result<f64, Invalid> {
     } else {
         Err(invalid(
             key,
-            format!("must be a finite number, got {}", shown(x)),
+            format!("must be a finite number, got {}", number_text(x)),
         ))
     }
 }
@@ -49,7 +49,7 @@ pub(crate) fn positive(key: &str, x: f64) -> Result<f64, Invalid> {
     } else {
         Err(invalid(
             key,
-            format!("must be finite and > 0, got {}", shown(x)),
+            format!("must be finite and > 0, got {}", number_text(x)),
         ))
     }
 }
@@ -60,7 +60,7 @@ pub(crate) fn non_negative(key: &str, x: f64) -> Result<f64, Invalid> {
     } else {
         Err(invalid(
             key,
-            format!("must be finite and >= 0, got {}", shown(x)),
+            format!("must be finite and >= 0, got {}", number_text(x)),
         ))
     }
 }

@@ -5,7 +5,7 @@
 use woodpile_sim::rods::{self, Material, Rod};
 use woodpile_sim::units::Scales;
 
-use super::check::{invalid, positive, reject_present, required, shown, Invalid};
+use super::check::{invalid, number_text, positive, reject_present, required, Invalid};
 use crate::raw;
 
 /// The paper's split of its 40 mm defect rod (M = 0.838 g, m = 0.894 g; Model section): the
@@ -106,7 +106,10 @@ pub(crate) fn material_of(key: &str, m: &raw::Material) -> Result<Material, Inva
     if !(poisson.is_finite() && poisson > -1.0 && poisson < 0.5) {
         return Err(invalid(
             at("poisson_ratio"),
-            format!("must be a number in (-1, 0.5), got {}", shown(poisson)),
+            format!(
+                "must be a number in (-1, 0.5), got {}",
+                number_text(poisson)
+            ),
         ));
     }
     Ok(Material {
@@ -160,7 +163,7 @@ pub(crate) fn rod_resonator(
     if !(share.is_finite() && share > 0.0 && share < 1.0) {
         return Err(invalid(
             key("resonator_share"),
-            format!("must be a number in (0, 1), got {}", shown(share)),
+            format!("must be a number in (0, 1), got {}", number_text(share)),
         ));
     }
     let rod = Rod {

@@ -328,9 +328,7 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
             Ok(out) => out,
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
             Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
-                self.coarse = None;
-                self.previous_change = None;
-                self.dt *= 0.5;
+                self.step_down(None, None);
                 return Ok(Rung::Refine(Refusal::BlewUp(e.to_string())));
             }
             Err(e) => return Err(e),
@@ -395,13 +393,17 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
                 after: change.unwrap_or(f64::NAN),
             }
         };
+        self.step_down(change, Some(fine));
+        let hopeless = self.out_of_reach(&why, halvings_left);
+        Ok(hopeless.map_or(Rung::Refine(why), Rung::GiveUp))
+    }
+
+    /// Halves the step: the run just made (`fine`, with its `change` from the coarse one)
+    /// becomes the next rung's coarse run, or none when it blew up.
+    fn step_down(&mut self, change: Option<f64>, fine: Option<Outcome>) {
         self.previous_change = change;
-        self.coarse = Some(fine);
+        self.coarse = fine;
         self.dt *= 0.5;
-        Ok(match self.out_of_reach(&why, halvings_left) {
-            Some(hopeless) => Rung::GiveUp(hopeless),
-            None => Rung::Refine(why),
-        })
     }
 
     /// A refusal on the estimate alone that the `halvings_left` rungs cannot overturn: it

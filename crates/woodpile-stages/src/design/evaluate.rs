@@ -5,7 +5,7 @@ use woodpile_scene::Scene;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
-use woodpile_points::{point_key, PointResult, PointStore, Series};
+use woodpile_points::{point_key, PointResult, PointStore, Shares};
 
 use super::{Design, Evaluated, Layout, Search};
 use crate::schema::Fraction;
@@ -91,8 +91,8 @@ impl Design {
                     }
                 }
                 let scene = self.scene(&layout, tolerance)?;
-                let key = point_key(&scene, Series::Energy);
-                let fetched = store.get_or_simulate(&key, &scene, Series::Energy)?;
+                let key = point_key(&scene, Shares::Energy);
+                let fetched = store.get_or_simulate(&key, &scene, Shares::Energy)?;
                 let (result, simulated) = (fetched.result, fetched.simulated);
                 events.point_done();
                 let score = self.score(&result);

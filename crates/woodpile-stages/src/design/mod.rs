@@ -198,7 +198,7 @@ impl Design {
 
     /// The stage: the searches, their refinement, the robustness study around the best design,
     /// then the best design inside the space verified and written as a scene file.
-    pub(crate) fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+    pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {
         let (stage, store, events) = (ctx.name(), ctx.store, ctx.events);
         let robust: usize = self
             .robustness
@@ -360,7 +360,7 @@ impl Design {
         let header = format!(
             "# The best design found by stage `{stage}` (woodpile run {stage}): {} = {} at t_end,\n# verified at tolerance {:e}. Run it with: woodpile simulate {}\n",
             self.objective_name(),
-            self.shown(verified.score),
+            self.fraction_of(verified.score),
             self.verify_tolerance,
             best_file.display()
         );
@@ -385,15 +385,15 @@ impl Design {
             "objective": self.objective_name(),
             "goal": if self.maximise { "max" } else { "min" },
             "evaluations": rows.len(),
-            "best": self.shown(verified.score),
+            "best": self.fraction_of(verified.score),
             "best_error_estimate": verified.result.as_ref().ok().and_then(|p| p.error_estimate),
             "best_sites": verified.layout.list(|r| r.site),
             "best_eps": verified.layout.list(|r| r.eps),
             "best_kappa": verified.layout.list(|r| r.kappa),
-            "differential_evolution_best": self.shown(de_best),
-            "random_best": self.shown(random_best),
-            "refined_best": self.shown(refined.max(de_best)),
-            "refined_random_best": self.shown(refined_random.max(random_best)),
+            "differential_evolution_best": self.fraction_of(de_best),
+            "random_best": self.fraction_of(random_best),
+            "refined_best": self.fraction_of(refined.max(de_best)),
+            "refined_random_best": self.fraction_of(refined_random.max(random_best)),
             "best_search": best.search.label(),
             "baseline_beat_optimiser": refined_random.max(random_best) > refined.max(de_best),
             "verify_tolerance": self.verify_tolerance,
@@ -466,7 +466,7 @@ impl Design {
     }
 
     /// A score back as the fraction.
-    fn shown(&self, score: f64) -> f64 {
+    fn fraction_of(&self, score: f64) -> f64 {
         if self.maximise {
             score
         } else {
@@ -488,7 +488,7 @@ impl Kind for Design {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx)
+        self.compute(ctx)
     }
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {

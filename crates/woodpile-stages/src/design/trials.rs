@@ -23,7 +23,7 @@ impl Design {
                     trial: e,
                     search_index: s,
                     evaluation: counters[s],
-                    best_so_far: bests[s].is_finite().then(|| self.shown(bests[s])),
+                    best_so_far: bests[s].is_finite().then(|| self.fraction_of(bests[s])),
                     quantile: None,
                 }
             })

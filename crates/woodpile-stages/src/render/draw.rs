@@ -3,7 +3,7 @@
 //! the `panels` column. The grid shaping of heat maps is `woodpile_plot::Grid`'s.
 
 use polars::prelude::DataFrame;
-use woodpile_plot::{Grid, HeatPanel, LinePanel, Mark, MarkAt, Panel, Series, SeriesStyle};
+use woodpile_plot::{Grid, HeatPanel, LinePanel, Mark, MarkAt, Panel, SeriesStyle, Trace};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::table::{f64_column, matching_rows, str_column};
@@ -147,7 +147,7 @@ impl PanelSpec {
         };
         let point =
             |y: &Values, r: usize| (data.x[r].unwrap_or(f64::NAN), y[r].unwrap_or(f64::NAN));
-        let series: Vec<Series> = match (&data.series, series_name) {
+        let series: Vec<Trace> = match (&data.series, series_name) {
             (Some(ids), Some(name)) => {
                 let mut curves: Vec<(f64, Vec<usize>)> = Vec::new();
                 for &r in rows {
@@ -159,7 +159,7 @@ impl PanelSpec {
                 }
                 curves
                     .into_iter()
-                    .map(|(id, members)| Series {
+                    .map(|(id, members)| Trace {
                         label: data
                             .labels
                             .as_ref()
@@ -173,16 +173,16 @@ impl PanelSpec {
             _ => y_names
                 .iter()
                 .zip(&data.y)
-                .map(|(name, y)| Series {
+                .map(|(name, y)| Trace {
                     label: name.clone(),
                     points: rows.iter().map(|&r| point(y, r)).collect(),
                     style: SeriesStyle::default(),
                 })
                 .collect(),
         };
-        let series: Vec<Series> = series
+        let series: Vec<Trace> = series
             .into_iter()
-            .map(|s: Series| Series {
+            .map(|s: Trace| Trace {
                 style: styles
                     .iter()
                     .find(|c| c.name == s.label)
@@ -225,7 +225,7 @@ impl PanelSpec {
         let overlays = overlays
             .iter()
             .zip(&data.overlays)
-            .map(|((_, label), at)| Series {
+            .map(|((_, label), at)| Trace {
                 label: label.clone(),
                 points: grid.row_steps(&y, &on(at, rows)),
                 style: SeriesStyle::default(),
@@ -259,7 +259,7 @@ impl PanelSpec {
 /// (the lossless end: γ = 0 first, or the largest quality factor first), found by
 /// interpolating between the two samples around the crossing (in log x when both are
 /// positive, as the axes these curves are drawn on). `None` when it never does.
-fn halving_mark(series: &Series) -> Option<Mark> {
+fn halving_mark(series: &Trace) -> Option<Mark> {
     let points: Vec<(f64, f64)> = series
         .points
         .iter()
@@ -325,8 +325,8 @@ fn panel_keys(panel_values: &[Option<f64>], panel_name: Option<&String>) -> Resu
 mod halving_tests {
     use super::*;
 
-    fn series(points: &[(f64, f64)]) -> Series {
-        Series {
+    fn series(points: &[(f64, f64)]) -> Trace {
+        Trace {
             label: "E_tr".into(),
             points: points.to_vec(),
             style: SeriesStyle::default(),

@@ -241,7 +241,7 @@ impl Render {
 
     /// Draws the panels from `inputs` (stage name to its table and manifest) and returns the
     /// plotted numbers, one row per drawn point or cell.
-    pub(crate) fn run(
+    pub(crate) fn compute(
         &self,
         ctx: &Context<'_>,
         inputs: &HashMap<String, (DataFrame, Manifest)>,
@@ -351,7 +351,7 @@ impl Kind for Render {
             .iter()
             .map(|name| Ok((name.clone(), ctx.input_with_manifest(name)?)))
             .collect::<Result<_>>()?;
-        self.run(ctx, &inputs)
+        self.compute(ctx, &inputs)
     }
 
     fn files(&self, stage: &str, _: &Path, figures: &Path) -> Vec<PathBuf> {

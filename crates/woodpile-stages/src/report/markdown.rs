@@ -7,7 +7,7 @@ use super::number::fmt;
 use super::{Paper, Quote, Report};
 
 /// A measured value as the report shows it: the number, or that it failed.
-fn shown(m: &Measured) -> String {
+fn measured_text(m: &Measured) -> String {
     match m.failure {
         Some(_) => "**failed**".into(),
         None => fmt(m.value),
@@ -106,7 +106,7 @@ fn summary_table(
             q.figure,
             q.quantity,
             paper_text(&q.paper),
-            shown(ours),
+            measured_text(ours),
             diff.map_or("–".into(), fmt),
             verdict(&q.paper, ours),
             if by.is_empty() {
@@ -158,7 +158,7 @@ fn convention_row(out: &mut String, paper: &Paper, name: &str, m: &Measured) {
     out.push_str(&format!(
         "| {} | {} | {} | {} | {} | {} | {} |\n",
         name,
-        shown(m),
+        measured_text(m),
         match (&m.failure, m.location.is_empty()) {
             (Some(reason), _) => reason.replace('|', "/"),
             (None, true) => "–".into(),

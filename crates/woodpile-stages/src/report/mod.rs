@@ -241,7 +241,7 @@ impl Report {
         woodpile_points::layout::markdown_path(results, &self.markdown)
     }
 
-    pub(crate) fn run(&self, ctx: &Context<'_>) -> Result<Output> {
+    pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {
         let (stage, results) = (ctx.name(), ctx.results);
         let mut reader = Reader {
             ctx,
@@ -376,7 +376,7 @@ impl Kind for Report {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.run(ctx)
+        self.compute(ctx)
     }
 
     fn files(&self, _: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
