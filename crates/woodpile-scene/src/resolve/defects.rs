@@ -60,7 +60,7 @@ pub(crate) fn resonators(
         let (eps, coupling) = match si {
             None => dimensionless(&key, d)?,
             Some(si) => {
-                let (eps, kappa, found) = physical(&key, d, p, si, site_paper)?;
+                let found = physical(&key, d, p, si, site_paper)?;
                 if found.host_mass_kg.is_some() || d.mass.is_some() {
                     sites.mass_from_defect[site] = Some(i);
                 }
@@ -70,8 +70,8 @@ pub(crate) fn resonators(
                     sites.set_contact(site, a);
                     sites.set_contact(site + 1, a);
                 }
-                derived.push(found.derived);
-                (eps, Coupling::Constant(kappa))
+                derived.push(found);
+                (found.eps, Coupling::Constant(found.kappa))
             }
         };
         resonators.push(Resonator {
@@ -107,22 +107,15 @@ fn dimensionless(
     Ok((eps, coupling))
 }
 
-/// What an SI defect derived: its host mass (ratio), its contact with its neighbours when its
-/// rod differs from the regular one (ratio), and the values the JSON lists.
-struct FoundSi {
-    host_mass_ratio: f64,
-    host_mass_kg: Option<f64>,
-    contact_ratio: Option<f64>,
-    derived: DerivedDefect,
-}
-
+/// A defect of a [physical] scene: what it derives (its eps and kappa, its host mass, its own
+/// contact when its rod differs from the regular one), as the JSON lists it.
 fn physical(
     key: &dyn Fn(&str) -> String,
     d: &raw::Defect,
     p: u32,
     si: &Si,
     site_paper: i64,
-) -> Result<(f64, f64, FoundSi), Invalid> {
+) -> Result<DerivedDefect, Invalid> {
     reject_present(
         key,
         &[("eps", d.eps.is_some()), ("kappa", d.kappa.is_some())],
@@ -141,7 +134,7 @@ fn physical_masses(
     p: u32,
     si: &Si,
     site_paper: i64,
-) -> Result<(f64, f64, FoundSi), Invalid> {
+) -> Result<DerivedDefect, Invalid> {
     let sc = si.scales;
     if d.resonator_share.is_some() {
         return Err(invalid(key("resonator_share"), "needs rod = { length }"));
@@ -159,23 +152,13 @@ fn physical_masses(
     let host = positive(&key("mass"), d.mass.unwrap_or(sc.mass_kg))?;
     let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, p));
     let host_mass_ratio = sc.mass_ratio(host);
-    let derived = DerivedDefect {
+    Ok(DerivedDefect {
         site: site_paper,
         host_mass_ratio,
         eps,
         kappa,
         ..DerivedDefect::default()
-    };
-    Ok((
-        eps,
-        kappa,
-        FoundSi {
-            host_mass_ratio,
-            host_mass_kg: None,
-            contact_ratio: None,
-            derived,
-        },
-    ))
+    })
 }
 
 /// A defect of a [physical] scene whose resonator is its rod's bending mode.
@@ -186,7 +169,7 @@ fn physical_rod(
     p: u32,
     si: &Si,
     site_paper: i64,
-) -> Result<(f64, f64, FoundSi), Invalid> {
+) -> Result<DerivedDefect, Invalid> {
     let sc = si.scales;
     reject_present(
         key,
@@ -213,7 +196,7 @@ fn physical_rod(
         .then_some(si.rod.as_ref())
         .flatten()
         .map(|regular| rods::crossed_rods_coefficient(&found.rod, regular) / sc.hertz);
-    let derived = DerivedDefect {
+    Ok(DerivedDefect {
         site: site_paper,
         host_mass_ratio,
         eps,
@@ -223,17 +206,7 @@ fn physical_rod(
         stiffness_n_per_m: Some(found.stiffness),
         bending_f1_hz: Some(found.f1_hz),
         contact_ratio: own_contact,
-    };
-    Ok((
-        eps,
-        kappa,
-        FoundSi {
-            host_mass_ratio,
-            host_mass_kg: Some(found.host_kg),
-            contact_ratio: own_contact,
-            derived,
-        },
-    ))
+    })
 }
 
 fn coupling(key: &str, value: &toml::Value) -> Result<Coupling, Invalid> {
