@@ -87,8 +87,6 @@ fn main() {
             .position(|a| a == name)
             .and_then(|i| args.get(i + 1).cloned())
     };
-    let c_binary = option("--c");
-    let numba_script = option("--numba");
     let repeats: usize = option("--repeats")
         .and_then(|r| r.parse().ok())
         .unwrap_or(10);
@@ -100,7 +98,27 @@ fn main() {
          (yoshida6, dt = 2.5e-4; |ref - rk4(dt = 5e-4)| = {:.1e}); best of {repeats} runs\n",
         (reference - check).abs()
     );
+    let mut rows = our_rows(repeats, reference);
+    let reference_ms = baseline_rows(
+        (option("--c"), option("--numba")),
+        repeats,
+        reference,
+        &mut rows,
+    );
+    print_rows(&rows, &reference_ms);
 
+    let per_sweep: usize = option("--paper").and_then(|n| n.parse().ok()).unwrap_or(8);
+    let seed: u64 = option("--seed")
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(2026);
+    if per_sweep > 0 {
+        paper_level(per_sweep, seed, option("--numba-scenes").as_deref());
+    }
+}
+
+/// woodpile's rows on the standard scene: each method at its steps, `auto`, and the full
+/// chain without the active window; `reference` is the converged E_tr.
+fn our_rows(repeats: usize, reference: f64) -> Vec<Row> {
     let mut rows = Vec::new();
     let mut ours = |setting: &str, ms_value: (f64, f64)| {
         rows.push(Row {
@@ -141,7 +159,17 @@ fn main() {
         "rk4 dt = 0.01, full chain (no active window)",
         best_ms(repeats, || full_chain(&scene, Method::Rk4, 0.01)),
     );
+    rows
+}
 
+/// The C and numba baselines given (`--c`, `--numba`), each run in this run, as rows; their
+/// names and times, which every row is divided by.
+fn baseline_rows(
+    (c_binary, numba_script): (Option<String>, Option<String>),
+    repeats: usize,
+    reference: f64,
+    rows: &mut Vec<Row>,
+) -> Vec<(String, f64)> {
     let mut baselines = Vec::new();
     let repeats_text = repeats.to_string();
     if let Some(c) = &c_binary {
@@ -165,20 +193,25 @@ fn main() {
             Err(e) => eprintln!("baseline skipped: {e}"),
         }
     }
+    reference_ms
+}
 
+/// The rows as a Markdown table on stdout (a ratio column per baseline) and as JSON lines on
+/// stderr.
+fn print_rows(rows: &[Row], reference_ms: &[(String, f64)]) {
     let mut header = "| implementation | setting | abs error E_tr | wall ms |".to_string();
     let mut rule = "|---|---|---|---|".to_string();
-    for (name, _) in &reference_ms {
+    for (name, _) in reference_ms {
         header.push_str(&format!(" time / {name} |"));
         rule.push_str("---|");
     }
     println!("{header}\n{rule}");
-    for r in &rows {
+    for r in rows {
         let mut line = format!(
             "| {} | {} | {:.1e} | {:.2} |",
             r.implementation, r.setting, r.error, r.ms
         );
-        for (_, ms) in &reference_ms {
+        for (_, ms) in reference_ms {
             line.push_str(&format!(" {:.2} |", r.ms / ms));
         }
         println!("{line}");
@@ -187,14 +220,6 @@ fn main() {
             serde_json::json!({"implementation": r.implementation, "setting": r.setting,
                 "abs_error_E_tr": r.error, "ms": r.ms})
         );
-    }
-
-    let per_sweep: usize = option("--paper").and_then(|n| n.parse().ok()).unwrap_or(8);
-    let seed: u64 = option("--seed")
-        .and_then(|n| n.parse().ok())
-        .unwrap_or(2026);
-    if per_sweep > 0 {
-        paper_level(per_sweep, seed, option("--numba-scenes").as_deref());
     }
 }
 

@@ -5,8 +5,9 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use crate::axis::Scale;
 use crate::chart::{chart, plot_rect, text, wrap, FONT};
-use crate::legend::{self, Entry, Glyph};
+use crate::legend::{self, Entry, Glyph, Rect};
 use crate::panel::{inside_place, mark_entries, marks, pixel_curves, range, Ranges, Shared};
 use crate::style::{Corner, Legend, Style};
 use crate::{Figure, LinePanel, Panel};
@@ -18,20 +19,7 @@ pub(crate) fn figure<DB: DrawingBackend>(
 ) -> Result<Vec<usize>, String> {
     let style = &fig.style;
     root.fill(&WHITE).map_err(text)?;
-    let width = root.dim_in_pixel().0 as f64;
-    let title_font = (FONT, style.font(1.2)).into_font().color(&BLACK);
-    let lines = wrap(root, &fig.title, width - style.pt(8.0), &title_font);
-    let strip = (lines.len() as f64 * style.font(1.2) * 1.3 + style.pt(4.0)).round() as u32;
-    let (top, body) = root.split_vertically(strip);
-    for (k, line) in lines.iter().enumerate() {
-        let y = style.pt(2.0) + k as f64 * style.font(1.2) * 1.3;
-        top.draw(&Text::new(
-            line.clone(),
-            (style.pt(4.0) as i32, y as i32),
-            title_font.clone(),
-        ))
-        .map_err(text)?;
-    }
+    let body = figure_title(root, &fig.title, style)?;
     let heat_maps: Vec<_> = fig.panels.iter().filter_map(Panel::as_heat).collect();
     let shared_bar = fig.shared_colour_bar && !heat_maps.is_empty();
     let (body, bar) = if shared_bar {
@@ -56,31 +44,7 @@ pub(crate) fn figure<DB: DrawingBackend>(
         Panel::Heat(_) => None,
     });
     let shared_heat = shared_ranges(fig, |p| p.as_heat().map(crate::heat::ranges));
-    // Every panel's title strip holds as many lines as the longest title needs, so the
-    // panels of a row stay aligned.
-    let title_font = (FONT, style.font(1.1)).into_font().color(&BLACK);
-    let title_lines: Vec<Vec<String>> = fig
-        .panels
-        .iter()
-        .zip(areas.iter())
-        .map(|(p, a)| {
-            wrap(
-                a,
-                p.title(),
-                a.dim_in_pixel().0 as f64 - style.pt(24.0),
-                &title_font,
-            )
-        })
-        .collect();
-    // One panel is the figure: no letter, and no strip for a title it does not have.
-    let letters = style.panel_letters && fig.panels.len() > 1;
-    let has_title = |lines: &Vec<String>| lines.iter().any(|l| !l.is_empty());
-    let strip_lines = title_lines
-        .iter()
-        .filter(|l| has_title(l))
-        .map(Vec::len)
-        .max()
-        .unwrap_or(usize::from(letters));
+    let (title_lines, strip_lines, letters) = panel_titles(fig, &areas, style);
     let mut covered = Vec::with_capacity(fig.panels.len());
     for (k, (panel, area)) in fig.panels.iter().zip(areas.iter()).enumerate() {
         let letter = letters.then(|| format!("({})", char::from(b'a' + (k % 26) as u8)));
@@ -104,6 +68,63 @@ pub(crate) fn figure<DB: DrawingBackend>(
         }
     }
     Ok(covered)
+}
+
+/// Draws the figure's title, wrapped, in a strip at the top of `root`; returns the area below.
+fn figure_title<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    style: &Style,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    let width = root.dim_in_pixel().0 as f64;
+    let title_font = (FONT, style.font(1.2)).into_font().color(&BLACK);
+    let lines = wrap(root, title, width - style.pt(8.0), &title_font);
+    let strip = (lines.len() as f64 * style.font(1.2) * 1.3 + style.pt(4.0)).round() as u32;
+    let (top, body) = root.split_vertically(strip);
+    for (k, line) in lines.iter().enumerate() {
+        let y = style.pt(2.0) + k as f64 * style.font(1.2) * 1.3;
+        top.draw(&Text::new(
+            line.clone(),
+            (style.pt(4.0) as i32, y as i32),
+            title_font.clone(),
+        ))
+        .map_err(text)?;
+    }
+    Ok(body)
+}
+
+/// Each panel's title wrapped to its area, the lines every panel's title strip holds (as
+/// many as the longest title needs, so the panels of a row stay aligned), and whether the
+/// panels are lettered (one panel is the figure: no letter, and no strip for a title it does
+/// not have).
+fn panel_titles<DB: DrawingBackend>(
+    fig: &Figure,
+    areas: &[DrawingArea<DB, Shift>],
+    style: &Style,
+) -> (Vec<Vec<String>>, usize, bool) {
+    let title_font = (FONT, style.font(1.1)).into_font().color(&BLACK);
+    let title_lines: Vec<Vec<String>> = fig
+        .panels
+        .iter()
+        .zip(areas.iter())
+        .map(|(p, a)| {
+            wrap(
+                a,
+                p.title(),
+                a.dim_in_pixel().0 as f64 - style.pt(24.0),
+                &title_font,
+            )
+        })
+        .collect();
+    let letters = style.panel_letters && fig.panels.len() > 1;
+    let has_title = |lines: &Vec<String>| lines.iter().any(|l| !l.is_empty());
+    let strip_lines = title_lines
+        .iter()
+        .filter(|l| has_title(l))
+        .map(Vec::len)
+        .max()
+        .unwrap_or(usize::from(letters));
+    (title_lines, strip_lines, letters)
 }
 
 /// Draws a panel's title lines (and letter) over it, in a strip of `strip_lines` lines; returns
@@ -200,6 +221,7 @@ fn lines_panel<DB: DrawingBackend>(
     if x1 <= x0 || x0.is_nan() || x1.is_nan() {
         (x0, x1) = (x0 - 0.5, x0 + 0.5);
     }
+    let (xs, ys) = ((x0, x1, sx), (y0, y1, sy));
     let curves: Vec<Vec<(f64, f64)>> = p
         .series
         .iter()
@@ -210,53 +232,9 @@ fn lines_panel<DB: DrawingBackend>(
                 .collect()
         })
         .collect();
-    let mut entries: Vec<Entry> = p
-        .series
-        .iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let (colour, dash, marker) = s.style.resolve(k);
-            Entry {
-                label: s.label.clone(),
-                glyph: Glyph::Line {
-                    colour,
-                    dash,
-                    marker,
-                    width_pt: 1.2,
-                },
-            }
-        })
-        .collect();
-    // One curve is named by the y label; a legend would only hide data.
-    let wants_legend = (p.series.len() > 1 || !p.marks.is_empty()) && style.legend != Legend::None;
-    // A mark labelled like a curve shares its entry.
-    entries.extend(
-        mark_entries(&p.marks)
-            .into_iter()
-            .filter(|m| !p.series.iter().any(|s| s.label == m.label)),
-    );
+    let entries = line_entries(p);
     let size = legend::measure(area, &entries, style);
-    // Where the legend goes decides the chart's area, so place it on a trial chart first.
-    let mut placement = if wants_legend {
-        style.legend
-    } else {
-        Legend::None
-    };
-    if placement == Legend::Best {
-        let trial = chart(area, (x0, x1, sx), (y0, y1, sy), style, None)?;
-        let points = pixel_curves(&trial, &curves);
-        if inside_place(
-            Legend::Best,
-            &plot_rect(&trial),
-            size,
-            &legend::dense(&points, 2.0),
-            style,
-        )
-        .is_none()
-        {
-            placement = Legend::OutsideRight;
-        }
-    }
+    let placement = line_legend_placement(area, p, (xs, ys), &curves, size, style)?;
     let gap = style.pt(4.0);
     let (main, side) = match placement {
         Legend::OutsideRight => {
@@ -271,36 +249,10 @@ fn lines_panel<DB: DrawingBackend>(
         }
         _ => (area.clone(), None),
     };
-    let chart = chart(
-        &main,
-        (x0, x1, sx),
-        (y0, y1, sy),
-        style,
-        Some((&p.x_label, &p.y_label, true)),
-    )?;
+    let chart = chart(&main, xs, ys, style, Some((&p.x_label, &p.y_label, true)))?;
     let rect = plot_rect(&chart);
     let points = pixel_curves(&chart, &curves);
-    for (k, (series, line)) in p.series.iter().zip(&points).enumerate() {
-        let (colour, dash, marker) = series.style.resolve(k);
-        // A non-finite value (a failed point, or <= 0 on a log axis) breaks the line.
-        for segment in line.split(|q| !(q.0.is_finite() && q.1.is_finite())) {
-            legend::polyline(area, segment, &rect, (colour, dash, 1.2), style)?;
-        }
-        // Every point when there are few; otherwise about eight per curve, evenly spaced
-        // across the plot's width (whatever the axis scale), staggered so that curves
-        // sharing an x do not stack their markers.
-        let spacing = (rect.x1 - rect.x0) / 8.0;
-        let mut next = rect.x0 + spacing * (k as f64 / p.series.len().max(1) as f64);
-        for &q in line {
-            if !(q.0.is_finite() && q.1.is_finite() && rect.contains_point(q)) {
-                continue;
-            }
-            if line.len() <= 40 || q.0 >= next {
-                legend::marker(area, q, marker, colour, style)?;
-                next = q.0 + spacing;
-            }
-        }
-    }
+    draw_lines(area, p, &points, &rect, style)?;
     let mark_lines = marks(area, &chart, &p.marks, (sx, sy), style)?;
     let all: Vec<Vec<(f64, f64)>> = points.into_iter().chain(mark_lines).collect();
     let dense = legend::dense(&all, 2.0);
@@ -325,4 +277,97 @@ fn lines_panel<DB: DrawingBackend>(
     };
     legend::draw(area, &entries, at, style)?;
     Ok(legend::covered(&dense, at, size, style))
+}
+
+/// The legend's entries of a line panel: a line per curve, then each mark whose label no
+/// curve has (a mark labelled like a curve shares its entry).
+fn line_entries(p: &LinePanel) -> Vec<Entry> {
+    let mut entries: Vec<Entry> = p
+        .series
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let (colour, dash, marker) = s.style.resolve(k);
+            Entry {
+                label: s.label.clone(),
+                glyph: Glyph::Line {
+                    colour,
+                    dash,
+                    marker,
+                    width_pt: 1.2,
+                },
+            }
+        })
+        .collect();
+    entries.extend(
+        mark_entries(&p.marks)
+            .into_iter()
+            .filter(|m| !p.series.iter().any(|s| s.label == m.label)),
+    );
+    entries
+}
+
+/// Where a line panel's legend goes: none for one curve without marks (the y label names
+/// it), and `Best` moves outside on the right when no corner of a trial chart is free.
+fn line_legend_placement<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &LinePanel,
+    (xs, ys): ((f64, f64, Scale), (f64, f64, Scale)),
+    curves: &[Vec<(f64, f64)>],
+    size: (f64, f64),
+    style: &Style,
+) -> Result<Legend, String> {
+    let wants_legend = (p.series.len() > 1 || !p.marks.is_empty()) && style.legend != Legend::None;
+    if !wants_legend {
+        return Ok(Legend::None);
+    }
+    if style.legend != Legend::Best {
+        return Ok(style.legend);
+    }
+    // Where the legend goes decides the chart's area, so place it on a trial chart first.
+    let trial = chart(area, xs, ys, style, None)?;
+    let points = pixel_curves(&trial, curves);
+    let free = inside_place(
+        Legend::Best,
+        &plot_rect(&trial),
+        size,
+        &legend::dense(&points, 2.0),
+        style,
+    );
+    Ok(match free {
+        Some(_) => Legend::Best,
+        None => Legend::OutsideRight,
+    })
+}
+
+/// Each curve of `p` at its pixel `points`, broken at non-finite values, with its markers.
+fn draw_lines<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    p: &LinePanel,
+    points: &[Vec<(f64, f64)>],
+    rect: &Rect,
+    style: &Style,
+) -> Result<(), String> {
+    for (k, (series, line)) in p.series.iter().zip(points).enumerate() {
+        let (colour, dash, marker) = series.style.resolve(k);
+        // A non-finite value (a failed point, or <= 0 on a log axis) breaks the line.
+        for segment in line.split(|q| !(q.0.is_finite() && q.1.is_finite())) {
+            legend::polyline(area, segment, rect, (colour, dash, 1.2), style)?;
+        }
+        // Every point when there are few; otherwise about eight per curve, evenly spaced
+        // across the plot's width (whatever the axis scale), staggered so that curves
+        // sharing an x do not stack their markers.
+        let spacing = (rect.x1 - rect.x0) / 8.0;
+        let mut next = rect.x0 + spacing * (k as f64 / p.series.len().max(1) as f64);
+        for &q in line {
+            if !(q.0.is_finite() && q.1.is_finite() && rect.contains_point(q)) {
+                continue;
+            }
+            if line.len() <= 40 || q.0 >= next {
+                legend::marker(area, q, marker, colour, style)?;
+                next = q.0 + spacing;
+            }
+        }
+    }
+    Ok(())
 }

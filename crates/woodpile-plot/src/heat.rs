@@ -5,9 +5,10 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::chart::{chart, pixel, plot_rect, text, Ticked, FONT};
+use crate::axis::Scale;
+use crate::chart::{chart, pixel, plot_rect, text, Chart, Ticked, FONT};
 use crate::colour::{diverging, viridis, Dash, Marker, CATEGORIES};
-use crate::legend::{self, Entry, Glyph};
+use crate::legend::{self, Entry, Glyph, Rect};
 use crate::panel::{inside_place, mark_entries, marks, pixel_curves, Ranges, Shared};
 use crate::style::{Corner, Legend, Style};
 use crate::{Colours, HeatPanel};
@@ -200,31 +201,9 @@ pub(crate) fn panel<DB: DrawingBackend>(
         chart.plotting_area().draw(&image).map_err(text)?;
     }
     let rect = plot_rect(&chart);
-    if let Some((x, y, label)) = &h.marker {
-        let at = pixel(&chart, (sx.to_plot(*x), sy.to_plot(*y)));
-        let r = style.pt(3.0);
-        let (bx, by) = area.get_base_pixel();
-        let (cx, cy) = (at.0 as i32 - bx, at.1 as i32 - by);
-        area.draw(&Circle::new(
-            (cx, cy),
-            r as i32,
-            ShapeStyle::from(&WHITE).stroke_width(style.stroke(0.8)),
-        ))
-        .map_err(text)?;
-        // The label goes above the circle, or below it near the top edge.
-        let font = (FONT, style.font(1.0)).into_font().color(&WHITE);
-        let dy = if at.1 - rect.y0 < 3.0 * style.font(1.0) {
-            r as i32
-        } else {
-            -(r as i32) - style.font(1.0) as i32
-        };
-        area.draw(&Text::new(label.clone(), (cx + r as i32, cy + dy), font))
-            .map_err(text)?;
+    if let Some(marker) = &h.marker {
+        draw_marker(area, &chart, &rect, marker, (sx, sy), style)?;
     }
-    let overlay_colours = match h.colours {
-        Colours::Sequential => OVERLAY_COLOURS,
-        Colours::Diverging | Colours::Categories(_) => OVERLAY_COLOURS_ON_COLOUR,
-    };
     let curves: Vec<Vec<(f64, f64)>> = h
         .overlays
         .iter()
@@ -236,22 +215,7 @@ pub(crate) fn panel<DB: DrawingBackend>(
         })
         .collect();
     let lines = pixel_curves(&chart, &curves);
-    let mut entries = Vec::new();
-    for (k, (overlay, line)) in h.overlays.iter().zip(&lines).enumerate() {
-        let colour = overlay_colours[k % overlay_colours.len()];
-        for segment in line.split(|q| !(q.0.is_finite() && q.1.is_finite())) {
-            legend::polyline(area, segment, &rect, (colour, Dash::Solid, 1.5), style)?;
-        }
-        entries.push(Entry {
-            label: overlay.label.clone(),
-            glyph: Glyph::Line {
-                colour,
-                dash: Dash::Solid,
-                marker: Marker::None,
-                width_pt: 1.5,
-            },
-        });
-    }
+    let mut entries = draw_overlays(area, h, &lines, &rect, style)?;
     let mark_lines = marks(area, &chart, &h.marks, (sx, sy), style)?;
     entries.extend(mark_entries(&h.marks));
     if let Some(bar) = bar {
@@ -279,6 +243,68 @@ pub(crate) fn panel<DB: DrawingBackend>(
     };
     legend::draw(area, &entries, at, style)?;
     Ok(legend::covered(&dense, at, size, style))
+}
+
+/// The map's marked point (the maximum): a white circle and its label, above the circle, or
+/// below it near the top edge.
+fn draw_marker<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    chart: &Chart<'_, DB>,
+    rect: &Rect,
+    (x, y, label): &(f64, f64, String),
+    (sx, sy): (Scale, Scale),
+    style: &Style,
+) -> Result<(), String> {
+    let at = pixel(chart, (sx.to_plot(*x), sy.to_plot(*y)));
+    let r = style.pt(3.0);
+    let (bx, by) = area.get_base_pixel();
+    let (cx, cy) = (at.0 as i32 - bx, at.1 as i32 - by);
+    area.draw(&Circle::new(
+        (cx, cy),
+        r as i32,
+        ShapeStyle::from(&WHITE).stroke_width(style.stroke(0.8)),
+    ))
+    .map_err(text)?;
+    let font = (FONT, style.font(1.0)).into_font().color(&WHITE);
+    let dy = if at.1 - rect.y0 < 3.0 * style.font(1.0) {
+        r as i32
+    } else {
+        -(r as i32) - style.font(1.0) as i32
+    };
+    area.draw(&Text::new(label.clone(), (cx + r as i32, cy + dy), font))
+        .map_err(text)
+}
+
+/// Each overlay curve at its pixel `lines`, in the overlay colours that read on the map's
+/// colours; their legend entries.
+fn draw_overlays<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    h: &HeatPanel,
+    lines: &[Vec<(f64, f64)>],
+    rect: &Rect,
+    style: &Style,
+) -> Result<Vec<Entry>, String> {
+    let overlay_colours = match h.colours {
+        Colours::Sequential => OVERLAY_COLOURS,
+        Colours::Diverging | Colours::Categories(_) => OVERLAY_COLOURS_ON_COLOUR,
+    };
+    let mut entries = Vec::new();
+    for (k, (overlay, line)) in h.overlays.iter().zip(lines).enumerate() {
+        let colour = overlay_colours[k % overlay_colours.len()];
+        for segment in line.split(|q| !(q.0.is_finite() && q.1.is_finite())) {
+            legend::polyline(area, segment, rect, (colour, Dash::Solid, 1.5), style)?;
+        }
+        entries.push(Entry {
+            label: overlay.label.clone(),
+            glyph: Glyph::Line {
+                colour,
+                dash: Dash::Solid,
+                marker: Marker::None,
+                width_pt: 1.5,
+            },
+        });
+    }
+    Ok(entries)
 }
 
 /// The map's colour scale as a strip with its own labelled axis, its label written level
