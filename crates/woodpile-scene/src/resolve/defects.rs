@@ -60,7 +60,13 @@ pub(crate) fn resonators(
         let (eps, coupling) = match si {
             None => dimensionless(&key, d)?,
             Some(si) => {
-                let found = physical(&key, d, p, si, site_paper)?;
+                let found = physical(&SiDefect {
+                    key: &key,
+                    d,
+                    p,
+                    si,
+                    site: site_paper,
+                })?;
                 if found.host_mass_kg.is_some() || d.mass.is_some() {
                     sites.mass_from_defect[site] = Some(i);
                 }
@@ -109,32 +115,38 @@ fn dimensionless(
 
 /// A defect of a [physical] scene: what it derives (its eps and kappa, its host mass, its own
 /// contact when its rod differs from the regular one), as the JSON lists it.
-fn physical(
-    key: &dyn Fn(&str) -> String,
-    d: &raw::Defect,
+/// One defect of a [physical] scene being resolved: the keys of its messages, its table, its
+/// exponent, the scene's scales and its paper site.
+struct SiDefect<'a> {
+    key: &'a dyn Fn(&str) -> String,
+    d: &'a raw::Defect,
     p: u32,
-    si: &Si,
-    site_paper: i64,
-) -> Result<DerivedDefect, Invalid> {
+    si: &'a Si,
+    site: i64,
+}
+
+fn physical(x: &SiDefect<'_>) -> Result<DerivedDefect, Invalid> {
+    let SiDefect { key, d, .. } = *x;
     reject_present(
         key,
         &[("eps", d.eps.is_some()), ("kappa", d.kappa.is_some())],
         "is derived in a [physical] scene: give resonator_mass (kg) and stiffness (N/m^p), or rod",
     )?;
     match &d.rod {
-        None => physical_masses(key, d, p, si, site_paper),
-        Some(rod) => physical_rod(key, d, rod, p, si, site_paper),
+        None => physical_masses(x),
+        Some(rod) => physical_rod(x, rod),
     }
 }
 
 /// A defect of a [physical] scene given by its resonator's mass and stiffness.
-fn physical_masses(
-    key: &dyn Fn(&str) -> String,
-    d: &raw::Defect,
-    p: u32,
-    si: &Si,
-    site_paper: i64,
-) -> Result<DerivedDefect, Invalid> {
+fn physical_masses(x: &SiDefect<'_>) -> Result<DerivedDefect, Invalid> {
+    let SiDefect {
+        key,
+        d,
+        p,
+        si,
+        site,
+    } = *x;
     let sc = si.scales;
     if d.resonator_share.is_some() {
         return Err(invalid(key("resonator_share"), "needs rod = { length }"));
@@ -153,7 +165,7 @@ fn physical_masses(
     let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, p));
     let host_mass_ratio = sc.mass_ratio(host);
     Ok(DerivedDefect {
-        site: site_paper,
+        site,
         host_mass_ratio,
         eps,
         kappa,
@@ -162,14 +174,14 @@ fn physical_masses(
 }
 
 /// A defect of a [physical] scene whose resonator is its rod's bending mode.
-fn physical_rod(
-    key: &dyn Fn(&str) -> String,
-    d: &raw::Defect,
-    rod: &raw::DefectRod,
-    p: u32,
-    si: &Si,
-    site_paper: i64,
-) -> Result<DerivedDefect, Invalid> {
+fn physical_rod(x: &SiDefect<'_>, rod: &raw::DefectRod) -> Result<DerivedDefect, Invalid> {
+    let SiDefect {
+        key,
+        d,
+        p,
+        si,
+        site,
+    } = *x;
     let sc = si.scales;
     reject_present(
         key,
@@ -197,7 +209,7 @@ fn physical_rod(
         .flatten()
         .map(|regular| rods::crossed_rods_coefficient(&found.rod, regular) / sc.hertz);
     Ok(DerivedDefect {
-        site: site_paper,
+        site,
         host_mass_ratio,
         eps,
         kappa,
