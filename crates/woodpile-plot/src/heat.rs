@@ -159,31 +159,7 @@ pub(crate) fn panel<DB: DrawingBackend>(
     own_bar: bool,
 ) -> Result<usize, String> {
     let (sx, sy) = (h.view.x_scale, h.view.y_scale);
-    let width = area.dim_in_pixel().0;
-    let bar_width = match &h.colours {
-        Colours::Categories(names) => {
-            legend::measure(area, &category_entries(names), style).0 + style.pt(6.0)
-        }
-        _ => style.mm(17.0),
-    };
-    let (main, bar) = if own_bar {
-        let (m, b) = area.split_horizontally(width.saturating_sub(bar_width as u32));
-        (m, Some(b))
-    } else {
-        (area.clone(), None)
-    };
-    // Overlay and mark legends go under the map, which has no free corner.
-    let entry_count = h.overlays.len() + mark_entries(&h.marks).len();
-    let (main, below) = if entry_count > 0
-        && style.legend != Legend::None
-        && !matches!(style.legend, Legend::Inside(_))
-    {
-        let rows = entry_count as f64 * style.font(1.35) + style.pt(8.0);
-        let (m, b) = main.split_vertically((main.dim_in_pixel().1 as f64 - rows).max(1.0) as u32);
-        (m, Some(b))
-    } else {
-        (main, None)
-    };
+    let (main, bar, below) = panel_areas(area, h, style, own_bar);
     let ((x0, x1), (y0, y1)) = shared.apply(&h.view, ranges(h));
     let scale = ColourScale::of(h);
     let chart = chart(
@@ -243,6 +219,43 @@ pub(crate) fn panel<DB: DrawingBackend>(
     };
     legend::draw(area, &entries, at, style)?;
     Ok(legend::covered(&dense, at, size, style))
+}
+
+/// A heat panel's areas: the map, its own colour bar (when it has one) on the right, and a
+/// strip under the map for the overlay and mark legends (the map has no free corner).
+#[allow(clippy::type_complexity)]
+fn panel_areas<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    h: &HeatPanel,
+    style: &Style,
+    own_bar: bool,
+) -> (
+    DrawingArea<DB, Shift>,
+    Option<DrawingArea<DB, Shift>>,
+    Option<DrawingArea<DB, Shift>>,
+) {
+    let width = area.dim_in_pixel().0;
+    let bar_width = match &h.colours {
+        Colours::Categories(names) => {
+            legend::measure(area, &category_entries(names), style).0 + style.pt(6.0)
+        }
+        _ => style.mm(17.0),
+    };
+    let (main, bar) = if own_bar {
+        let (m, b) = area.split_horizontally(width.saturating_sub(bar_width as u32));
+        (m, Some(b))
+    } else {
+        (area.clone(), None)
+    };
+    let entry_count = h.overlays.len() + mark_entries(&h.marks).len();
+    if entry_count > 0 && style.legend != Legend::None && !matches!(style.legend, Legend::Inside(_))
+    {
+        let rows = entry_count as f64 * style.font(1.35) + style.pt(8.0);
+        let (m, b) = main.split_vertically((main.dim_in_pixel().1 as f64 - rows).max(1.0) as u32);
+        (m, bar, Some(b))
+    } else {
+        (main, bar, None)
+    }
 }
 
 /// The map's marked point (the maximum): a white circle and its label, above the circle, or
