@@ -83,7 +83,7 @@ pub fn cost_note(scene: &Scene) -> Option<String> {
     let f = budget::forecast(&scene.scenario)?;
     (f.first_rung_s > budget::LONG_RUN_S).then(|| {
         format!(
-            "auto's first rung is two runs of about {:.2e} and {:.2e} steps over {} sites and resonators (step {:.2e}): roughly {} on a 2026 laptop core, and up to {} if the tolerance needs every halving; a looser tolerance or a shorter t_end is faster",
+            "auto's first rung is two runs of about {:.2e} and {:.2e} steps over {} sites and resonators (step {:.2e}): roughly {} at the rate measured on woodpile's development machine, and up to {} if the tolerance needs every halving; a looser tolerance or a shorter t_end is faster",
             f.steps,
             f.steps / 2.0,
             f.sites,

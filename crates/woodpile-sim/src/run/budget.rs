@@ -13,7 +13,7 @@ use crate::integrate::{intervals, MethodChoice, Plan, MAX_STEPS};
 use crate::SimError;
 
 /// Seconds one step of one site costs `auto` on a chain whose moving window spans it, as
-/// measured on the development machine (2 cores, 2026; `rkn6-contact`, five force evaluations
+/// measured on the development machine (a 2-core VM; `rkn6-contact`, five force evaluations
 /// a step): the 401-site chain with three nonlinear resonators over t = 1500 took 33 s for
 /// 3.6e9 site-steps. A narrower window (a short run on a long chain) costs less, so forecasts
 /// made with it are upper bounds, within a factor of a few of any recent machine.
