@@ -48,7 +48,7 @@ wheel-test: wheel ## Install the wheel into a fresh venv with no cargo on the PA
 	rm -rf $(WHEEL_VENV)
 	python3 -m venv $(WHEEL_VENV)
 	$(WHEEL_VENV)/bin/pip install --quiet --disable-pip-version-check "$$(ls dist/woodpile-*.whl)[notebook]" pytest nbclient nbformat
-	env -u WOODPILE_BIN WOODPILE_TEST_INSTALLED=1 PATH="$(abspath $(WHEEL_VENV))/bin:$(NO_CARGO_PATH)" sh -ec '\
+	env -u WOODPILE_BIN WOODPILE_TEST_INSTALLED=1 PATH="$(abspath $(WHEEL_VENV))/bin:$(NO_CARGO_PATH)" /bin/sh -ec '\
 	  if command -v cargo; then echo "cargo is still on the PATH" >&2; exit 1; fi; \
 	  woodpile --version; \
 	  python -m pytest -q -p no:cacheprovider python/tests; \
