@@ -9,12 +9,13 @@ use std::sync::Arc;
 use polars::prelude::{Column, DataFrame};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::kind::{Context, Kind, Registry};
+use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck, Registry};
 use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::{Output, Pipeline, PipelineError};
 
-/// `kind = "note"`: writes `text` to `<results>/<folder>/<stage>.txt` (declared), or, with
+/// `kind = "note"` (any inputs): writes `text` to `<results>/<folder>/<stage>.txt` (declared), or, with
 /// `stray = "name"`, to `<results>/name`, which it does not declare.
 #[derive(Debug)]
 struct Note {
@@ -30,6 +31,11 @@ impl Note {
 }
 
 impl Kind for Note {
+    // A note may read any stage: the tests chain notes to see failures travel downstream.
+    fn check_inputs(&self, _: &Stage, _: &Inputs<'_>) -> KindCheck {
+        Ok(())
+    }
+
     fn run(&self, ctx: &Context<'_>) -> woodpile_pipeline::Result<Output> {
         let path = match &self.stray {
             None => self.path(ctx.results, ctx.name()),
@@ -58,10 +64,17 @@ impl Events for Silent {}
 
 /// A project with one `note` stage whose file holds `body` (TOML keys of the stage).
 fn project(body: &str) -> tempfile::TempDir {
+    notes(&[("note", body)])
+}
+
+/// A project with a `note` stage per (name, body).
+fn notes(stages: &[(&str, &str)]) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("pipeline")).unwrap();
-    let stage = format!("kind = \"note\"\n{body}\n");
-    std::fs::write(dir.path().join("pipeline/note.toml"), stage).unwrap();
+    for (name, body) in stages {
+        let stage = format!("kind = \"note\"\n{body}\n");
+        std::fs::write(dir.path().join(format!("pipeline/{name}.toml")), stage).unwrap();
+    }
     dir
 }
 
@@ -120,4 +133,43 @@ fn a_folder_on_the_way_that_is_a_link_is_refused() {
     let err = run_all(dir.path()).unwrap_err();
     assert!(err.to_string().contains("is a symbolic link"), "{err}");
     assert_eq!(std::fs::read_dir(elsewhere.path()).unwrap().count(), 0);
+}
+
+#[test]
+fn a_damaged_table_is_never_fresh_and_a_run_recomputes_it() {
+    let dir = project("text = \"hello\"");
+    let pipeline = run_all(dir.path()).unwrap();
+    let table = dir.path().join("results/note.parquet");
+    let intact = std::fs::read(&table).unwrap();
+    let mut damaged = intact.clone();
+    damaged[intact.len() / 2] ^= 1;
+    std::fs::write(&table, &damaged).unwrap();
+    assert!(matches!(state_of(dir.path(), &pipeline), State::Damaged(_)));
+    run_all(dir.path()).unwrap();
+    assert_eq!(std::fs::read(&table).unwrap(), intact);
+    assert_eq!(state_of(dir.path(), &pipeline), State::Fresh);
+}
+
+#[test]
+fn a_failed_stage_stops_only_what_reads_it() {
+    let dir = notes(&[
+        ("broken", "text = \"x\"\nstray = \"stray.txt\""),
+        ("reader", "text = \"y\"\ninputs = [\"broken\"]"),
+        ("apart", "text = \"z\""),
+    ]);
+    let err = run_all(dir.path()).unwrap_err();
+    let PipelineError::Failed { failures } = &err else {
+        panic!("{err}");
+    };
+    assert_eq!(failures.len(), 2, "{failures:?}");
+    assert!(failures
+        .iter()
+        .any(|f| f.contains("stage `reader` skipped: input `broken` failed")));
+    let results = dir.path().join("results");
+    assert!(!results.join("broken.parquet").exists() && !results.join("reader.parquet").exists());
+    assert_eq!(
+        std::fs::read_to_string(results.join("apart.txt")).unwrap(),
+        "z"
+    );
+    assert!(results.join("apart.parquet").is_file());
 }
