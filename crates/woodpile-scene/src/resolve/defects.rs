@@ -113,8 +113,6 @@ fn dimensionless(
     Ok((eps, coupling))
 }
 
-/// A defect of a [physical] scene: what it derives (its eps and kappa, its host mass, its own
-/// contact when its rod differs from the regular one), as the JSON lists it.
 /// One defect of a [physical] scene being resolved: the keys of its messages, its table, its
 /// exponent, the scene's scales and its paper site.
 struct SiDefect<'a> {
@@ -125,6 +123,8 @@ struct SiDefect<'a> {
     site: i64,
 }
 
+/// A defect of a [physical] scene: what it derives (its eps and kappa, its host mass, its own
+/// contact when its rod differs from the regular one), as the JSON lists it.
 fn physical(x: &SiDefect<'_>) -> Result<DerivedDefect, Invalid> {
     let SiDefect { key, d, .. } = *x;
     reject_present(
