@@ -12,7 +12,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::rk::rk_stages;
-use super::{StepOutcome, StepSpan, Stepper};
+use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
 const STAGES: usize = 12;
@@ -204,7 +204,7 @@ impl Dop853 {
 
 impl Stepper for Dop853 {
     fn name(&self) -> &'static str {
-        "dop853"
+        Method::Dop853.name()
     }
 
     #[allow(clippy::needless_range_loop)] // one pass over components, reading 12 stage rows

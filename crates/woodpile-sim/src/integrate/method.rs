@@ -45,12 +45,12 @@ impl Method {
         Method::Dop853,
     ];
 
-    fn facts(self) -> &'static Facts {
+    const fn facts(self) -> &'static Facts {
         &FACTS[self as usize]
     }
 
-    /// The name used in scene files.
-    pub fn name(self) -> &'static str {
+    /// The name used in scene files. Const, so that each stepper takes its name from here.
+    pub const fn name(self) -> &'static str {
         self.facts().name
     }
 

@@ -5,7 +5,7 @@
 
 use std::marker::PhantomData;
 
-use super::{StepOutcome, StepSpan, Stepper};
+use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
 
 /// A Butcher tableau with `STAGES` stages: `A` (strictly lower triangular, row i has i
@@ -28,7 +28,7 @@ pub trait Tableau {
 pub struct Rk4;
 
 impl Tableau for Rk4 {
-    const NAME: &'static str = "rk4";
+    const NAME: &'static str = Method::Rk4.name();
     const ORDER: u32 = 4;
     const A: &'static [&'static [f64]] = &[&[], &[0.5], &[0.0, 0.5], &[0.0, 0.0, 1.0]];
     const B: &'static [f64] = &[1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];

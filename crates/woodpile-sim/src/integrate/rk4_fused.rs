@@ -12,7 +12,7 @@
 
 use super::contact_event::rk4_quadrature;
 use super::event_correction::{finish_step, stage_accelerations, FixedStepScratch, Quadrature};
-use super::{StepOutcome, StepSpan, Stepper};
+use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
 const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
@@ -46,7 +46,11 @@ impl Rk4Fused {
     fn with_quadrature(model: &Model, quadrature: Option<Quadrature<4>>) -> Self {
         let n = model.n_dof();
         Self {
-            scratch: FixedStepScratch::new(model, ["rk4", "rk4-contact"], quadrature),
+            scratch: FixedStepScratch::new(
+                model,
+                [Method::Rk4.name(), Method::Rk4Contact.name()],
+                quadrature,
+            ),
             v_stage: vec![0.0; n],
             a_stage: vec![0.0; n],
         }

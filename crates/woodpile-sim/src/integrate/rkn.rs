@@ -22,7 +22,7 @@
 use super::event_correction::{
     copy_window, finish_step, stage_accelerations, ContactEvents, Quadrature, NYSTROM_VELOCITIES,
 };
-use super::{StepOutcome, StepSpan, Stepper};
+use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
 
 /// An explicit Nyström tableau of `S` stages. `a` is strictly lower triangular.
@@ -48,7 +48,7 @@ pub struct RknTableau<const S: usize> {
 /// reuses it spends five evaluations a step). The coefficients involve √8581; these are their
 /// values rounded to double precision (the order conditions hold to 1e-16, tested).
 pub const DPRKN6: RknTableau<6> = RknTableau {
-    names: ["rkn6", "rkn6-contact", "rkn6-located"],
+    names: ["rkn6", Method::Rkn6Contact.name(), "rkn6-located"],
     c: [
         0.0,
         0.129_295_903_136_704_42,
@@ -117,7 +117,7 @@ fn dprkn6_quadrature(f: [f64; 6], h: f64) -> (f64, f64) {
 /// Nyström's three-stage order-4 method (the one [`super::Rkn4`] hand-codes), as a tableau: the
 /// located variant of `rkn4-contact` for the comparison of contact treatments.
 pub const NYSTROM4: RknTableau<3> = RknTableau {
-    names: ["rkn4", "rkn4-contact", "rkn4-located"],
+    names: ["rkn4", Method::Rkn4Contact.name(), "rkn4-located"],
     c: [0.0, 0.5, 1.0],
     a: [[0.0; 3], [0.125, 0.0, 0.0], [0.0, 0.5, 0.0]],
     b: [1.0 / 6.0, 1.0 / 3.0, 0.0],

@@ -25,7 +25,7 @@
 use super::event_correction::{
     finish_step, stage_accelerations, FixedStepScratch, Quadrature, NYSTROM_VELOCITIES,
 };
-use super::{StepOutcome, StepSpan, Stepper};
+use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
 /// Stage times c_i.
@@ -65,7 +65,7 @@ impl Rkn4 {
 
     fn with_quadrature(model: &Model, quadrature: Option<Quadrature<3>>) -> Self {
         Self {
-            scratch: FixedStepScratch::new(model, ["rkn4", "rkn4-contact"], quadrature),
+            scratch: FixedStepScratch::new(model, ["rkn4", Method::Rkn4Contact.name()], quadrature),
             a: std::array::from_fn(|_| vec![0.0; model.n_dof()]),
         }
     }

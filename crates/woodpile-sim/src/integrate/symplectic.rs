@@ -10,7 +10,7 @@
 //! Each sub-step costs one force evaluation: the closing kick's acceleration is cached and opens
 //! the next sub-step (first-same-as-last).
 
-use super::{StepOutcome, StepSpan, Stepper};
+use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
 /// A symmetric composition of Verlet sub-steps.
@@ -26,7 +26,7 @@ pub struct Composition {
 
 /// Störmer–Verlet (velocity Verlet), order 2.
 pub const VERLET: Composition = Composition {
-    name: "verlet",
+    name: Method::Verlet.name(),
     order: 2,
     gammas: &[1.0],
 };
@@ -34,7 +34,7 @@ pub const VERLET: Composition = Composition {
 /// Yoshida's / Forest–Ruth's triple jump, order 4: gamma_1 = gamma_3 = 1/(2 - 2^{1/3}),
 /// gamma_2 = -2^{1/3}/(2 - 2^{1/3}).
 pub const YOSHIDA4: Composition = Composition {
-    name: "yoshida4",
+    name: Method::Yoshida4.name(),
     order: 4,
     gammas: &[
         1.351_207_191_959_657_8,
@@ -46,7 +46,7 @@ pub const YOSHIDA4: Composition = Composition {
 /// Yoshida's 7-stage composition of order 6, solution A (Yoshida 1990; HLW Eq. V.3.11).
 #[allow(clippy::excessive_precision)] // digits as published
 pub const YOSHIDA6: Composition = Composition {
-    name: "yoshida6",
+    name: Method::Yoshida6.name(),
     order: 6,
     gammas: &[
         0.784_513_610_477_557_263_8,
