@@ -14,7 +14,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use woodpile_points::rows::{SweepPoint, SweepShape};
 use woodpile_points::{point_key, Key, PointResult, PointStore, Shares};
-use woodpile_scene::grid::{parse_axes, point, point_count, Axis, AxisValue};
+use woodpile_scene::grid::{at_point, parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
 
@@ -117,17 +117,7 @@ impl Grid {
     /// The validated scene of point `index`, or the error naming its axis values.
     fn scene_at(&self, index: usize) -> Result<Scene, String> {
         let values = point(&self.axes, index);
-        let at: Vec<String> = self
-            .axes
-            .iter()
-            .zip(&values)
-            .map(|(a, v)| format!("{} = {v}", a.name))
-            .collect();
-        let at = if at.is_empty() {
-            String::new()
-        } else {
-            format!(" (at {})", at.join(", "))
-        };
+        let at = at_point(&self.axes, &values);
         let table = self
             .template
             .instantiate(&self.axes, &values)

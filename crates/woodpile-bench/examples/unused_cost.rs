@@ -32,17 +32,11 @@ const SAME: [&str; 6] = ["R", "T", "E_tr", "E_final", "steps", "method"];
 /// Runs `binary` on `scene`: its simulation time (s) and the JSON values that must agree.
 fn simulate(binary: &Path, scene: &Path) -> (f64, Vec<serde_json::Value>) {
     let out = Command::new(binary)
-        .arg("simulate")
-        .arg(scene)
+        .args([Path::new("simulate"), scene])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{} simulate {}: {}",
-        binary.display(),
-        scene.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let (shown, stderr) = (scene.display(), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{shown}: {stderr}");
     let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let same = SAME.iter().map(|k| json[*k].clone()).collect();
     (json["wall_s"].as_f64().unwrap(), same)

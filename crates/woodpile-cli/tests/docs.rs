@@ -10,16 +10,10 @@ fn repo() -> PathBuf {
 }
 
 fn woodpile(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_woodpile"))
-        .current_dir(repo())
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut command = Command::new(env!("CARGO_BIN_EXE_woodpile"));
+    let out = command.current_dir(repo()).args(args).output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?}: {stderr}");
     String::from_utf8(out.stdout).unwrap()
 }
 

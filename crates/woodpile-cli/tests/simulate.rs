@@ -49,6 +49,12 @@ fn assert_refused(path: &Path, needles: &[&str]) {
     }
 }
 
+/// Asserts that a run exited 0, showing its stderr when it did not.
+fn assert_success(out: &Output) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+}
+
 fn json_number(stdout: &str, key: &str) -> f64 {
     let v: serde_json::Value = serde_json::from_str(stdout).unwrap();
     v[key]
@@ -62,11 +68,7 @@ fn json_number(stdout: &str, key: &str) -> f64 {
 fn simulate_prints_the_contract_json() {
     let (out, _) =
         simulate("[[defect]]\nsite = 0\neps = 3.0\n\n[run]\nmethod = \"auto\"\ntolerance = 1e-8\n");
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let stdout = String::from_utf8(out.stdout).unwrap();
     assert_eq!(stdout.lines().count(), 1, "one JSON object on one line");
     for (key, reference) in [
@@ -95,11 +97,7 @@ fn named_method_with_dt() {
     let (out, _) = simulate(
         "[[defect]]\nsite = 0\neps = 3.0\n[run]\nmethod = \"yoshida6\"\ndt = 0.01\nt_end = 20.0\n",
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let stdout = String::from_utf8(out.stdout).unwrap();
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(v["method"], "yoshida6");
@@ -111,11 +109,7 @@ fn named_method_with_dt() {
 fn physical_scene_reports_derived_parameters() {
     let text = "[chain]\nn = 20\nboundary = \"free\"\n[impulse]\nsite = -19\n[physical]\ncontact = 2.47e9\nmass = 0.866e-3\nvelocity = 1.98\n[[defect]]\nsite = 0\nmass = 0.838e-3\nresonator_mass = 0.894e-3\nstiffness = 3.961e6\n[run]\nt_end = 30.0\nmethod = \"rk4\"\ndt = 0.01\n";
     let (out, _) = simulate(text);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let d = &v["physical"]["defects"][0];
     assert!((d["eps"].as_f64().unwrap() - 0.894 / 0.866).abs() < 1e-12);
@@ -145,11 +139,7 @@ fn si_outputs_of_a_physical_scene() {
             .arg(table)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_success(&out);
         serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
     };
     let scaled = run(&[], &scaled_table);
@@ -198,55 +188,24 @@ fn si_outputs_of_a_physical_scene() {
 /// Each bad scene exits 2 with a message naming the file, the key and the reason.
 #[test]
 fn bad_scenes_exit_nonzero_with_a_clear_message() {
+    #[rustfmt::skip]
     let cases: &[(&str, &str, &str)] = &[
         ("[chain]\nn = 100\nfoo = 1\n", "foo", "unknown field"),
         ("[[defect]]\nsite = 0\neps = 0.0\n", "defect[0].eps", "> 0"),
         ("[[defect]]\nsite = 0\neps = -2.0\n", "defect[0].eps", "> 0"),
-        (
-            "[[defect]]\nsite = 0\neps = 1.0\np = 4\n",
-            "defect[0].p",
-            "odd",
-        ),
-        (
-            "[[defect]]\nsite = 101\neps = 1.0\n",
-            "defect[0].site",
-            "off the chain",
-        ),
+        ("[[defect]]\nsite = 0\neps = 1.0\np = 4\n", "defect[0].p", "odd"),
+        ("[[defect]]\nsite = 101\neps = 1.0\n", "defect[0].site", "off the chain"),
         ("[impulse]\nsite = -150\n", "impulse.site", "off the chain"),
         ("[run]\nt_end = 0.0\n", "run.t_end", "> 0"),
         ("[run]\nt_end = -5.0\n", "run.t_end", "> 0"),
-        (
-            "[[defect]]\nsite = 0\neps = nan\n",
-            "defect[0].eps",
-            "finite",
-        ),
-        (
-            "[[defect]]\nsite = 0\neps = 1.0\nkappa = inf\n",
-            "defect[0].kappa",
-            "finite",
-        ),
+        ("[[defect]]\nsite = 0\neps = nan\n", "defect[0].eps", "finite"),
+        ("[[defect]]\nsite = 0\neps = 1.0\nkappa = inf\n", "defect[0].kappa", "finite"),
         ("[impulse]\nvelocity = inf\n", "impulse.velocity", "finite"),
-        (
-            "[run]\nmethod = \"euler\"\n",
-            "run.method",
-            "unknown method",
-        ),
-        (
-            "[[defect]]\nsite = 0\neps = 1.0\nkappa = { k1 = 0.0, k2 = 1.0, t0 = 1.0 }\n",
-            "defect[0].kappa.tau",
-            "required",
-        ),
-        (
-            "[fractions]\nregion = [3, 1]\n",
-            "fractions.region",
-            "greater",
-        ),
+        ("[run]\nmethod = \"euler\"\n", "run.method", "unknown method"),
+        ("[[defect]]\nsite = 0\neps = 1.0\nkappa = { k1 = 0.0, k2 = 1.0, t0 = 1.0 }\n", "defect[0].kappa.tau", "required"),
+        ("[fractions]\nregion = [3, 1]\n", "fractions.region", "greater"),
         ("[[defect]]\neps = 1.0\n", "defect[0].site", "required"),
-        (
-            "[chain]\nboundary = \"periodic\"\n",
-            "chain.boundary",
-            "fixed",
-        ),
+        ("[chain]\nboundary = \"periodic\"\n", "chain.boundary", "fixed"),
         ("[[defect]\nsite = 0\n", "line 1", "column 10"),
     ];
     for (text, key, reason) in cases {
@@ -424,11 +383,7 @@ fn dt_is_the_step_taken() {
     let (out, _) =
         simulate("[run]\nmethod = \"rkn6-contact\"\ndt = 0.08\nsample_every = 1.0\nt_end = 20.0\n");
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     assert_eq!(json_number(&stdout, "dt_requested"), 0.08);
     assert!(
         (json_number(&stdout, "dt") - 1.0 / 13.0).abs() < 1e-12,
@@ -452,11 +407,7 @@ fn fixed_steps_on_a_kappa_ramp_are_checked_by_halving() {
     );
     let (out, _) = simulate(&format!("{ramp}dt = 0.01\n"));
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let estimate = json_number(&stdout, "error_estimate");
     assert!(estimate > 0.0 && estimate < 1e-6, "{stdout}");
 }
@@ -474,11 +425,7 @@ fn a_damped_scene_reports_its_ledger() {
         .arg(&series)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["normalisation"], "E(0)");
     assert_eq!(v["energy_conserved"], false);
@@ -504,11 +451,7 @@ fn a_damped_scene_reports_its_ledger() {
 fn a_wave_reaching_an_end_before_t_end_is_noted() {
     let short = "[chain]\nn = 20\n[impulse]\nsite = -15\n[run]\nt_end = 60.0\ntolerance = 1e-6\n";
     let (out, _) = simulate(short);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let reached = json_number(&String::from_utf8(out.stdout).unwrap(), "end_reached_at");
     assert!(reached > 10.0 && reached < 60.0, "{reached}");
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -306,9 +306,6 @@ fn intra_doc_links_resolve() {
         .env("RUSTDOCFLAGS", "-D rustdoc::broken_intra_doc_links")
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "broken intra-doc links:\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "broken intra-doc links:\n{stderr}");
 }

@@ -1,13 +1,14 @@
 //! The engine on its own, with a tiny kind of the test's (`note`: a one-row table and a text
 //! file): `Context` is the one door to the tree, a stage's other files are sealed in its
-//! manifest, and a run reports what it did.
+//! manifest, a run reports what it did, and what is loaded or read from the tree is bounded
+//! and never followed through links.
 #![allow(clippy::unwrap_used)]
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use polars::prelude::{Column, DataFrame};
-use woodpile_pipeline::events::Events;
+use woodpile_pipeline::events::Silent;
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck, Registry};
 use woodpile_pipeline::run::{run, RunOptions};
@@ -58,9 +59,6 @@ static KINDS: &Registry = &[("note", |f: &mut Fields<'_>, _| {
         stray: f.optional("stray")?,
     }))
 })];
-
-struct Silent;
-impl Events for Silent {}
 
 /// A project with one `note` stage whose file holds `body` (TOML keys of the stage).
 fn project(body: &str) -> tempfile::TempDir {
@@ -172,4 +170,88 @@ fn a_failed_stage_stops_only_what_reads_it() {
         "z"
     );
     assert!(results.join("apart.parquet").is_file());
+}
+
+/// A defaults file is copied into every stage of its kind, so it is bounded: a large one is
+/// refused at load naming the file, before any stage is parsed.
+#[test]
+fn an_oversized_defaults_file_is_refused() {
+    let dir = project("text = \"hello\"");
+    let keys: String = (0..4000)
+        .map(|i| format!("key_{i} = \"value {i}\"\n"))
+        .collect();
+    let defaults = dir.path().join("pipeline/defaults.toml");
+    std::fs::write(defaults, format!("[note]\n{keys}")).unwrap();
+    let e = Pipeline::load(&dir.path().join("pipeline"), KINDS).unwrap_err();
+    let e = e.to_string();
+    assert!(
+        e.contains("defaults.toml") && e.contains("a defaults file may have"),
+        "{e}"
+    );
+}
+
+/// Stage files and the defaults file must be files of the pipeline folder, not links to files
+/// elsewhere (which would enter the stage's parameters and messages).
+#[cfg(unix)]
+#[test]
+fn linked_stage_files_are_refused() {
+    for name in ["linked.toml", "defaults.toml"] {
+        let dir = project("text = \"hello\"");
+        let outside = tempfile::tempdir().unwrap();
+        let target = outside.path().join("x.toml");
+        std::fs::write(&target, "kind = \"note\"\ntext = \"x\"\n").unwrap();
+        std::os::unix::fs::symlink(&target, dir.path().join("pipeline").join(name)).unwrap();
+        let e = Pipeline::load(&dir.path().join("pipeline"), KINDS).unwrap_err();
+        let e = e.to_string();
+        assert!(e.contains(name) && e.contains("a symbolic link"), "{e}");
+    }
+}
+
+/// Symbolic links to `.` in the stage folder or a results tree do not make a walk endless.
+#[cfg(unix)]
+#[test]
+fn symlink_loops_are_not_followed() {
+    let dir = project("text = \"hello\"");
+    for name in ["x", "y"] {
+        std::os::unix::fs::symlink(".", dir.path().join("pipeline").join(name)).unwrap();
+    }
+    let pipeline = run_all(dir.path()).unwrap();
+    assert_eq!(pipeline.stages().len(), 1);
+    let (results, copy) = (dir.path().join("results"), dir.path().join("copy"));
+    std::fs::create_dir(&copy).unwrap();
+    std::fs::copy(results.join("note.parquet"), copy.join("note.parquet")).unwrap();
+    std::os::unix::fs::symlink(".", results.join("loop")).unwrap();
+    std::os::unix::fs::symlink(".", copy.join("loop")).unwrap();
+    let report = woodpile_pipeline::diff::diff(&results, &copy, &Default::default()).unwrap();
+    assert!(report.agrees(), "{:?}", report.problems);
+}
+
+/// A FIFO, a link to /dev/zero or a directory in place of a table reads as damaged at once;
+/// a run recomputes it.
+#[cfg(unix)]
+#[test]
+fn non_regular_files_in_results_are_damaged_never_read() {
+    let dir = project("text = \"hello\"");
+    let pipeline = run_all(dir.path()).unwrap();
+    let table = dir.path().join("results/note.parquet");
+    std::fs::remove_file(&table).unwrap();
+    let fifo = std::process::Command::new("mkfifo").arg(&table).status();
+    if fifo.is_ok_and(|s| s.success()) {
+        assert!(matches!(state_of(dir.path(), &pipeline), State::Damaged(_)));
+        std::fs::remove_file(&table).unwrap();
+    }
+    std::fs::create_dir(&table).unwrap();
+    assert!(matches!(state_of(dir.path(), &pipeline), State::Damaged(_)));
+    std::fs::remove_dir(&table).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &table).unwrap();
+    let state = state_of(dir.path(), &pipeline);
+    assert!(
+        matches!(state, State::Damaged(ref why) if why.contains("symbolic link")),
+        "{state:?}"
+    );
+    assert!(woodpile_pipeline::table::read(&table).is_err());
+    // The run refuses to treat the link as its table but replaces it by a real one.
+    run_all(dir.path()).unwrap();
+    assert_eq!(state_of(dir.path(), &pipeline), State::Fresh);
+    assert!(std::fs::symlink_metadata(&table).unwrap().is_file());
 }

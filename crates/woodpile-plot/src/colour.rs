@@ -4,27 +4,19 @@
 
 use plotters::style::RGBColor;
 
+/// Viridis at nine evenly spaced anchors, from dark purple to yellow.
+#[rustfmt::skip]
 const ANCHORS: [(u8, u8, u8); 9] = [
-    (68, 1, 84),
-    (71, 44, 122),
-    (59, 81, 139),
-    (44, 113, 142),
-    (33, 144, 141),
-    (39, 173, 129),
-    (92, 200, 99),
-    (170, 220, 50),
-    (253, 231, 37),
+    (68, 1, 84), (71, 44, 122), (59, 81, 139),
+    (44, 113, 142), (33, 144, 141), (39, 173, 129),
+    (92, 200, 99), (170, 220, 50), (253, 231, 37),
 ];
 
 /// Matplotlib's RdBu reversed: dark blue (most negative) through white (zero) to dark red.
+#[rustfmt::skip]
 const DIVERGING: [(u8, u8, u8); 7] = [
-    (5, 48, 97),
-    (67, 147, 195),
-    (209, 229, 240),
-    (247, 247, 247),
-    (253, 219, 199),
-    (214, 96, 77),
-    (103, 0, 31),
+    (5, 48, 97), (67, 147, 195), (209, 229, 240), (247, 247, 247),
+    (253, 219, 199), (214, 96, 77), (103, 0, 31),
 ];
 
 /// Okabe and Ito's colours, told apart by red-green colour-blind readers.

@@ -353,27 +353,21 @@ mod tests {
         assert_eq!(store.load(&failed), Some(Err("blew up at t = 3".into())));
     }
 
-    /// A striker's S is a sixth column, read back as such; a point without one keeps five.
+    /// A striker's S and the dissipated D are extra columns, read back as such, alone or
+    /// together; a point without them keeps five.
     #[test]
-    fn a_strikers_share_round_trips() {
+    fn the_strikers_and_dissipated_shares_round_trip() {
         let (_dir, store, _) = store_with_sample("five");
-        let key = Key::of(&serde_json::json!("six"));
-        let with = PointData {
-            striker: Some(vec![0.0, 0.25]),
-            ..sample()
-        };
-        store.save(&key, &Ok(with.clone())).unwrap();
-        assert_eq!(store.load(&key), Some(Ok(with)));
-    }
-
-    #[test]
-    fn the_dissipated_share_round_trips_with_and_without_a_striker() {
-        let (_dir, store, _) = store_with_sample("five");
-        for (name, striker) in [("d", None), ("sd", Some(vec![0.0, 0.25]))] {
+        let share = || Some(vec![0.0, 0.25]);
+        for (name, striker, dissipated) in [
+            ("s", share(), None),
+            ("d", None, share()),
+            ("sd", share(), share()),
+        ] {
             let key = Key::of(&serde_json::json!(name));
             let with = PointData {
                 striker,
-                dissipated: Some(vec![0.0, 0.5]),
+                dissipated,
                 ..sample()
             };
             store.save(&key, &Ok(with.clone())).unwrap();

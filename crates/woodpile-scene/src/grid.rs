@@ -56,6 +56,23 @@ impl Axis {
     }
 }
 
+/// Each axis with its value at one point, as `name{between}value`: how messages and labels
+/// name a point.
+pub fn named_values(axes: &[Axis], values: &[AxisValue], between: &str) -> Vec<String> {
+    axes.iter()
+        .zip(values)
+        .map(|(a, v)| format!("{}{between}{v}", a.name))
+        .collect()
+}
+
+/// ` (at eps = 1, L = 2)`, for messages about the point at `values`; empty without axes.
+pub fn at_point(axes: &[Axis], values: &[AxisValue]) -> String {
+    if axes.is_empty() {
+        return String::new();
+    }
+    format!(" (at {})", named_values(axes, values, " = ").join(", "))
+}
+
 /// Most points a single sweep may have: a hundred times the paper's largest grid (10^4). A
 /// run plans every point (about 1.4 KB each) and keeps its series, so beyond this a grid
 /// needs gigabytes before its first simulation: split it into several sweeps (or fix a typo

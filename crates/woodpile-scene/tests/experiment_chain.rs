@@ -142,20 +142,10 @@ dt = 0.01
 fn a_precompressed_chain_at_rest_stays_at_rest() {
     let scene = scene(
         r#"
-[chain]
-n = 15
-precompression = 2.5
-exponent = 1.5
-wall_contact = 3.0
-[[segment]]
-sites = [-15, 15]
-mass = [1.0, 0.3]
-contact = [0.4, 1.0, 7.0]
-[impulse]
-site = 0
-[[defect]]
-site = 0
-eps = 1.0
+chain = { n = 15, precompression = 2.5, exponent = 1.5, wall_contact = 3.0 }
+segment = [{ sites = [-15, 15], mass = [1.0, 0.3], contact = [0.4, 1.0, 7.0] }]
+impulse = { site = 0 }
+defect = [{ site = 0, eps = 1.0 }]
 "#,
     );
     let model = &scene.scenario.model;
@@ -324,18 +314,13 @@ sample_every = 0.05
 fn bad_chains_are_refused_naming_the_key() {
     let striker = "[striker]\nmass = 2.0\n";
     let free_left = "[chain]\nboundary = { left = \"free\", right = \"fixed\" }\n";
+    #[rustfmt::skip]
     let cases = [
         ("[chain]\nboundary = \"free\"\nprecompression = 1.0\n", "chain.precompression"),
-        (
-            "[chain]\nboundary = { left = \"free\", right = \"fixed\" }\nprecompression = 1.0\n[striker]\nmass = 2.0\n",
-            "chain.precompression",
-        ),
+        ("[chain]\nboundary = { left = \"free\", right = \"fixed\" }\nprecompression = 1.0\n[striker]\nmass = 2.0\n", "chain.precompression"),
         (striker, "striker"),
         (&format!("{free_left}{striker}[impulse]\nsite = 0\n"), "impulse"),
-        (
-            "[[segment]]\nsites = [0, 10]\nmass = 2.0\n[[segment]]\nsites = [10, 20]\nmass = 1.0\n",
-            "segment[1].sites",
-        ),
+        ("[[segment]]\nsites = [0, 10]\nmass = 2.0\n[[segment]]\nsites = [10, 20]\nmass = 1.0\n", "segment[1].sites"),
         ("[[segment]]\nsites = [90, 101]\nmass = 2.0\n", "segment[0].sites"),
         ("[[segment]]\nsites = [0, 3]\nmass = [1.0, 0.0]\n", "segment[0].mass[1]"),
         ("[[segment]]\nsites = [0, 3]\ncontact = -1.0\n", "segment[0].contact"),
@@ -347,22 +332,10 @@ fn bad_chains_are_refused_naming_the_key() {
         ("[chain]\nboundary = { left = \"free\", right = \"sticky\" }\n", "chain.boundary.right"),
         (&format!("{free_left}[striker]\nmass = -2.0\n"), "striker.mass"),
         (&format!("{free_left}[striker]\nvelocity = 1.0\n"), "striker.mass"),
-        (
-            "[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[[defect]]\nsite = 0\nmass = 1e-3\nresonator_mass = 1e-3\nstiffness = 1e6\n[[segment]]\nsites = [-2, 2]\nmass = 2e-3\n",
-            "segment[0].mass",
-        ),
-        (
-            "[physical]\nvelocity = 1.0\nmaterial = { youngs_modulus = 72e9, poisson_ratio = 0.17, density = 2200.0 }\nrod = { length = 0.02, diameter = 0.005 }\n[[defect]]\nsite = 0\nrod = { length = 0.04 }\nresonator_share = 1.5\n",
-            "defect[0].resonator_share",
-        ),
-        (
-            "[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[[defect]]\nsite = 0\nrod = { length = 0.04 }\n",
-            "defect[0].rod.diameter",
-        ),
-        (
-            "[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[chain]\nexponent = 2.0\n",
-            "chain.exponent",
-        ),
+        ("[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[[defect]]\nsite = 0\nmass = 1e-3\nresonator_mass = 1e-3\nstiffness = 1e6\n[[segment]]\nsites = [-2, 2]\nmass = 2e-3\n", "segment[0].mass"),
+        ("[physical]\nvelocity = 1.0\nmaterial = { youngs_modulus = 72e9, poisson_ratio = 0.17, density = 2200.0 }\nrod = { length = 0.02, diameter = 0.005 }\n[[defect]]\nsite = 0\nrod = { length = 0.04 }\nresonator_share = 1.5\n", "defect[0].resonator_share"),
+        ("[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[[defect]]\nsite = 0\nrod = { length = 0.04 }\n", "defect[0].rod.diameter"),
+        ("[physical]\nvelocity = 1.0\nmass = 1e-3\ncontact = 2.47e9\n[chain]\nexponent = 2.0\n", "chain.exponent"),
     ];
     for (text, key) in cases {
         assert_eq!(invalid_key(text), key, "for {text:?}");

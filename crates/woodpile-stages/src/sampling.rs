@@ -77,12 +77,7 @@ fn drawn<T>(
                     PipelineError::stage(stage, "a survey draws from this sweep, which is missing")
                 })?;
             let values: Vec<_> = sweep.axes.iter().map(|a| rng.pick(&a.values)).collect();
-            let named: Vec<String> = sweep
-                .axes
-                .iter()
-                .zip(&values)
-                .map(|(a, v)| format!("{}={v}", a.name))
-                .collect();
+            let named = woodpile_scene::grid::named_values(&sweep.axes, &values, "=");
             scenes.push((
                 format!("{label} {}", named.join(" ")),
                 make(sweep, &values)?,

@@ -147,17 +147,7 @@ impl Sweep {
 
     /// ` (at eps = 1, L = 2)` for messages about the point at `values`.
     fn at(&self, values: &[AxisValue]) -> String {
-        let parts: Vec<String> = self
-            .axes
-            .iter()
-            .zip(values)
-            .map(|(a, v)| format!("{} = {v}", a.name))
-            .collect();
-        if parts.is_empty() {
-            String::new()
-        } else {
-            format!(" (at {})", parts.join(", "))
-        }
+        woodpile_scene::grid::at_point(&self.axes, values)
     }
 
     /// The scene table at `values` (a scene file's content), before validation.

@@ -6,7 +6,7 @@ mod common;
 
 use common::{
     load_error, load_error_after_reduce, single_defect_sweep_to, sweep_file, Counter, Project,
-    REDUCE, SWEEP,
+    FIGURE, REDUCE, SWEEP,
 };
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::State;
@@ -14,17 +14,9 @@ use woodpile_pipeline::{table, PipelineError};
 
 #[test]
 fn render_stages_draw_figures_and_keep_the_plotted_numbers() {
-    let figure = r#"
-kind = "render"
-inputs = ["at_end"]
-title = "test figure"
-[lines]
-x = "eps"
-y = ["R", "E_tr"]
-panels = "L"
-x_label = "eps"
-y_label = "fraction"
-"#;
+    let figure = FIGURE
+        .replace("TITLE", "test figure")
+        .replace("[lines]", "[lines]\npanels = \"L\"");
     let heat = r#"
 kind = "render"
 inputs = ["at_end"]
@@ -41,7 +33,7 @@ mark_max = true
     let p = Project::new(&[
         ("sweep", SWEEP),
         ("at_end", REDUCE),
-        ("figure", figure),
+        ("figure", &figure),
         ("map", heat),
     ]);
     p.counted(&[]);
@@ -142,18 +134,12 @@ fn the_product_approximation_evaluates_the_fitted_forms() {
     let single = single_defect_sweep_to(4.0);
     let fits = r#"
 kind = "fit"
-inputs = ["single_at_end"]
 x = "eps"
-[[model]]
-name = "T1"
-y = "T"
-form = "power"
-start = [0.5, -0.3, 0.2]
-[[model]]
-name = "R"
-y = "R"
-form = "tanh"
-start = [0.5, 0.5, 0.0]
+inputs = ["single_at_end"]
+model = [
+  { name = "T1", y = "T", form = "power", start = [0.5, -0.3, 0.2] },
+  { name = "R", y = "R", form = "tanh", start = [0.5, 0.5, 0.0] },
+]
 "#;
     let pair = &sweep_file(
         "eps1 = [1.0, 2.0]\neps2 = [1.0, 2.0]",
@@ -339,19 +325,12 @@ z_label = "E_tr"
 fn a_failed_fit_is_a_row_the_run_goes_on_and_ends_naming_it() {
     let fits = r#"
 kind = "fit"
-inputs = ["at_end"]
 x = "eps"
-[[model]]
-name = "good"
-y = "E_tr"
-form = "tanh"
-start = [0.1, 1.0, 0.0]
-[[model]]
-name = "hopeless"
-y = "E_tr"
-form = "power"
-start = [1.0, 1.0, 0.0]
-x_range = [100.0, 200.0]
+inputs = ["at_end"]
+model = [
+  { name = "good", y = "E_tr", form = "tanh", start = [0.1, 1.0, 0.0] },
+  { name = "hopeless", y = "E_tr", form = "power", start = [1.0, 1.0, 0.0], x_range = [100.0, 200.0] },
+]
 "#;
     let report = r#"
 kind = "report"

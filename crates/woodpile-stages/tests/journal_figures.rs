@@ -32,9 +32,7 @@ inputs = ["at_end"]
 title = "fractions against \\varepsilon"
 x_scale = "log"
 labels = { E_tr = "E_{tr}" }
-[style]
-font_pt = 7
-legend = "best"
+style = { font_pt = 7, legend = "best" }
 [lines]
 x = "eps"
 y = ["R", "T", "E_tr"]

@@ -85,13 +85,10 @@ fn a_design_at_fixed_sites_writes_the_best_design_any_search_found() {
 fn scene_files_by_reference_variants_and_log_axes() {
     let sweep = r#"
 kind = "sweep"
-[axes]
-eps = { from = 0.1, to = 10.0, count = 5, log = true }
+axes = { eps = { from = 0.1, to = 10.0, count = 5, log = true } }
 [scene]
 file = "scenes/base.toml"
-[[scene.defect]]
-site = 0
-eps = "$eps"
+defect = [{ site = 0, eps = "$eps" }]
 "#;
     let reduce = "kind = \"reduce\"\ninputs = [\"sweep\"]\nat = 10.0\n";
     let p = Project::new(&[("sweep", sweep), ("at_end", reduce)]);

@@ -56,21 +56,14 @@ fn perturb(path: &Path, column: &str, delta: f64) {
 
 #[test]
 fn sharded_runs_merge_into_the_single_machine_result() {
-    use woodpile_pipeline::shard::{merge, run_shard, Shard};
+    use woodpile_pipeline::shard::merge;
     let single = Project::new(&[("sweep", SWEEP)]);
     single.counted(&[]);
     let sharded = Project::new(&[("sweep", SWEEP)]);
     let pipeline = sharded.load();
     let events = Counter::default();
     let shard = |i: usize, n: usize| {
-        run_shard(
-            &pipeline,
-            "sweep",
-            Shard::new(i, n).unwrap(),
-            &sharded.results(),
-            &events,
-        )
-        .unwrap();
+        sharded.shard(&pipeline, "sweep", (i, n), &events).unwrap();
     };
     let merge_error = || {
         merge(&pipeline, "sweep", &sharded.results(), &Counter::default())
@@ -94,14 +87,7 @@ fn sharded_runs_merge_into_the_single_machine_result() {
     }
     // A shard re-run finds its part done and simulates nothing.
     let again = Counter::default();
-    let rerun = run_shard(
-        &pipeline,
-        "sweep",
-        Shard::new(1, 4).unwrap(),
-        &sharded.results(),
-        &again,
-    )
-    .unwrap();
+    let rerun = sharded.shard(&pipeline, "sweep", (1, 4), &again).unwrap();
     assert!(rerun.already_done);
     assert_eq!(again.points.load(Ordering::SeqCst), 0);
     assert_eq!(

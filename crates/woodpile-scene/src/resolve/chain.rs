@@ -5,7 +5,8 @@ use woodpile_sim::model::{Boundary, End};
 use woodpile_sim::ContactLaw;
 
 use super::check::{
-    invalid, non_negative, number, number_text, positive, positive_pattern, required, Invalid,
+    invalid, non_negative, number, number_text, only_keys, positive, positive_pattern, required,
+    Invalid,
 };
 use super::physical::Si;
 use crate::raw;
@@ -55,15 +56,12 @@ impl Layout {
 /// A soft end `{ spring = k, damping = c }`: a linear spring and a dashpot on a rigid support
 /// (both default to 0; an SI scene gives N/m and N·s/m).
 fn soft_end(key: &str, table: &toml::Table, si: Option<&Si>) -> Result<End, Invalid> {
-    if let Some(other) = table
-        .keys()
-        .find(|k| !["spring", "damping"].contains(&k.as_str()))
-    {
-        return Err(invalid(
-            format!("{key}.{other}"),
-            "unknown key; a soft end has spring and damping",
-        ));
-    }
+    only_keys(
+        key,
+        table,
+        &["spring", "damping"],
+        "a soft end has spring and damping",
+    )?;
     let get = |name: &str| -> Result<f64, Invalid> {
         let full = format!("{key}.{name}");
         match table.get(name) {
@@ -135,15 +133,7 @@ pub(crate) fn boundary(chain: Option<&raw::Chain>, si: Option<&Si>) -> Result<Bo
             "a soft end belongs to one side: boundary = { left = \"free\", right = { spring = .., damping = .. } }",
         )),
         Some(toml::Value::Table(ends)) => {
-            if let Some(other) = ends
-                .keys()
-                .find(|k| !["left", "right"].contains(&k.as_str()))
-            {
-                return Err(invalid(
-                    format!("chain.boundary.{other}"),
-                    "unknown key; the ends are left and right",
-                ));
-            }
+            only_keys("chain.boundary", ends, &["left", "right"], "the ends are left and right")?;
             let side = |name: &str| {
                 let key = format!("chain.boundary.{name}");
                 end(&key, required(&key, ends.get(name))?)

@@ -33,35 +33,37 @@ pub(crate) fn velocity(key: &str, v: f64) -> Result<f64, Invalid> {
 }
 
 pub(crate) fn finite(key: &str, x: f64) -> Result<f64, Invalid> {
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(invalid(
-            key,
-            format!("must be a finite number, got {}", number_text(x)),
-        ))
-    }
+    within(key, x, x.is_finite(), "must be a finite number")
 }
 
 pub(crate) fn positive(key: &str, x: f64) -> Result<f64, Invalid> {
-    if x.is_finite() && x > 0.0 {
-        Ok(x)
-    } else {
-        Err(invalid(
-            key,
-            format!("must be finite and > 0, got {}", number_text(x)),
-        ))
-    }
+    within(key, x, x.is_finite() && x > 0.0, "must be finite and > 0")
 }
 
 pub(crate) fn non_negative(key: &str, x: f64) -> Result<f64, Invalid> {
-    if x.is_finite() && x >= 0.0 {
-        Ok(x)
-    } else {
-        Err(invalid(
-            key,
-            format!("must be finite and >= 0, got {}", number_text(x)),
-        ))
+    within(key, x, x.is_finite() && x >= 0.0, "must be finite and >= 0")
+}
+
+/// `x` where `ok`, else the reason `rule` with the value it got.
+fn within(key: &str, x: f64, ok: bool, rule: &str) -> Result<f64, Invalid> {
+    ok.then_some(x)
+        .ok_or_else(|| invalid(key, format!("{rule}, got {}", number_text(x))))
+}
+
+/// Refuses a key of `table` (at `key`) that is not one of `known`: the reason says what the
+/// table takes (`"a soft end has spring and damping"`).
+pub(crate) fn only_keys(
+    key: &str,
+    table: &toml::Table,
+    known: &[&str],
+    takes: &str,
+) -> Result<(), Invalid> {
+    match table.keys().find(|k| !known.contains(&k.as_str())) {
+        Some(other) => Err(invalid(
+            format!("{key}.{other}"),
+            format!("unknown key; {takes}"),
+        )),
+        None => Ok(()),
     }
 }
 

@@ -9,7 +9,7 @@ use woodpile_sim::rods;
 
 use super::chain::{Layout, Sites};
 use super::check::{
-    finite, invalid, non_negative, number, positive, reject_present, required, Invalid,
+    finite, invalid, non_negative, number, only_keys, positive, reject_present, required, Invalid,
 };
 use super::physical::{rod_resonator, Si};
 use super::DerivedDefect;
@@ -140,14 +140,7 @@ fn physical(x: &SiDefect<'_>) -> Result<DerivedDefect, Invalid> {
 
 /// A defect of a [physical] scene given by its resonator's mass and stiffness.
 fn physical_masses(x: &SiDefect<'_>) -> Result<DerivedDefect, Invalid> {
-    let SiDefect {
-        key,
-        d,
-        p,
-        si,
-        site,
-    } = *x;
-    let sc = si.scales;
+    let (key, d, sc) = (x.key, x.d, x.si.scales);
     if d.resonator_share.is_some() {
         return Err(invalid(key("resonator_share"), "needs rod = { length }"));
     }
@@ -162,10 +155,10 @@ fn physical_masses(x: &SiDefect<'_>) -> Result<DerivedDefect, Invalid> {
             .ok_or_else(|| invalid(key("stiffness"), "is required in a [physical] scene"))?,
     )?;
     let host = positive(&key("mass"), d.mass.unwrap_or(sc.mass_kg))?;
-    let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, p));
+    let (eps, kappa) = (sc.mass_ratio(m), sc.kappa(k, x.p));
     let host_mass_ratio = sc.mass_ratio(host);
     Ok(DerivedDefect {
-        site,
+        site: x.site,
         host_mass_ratio,
         eps,
         kappa,
@@ -224,14 +217,12 @@ fn physical_rod(x: &SiDefect<'_>, rod: &raw::DefectRod) -> Result<DerivedDefect,
 fn coupling(key: &str, value: &toml::Value) -> Result<Coupling, Invalid> {
     match value {
         toml::Value::Table(t) => {
-            for k in t.keys() {
-                if !["k1", "k2", "t0", "tau"].contains(&k.as_str()) {
-                    return Err(invalid(
-                        format!("{key}.{k}"),
-                        "unknown key; a ramp has k1, k2, t0, tau",
-                    ));
-                }
-            }
+            only_keys(
+                key,
+                t,
+                &["k1", "k2", "t0", "tau"],
+                "a ramp has k1, k2, t0, tau",
+            )?;
             let get = |k: &str| -> Result<f64, Invalid> {
                 let full = format!("{key}.{k}");
                 let v = t

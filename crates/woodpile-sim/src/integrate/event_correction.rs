@@ -527,7 +527,11 @@ pub(crate) fn stage_accelerations<const S: usize>(
     window: Window,
 ) -> f64 {
     if model.is_dissipative() {
-        return damped_stage_accelerations(model, contact, (q, v, acc), (t, stage), window);
+        let record = contact.map(|c| BondRecord {
+            force: &mut c.stage_force[stage],
+            power: &mut c.stage_power[stage],
+        });
+        return damped_accelerations(model, record, (q, v, acc), t, window);
     }
     match contact {
         None => model.accelerations_in(t, q, acc, window),
@@ -536,21 +540,18 @@ pub(crate) fn stage_accelerations<const S: usize>(
     0.0
 }
 
-/// [`stage_accelerations`] of a dissipative chain. Kept out of line: the conservative
-/// methods' stage loops inline [`stage_accelerations`], and should not carry this path's code.
+/// [`stage_accelerations`] of a dissipative chain, recording into the stage's bond record.
+/// Kept out of line: the conservative methods' stage loops inline [`stage_accelerations`],
+/// and should not carry this path's code.
 #[inline(never)]
 #[cold]
-fn damped_stage_accelerations<const S: usize>(
+fn damped_accelerations(
     model: &Model,
-    contact: Option<&mut ContactEvents<S>>,
+    record: Option<BondRecord<'_>>,
     (q, v, acc): (&[f64], &[f64], &mut [f64]),
-    (t, stage): (f64, usize),
+    t: f64,
     window: Window,
 ) -> f64 {
-    let record = contact.map(|c| BondRecord {
-        force: &mut c.stage_force[stage],
-        power: &mut c.stage_power[stage],
-    });
     model.damped_recording(t, (q, v), acc, window, record)
 }
 

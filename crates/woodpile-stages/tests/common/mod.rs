@@ -9,6 +9,7 @@ use woodpile_stages::KINDS;
 
 use woodpile_pipeline::events::{Events, Silent};
 use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::shard::{run_shard, Shard, ShardRun};
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::Pipeline;
@@ -19,6 +20,18 @@ pub struct Project {
 }
 
 impl Project {
+    /// Shard `index` of `count` of the sweep stage `stage`, into this project's results.
+    pub fn shard(
+        &self,
+        pipeline: &Pipeline,
+        stage: &str,
+        (index, count): (usize, usize),
+        events: &dyn Events,
+    ) -> woodpile_pipeline::Result<ShardRun> {
+        let shard = Shard::new(index, count).unwrap();
+        run_shard(pipeline, stage, shard, &self.results(), events)
+    }
+
     /// A project with these stage files (`name`, text).
     pub fn new(stages: &[(&str, &str)]) -> Project {
         let dir = tempfile::tempdir().unwrap();
