@@ -4,8 +4,9 @@ them.
 
 Reads a JSON list of scenes on stdin, each
   {"n": sites, "fixed": true, "striker": index, "velocity": v, "t_end": t, "dt": dt,
-   "lo": first site of the region, "hi": last site, "res": [[site, eps, kappa], ...]}
-(linear resonators, sites as 0-based indices) and an optional count of repeats (argument, 3 by
+   "lo": first site of the region, "hi": last site, "res": [[site, eps, kappa, p], ...]}
+(resonators with the coupling force kappa (u - w)^p, p odd, 1 when left out; sites as 0-based
+indices) and an optional count of repeats (argument, 3 by
 default), and prints one JSON line: the fractions R, T,
 E_tr of every scene (normalised by the total energy at t_end, each site carrying its kinetic
 energy, half of each contact's potential, all of a wall contact's, and its resonator's energy:
@@ -27,7 +28,7 @@ from numba import njit
 
 
 @njit(cache=False, fastmath=False)
-def accel(q, a, n, fixed, rs, re, rk):
+def accel(q, a, n, fixed, rs, re, rk, rp):
     a[:] = 0.0
     for b in range(n - 1):
         d = q[b] - q[b + 1]
@@ -41,13 +42,14 @@ def accel(q, a, n, fixed, rs, re, rk):
         if q[n - 1] > 0.0:
             a[n - 1] -= q[n - 1] * math.sqrt(q[n - 1])
     for j in range(rs.shape[0]):
-        f = rk[j] * (q[rs[j]] - q[n + j])
+        d = q[rs[j]] - q[n + j]
+        f = rk[j] * d if rp[j] == 1 else rk[j] * d ** rp[j]
         a[rs[j]] -= f
         a[n + j] = f / re[j]
 
 
 @njit(cache=False)
-def run(n, fixed, striker, velocity, t_end, dt, rs, re, rk, lo, hi):
+def run(n, fixed, striker, velocity, t_end, dt, rs, re, rk, rp, lo, hi):
     m = n + rs.shape[0]
     q = np.zeros(m)
     v = np.zeros(m)
@@ -58,19 +60,19 @@ def run(n, fixed, striker, velocity, t_end, dt, rs, re, rk, lo, hi):
     steps = int(math.ceil(t_end / dt - 1e-9))
     h = t_end / steps
     for _ in range(steps):
-        accel(q, a1, n, fixed, rs, re, rk)
+        accel(q, a1, n, fixed, rs, re, rk, rp)
         for i in range(m):
             qs[i] = q[i] + 0.5 * h * v[i]
             v2[i] = v[i] + 0.5 * h * a1[i]
-        accel(qs, a2, n, fixed, rs, re, rk)
+        accel(qs, a2, n, fixed, rs, re, rk, rp)
         for i in range(m):
             qs[i] = q[i] + 0.5 * h * v2[i]
             v3[i] = v[i] + 0.5 * h * a2[i]
-        accel(qs, a3, n, fixed, rs, re, rk)
+        accel(qs, a3, n, fixed, rs, re, rk, rp)
         for i in range(m):
             qs[i] = q[i] + h * v3[i]
             v4[i] = v[i] + h * a3[i]
-        accel(qs, a4, n, fixed, rs, re, rk)
+        accel(qs, a4, n, fixed, rs, re, rk, rp)
         for i in range(m):
             q[i] += h / 6.0 * (v[i] + 2.0 * v2[i] + 2.0 * v3[i] + v4[i])
             v[i] += h / 6.0 * (a1[i] + 2.0 * a2[i] + 2.0 * a3[i] + a4[i])
@@ -90,7 +92,7 @@ def run(n, fixed, striker, velocity, t_end, dt, rs, re, rk, lo, hi):
             e[n - 1] += 0.4 * q[n - 1] ** 2.5
     for j in range(rs.shape[0]):
         x = q[rs[j]] - q[n + j]
-        e[rs[j]] += 0.5 * re[j] * v[n + j] * v[n + j] + 0.5 * rk[j] * x * x
+        e[rs[j]] += 0.5 * re[j] * v[n + j] * v[n + j] + rk[j] * x ** (rp[j] + 1) / (rp[j] + 1)
     total = e.sum()
     return e[:lo].sum() / total, e[hi + 1:].sum() / total, e[lo:hi + 1].sum() / total
 
@@ -103,6 +105,7 @@ def arguments(scene):
         np.array([r[0] for r in res], dtype=np.int64),
         np.array([r[1] for r in res], dtype=np.float64),
         np.array([r[2] for r in res], dtype=np.float64),
+        np.array([r[3] if len(r) > 3 else 1 for r in res], dtype=np.int64),
         scene["lo"], scene["hi"],
     )
 

@@ -4,6 +4,7 @@
 //! timings (`baseline/`).
 
 pub mod paper;
+pub mod sweeps;
 
 use woodpile_sim::integrate::{
     drive, Accuracy, DriveConfig, Method, MethodChoice, Stats, StepControl, Stepper,

@@ -6,9 +6,14 @@
 //! coarse and F7 fine sweeps' scenes, woodpile at the pipeline's settings against the numba
 //! script at RK4 dt = 0.01, one thread each.
 //!
+//! Then, with `--sweeps`, the paper's five sweeps whole against the same script on every core
+//! ([`woodpile_bench::sweeps`]), and with `--whole-paper` the whole pipeline from a cold cache
+//! against the script's sweeps: the ratios the speed targets are stated in.
+//!
 //! ```text
 //! woodpile-bench [--c PATH_TO_C_BINARY] [--numba PATH_TO_SCRIPT] [--numba-scenes PATH]
 //!                [--repeats N] [--paper SCENES_PER_SWEEP] [--seed SEED]
+//!                [--sweeps [--sweep-points N]] [--whole-paper]
 //! ```
 //!
 //! Accuracy is |ΔE_tr| against a reference (Yoshida-6 at dt = 2.5e-4, whose own error is about
@@ -19,7 +24,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use serde_json::Value;
-use woodpile_bench::{fixed, paper, run, standard_scene};
+use woodpile_bench::{fixed, paper, run, standard_scene, sweeps};
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
 use woodpile_sim::run::{run_with_plan, Scenario};
 use woodpile_sim::testing::{fixed_dt, tolerance};
@@ -113,6 +118,11 @@ fn main() {
         .unwrap_or(2026);
     if per_sweep > 0 {
         paper_level(per_sweep, seed, option("--numba-scenes").as_deref());
+    }
+    if args.iter().any(|a| a == "--sweeps") {
+        let points = option("--sweep-points").and_then(|n| n.parse().ok());
+        let whole = args.iter().any(|a| a == "--whole-paper");
+        paper_sweeps(option("--numba-scenes").as_deref(), points, whole);
     }
 }
 
@@ -256,5 +266,59 @@ fn paper_level(per_sweep: usize, seed: u64, numba_script: Option<&str>) {
     }
     if let Err(e) = &c.numba {
         eprintln!("numba side skipped: {e}");
+    }
+}
+
+/// The paper's sweeps against the numba script, and the whole paper when asked, as tables.
+fn paper_sweeps(numba_script: Option<&str>, max_points: Option<usize>, whole_paper: bool) {
+    let pipeline = std::path::Path::new("pipeline");
+    let timings = match sweeps::time_sweeps(pipeline, numba_script, max_points) {
+        Ok(timings) => timings,
+        Err(e) => return eprintln!("sweep comparison skipped: {e}"),
+    };
+    let cores = std::thread::available_parallelism().map_or(1, usize::from);
+    let how = match max_points {
+        None => "each sweep stage run whole into an empty results tree".to_string(),
+        Some(n) => format!("at most {n} points of each grid, woodpile's simulate alone"),
+    };
+    println!(
+        "\nthe paper's sweeps, {how}; numba RK4 dt = 0.01 on the full chain in {cores} \
+         processes; both on {cores} cores, in this run\n"
+    );
+    println!("| sweep | points | woodpile s | numba s | numba / woodpile |");
+    println!("|---|---|---|---|---|");
+    let (mut ours, mut theirs) = (0.0, Some(0.0));
+    for t in &timings {
+        let numba = t.numba_s.as_ref().ok().copied();
+        println!(
+            "| {} | {} | {:.1} | {} | {} |",
+            t.label,
+            t.points,
+            t.woodpile_s,
+            numba.map_or("–".into(), |n| format!("{n:.1}")),
+            numba.map_or("–".into(), |n| format!("{:.2}x", n / t.woodpile_s)),
+        );
+        ours += t.woodpile_s;
+        theirs = theirs.zip(numba).map(|(a, b)| a + b);
+        if let Err(e) = &t.numba_s {
+            eprintln!("{}: numba side skipped: {e}", t.label);
+        }
+    }
+    let ratio = |n: Option<f64>, w: f64| n.map_or("–".into(), |n| format!("{:.2}x", n / w));
+    let shown = theirs.map_or("–".into(), |n| format!("{n:.1}"));
+    println!(
+        "| all five | {} | {ours:.1} | {shown} | {} |",
+        timings.iter().map(|t| t.points).sum::<usize>(),
+        ratio(theirs, ours)
+    );
+    if whole_paper && max_points.is_none() {
+        match sweeps::time_whole_paper(pipeline) {
+            Ok(s) => println!(
+                "\nthe whole paper (every stage and figure, cold): {s:.1} s; \
+                 the numba sweeps alone / the whole paper = {}",
+                ratio(theirs, s)
+            ),
+            Err(e) => eprintln!("whole-paper run failed: {e}"),
+        }
     }
 }

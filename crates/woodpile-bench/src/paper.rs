@@ -10,10 +10,9 @@ use std::process::{Command, Stdio};
 use std::time::Instant;
 use woodpile_stages::KINDS;
 
-use serde_json::{json, Value};
+use serde_json::Value;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::Fractions;
-use woodpile_sim::model::{Boundary, Coupling};
 use woodpile_sim::run::{simulate, Scenario};
 use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance};
 use woodpile_stages::sampling::sampled_scenes;
@@ -119,30 +118,6 @@ fn woodpile_side(label: &str, scenes: &[(String, Scenario)], references: &[Fract
     }
 }
 
-/// The scene as the numba script reads it (linear resonators with constant couplings).
-fn numba_scene(scene: &Scenario, dt: f64) -> Result<Value, String> {
-    let model = &scene.model;
-    let res = model
-        .resonators()
-        .iter()
-        .map(|r| match (r.coupling, r.p) {
-            (Coupling::Constant(k), 1) => Ok(json!([r.site, r.eps, k])),
-            _ => Err("the numba baseline takes linear, constant couplings only".to_string()),
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok(json!({
-        "n": model.n_sites(),
-        "fixed": model.boundary() == Boundary::Fixed,
-        "striker": scene.impulse_site,
-        "velocity": scene.impulse_velocity,
-        "t_end": scene.t_end,
-        "dt": dt,
-        "lo": scene.region.lo(),
-        "hi": scene.region.hi(),
-        "res": res,
-    }))
-}
-
 fn numba_side(
     script: &str,
     scenes: &[(String, Scenario)],
@@ -150,7 +125,7 @@ fn numba_side(
 ) -> Result<Side, String> {
     let input = scenes
         .iter()
-        .map(|(_, s)| numba_scene(s, 0.01))
+        .map(|(_, s)| crate::sweeps::numba_scene(s, 0.01))
         .collect::<Result<Vec<_>, _>>()?;
     let mut child = Command::new("python3")
         .arg(script)

@@ -1,0 +1,202 @@
+//! The paper's five sweeps, whole, against the numba script in one run: the comparison the
+//! speed targets are stated in. woodpile runs each sweep stage as `woodpile run` does (every
+//! core, into an empty results tree, so no point is cached); the numba script
+//! (`baseline/rk4_numba_scenes.py`, RK4 at dt = 0.01 on the full chain, as a researcher would
+//! write it) runs the same grid's scenes split over as many processes as there are cores. Then,
+//! optionally, the whole paper from a cold cache, against the numba sweeps' total.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use woodpile_pipeline::events::Silent;
+use woodpile_pipeline::grid::{point, point_count};
+use woodpile_pipeline::run::{run, RunOptions};
+use woodpile_pipeline::Pipeline;
+use woodpile_sim::model::{Boundary, Coupling};
+use woodpile_sim::run::Scenario;
+use woodpile_stages::sampling::SURVEY_SWEEPS;
+use woodpile_stages::sweep::Sweep;
+use woodpile_stages::KINDS;
+
+/// One sweep timed on both sides.
+#[derive(Debug, Clone)]
+pub struct SweepTiming {
+    /// The sweep's label (`F4`, ...).
+    pub label: String,
+    /// Its grid points.
+    pub points: usize,
+    /// woodpile's wall time for the stage, s.
+    pub woodpile_s: f64,
+    /// The numba script's wall time over the same scenes on every core, s; or why it did
+    /// not run.
+    pub numba_s: Result<f64, String>,
+}
+
+/// The paper's sweeps ([`SURVEY_SWEEPS`]: F4, F5, F6, F7 coarse, F7 fine) under
+/// `pipeline_dir`, each timed on both sides; `max_points` (when given) keeps every k-th point
+/// of each grid so that at most that many run, for a quick look.
+pub fn time_sweeps(
+    pipeline_dir: &Path,
+    numba_script: Option<&str>,
+    max_points: Option<usize>,
+) -> Result<Vec<SweepTiming>, String> {
+    let pipeline = Pipeline::load(pipeline_dir, KINDS).map_err(|e| e.to_string())?;
+    let workers = std::thread::available_parallelism().map_or(1, usize::from);
+    let mut timings = Vec::new();
+    for (stage, label) in SURVEY_SWEEPS {
+        let scenes = grid_scenes(&pipeline, stage, max_points)?;
+        let woodpile_s = match max_points {
+            None => time_stage(&pipeline, stage)?,
+            Some(_) => time_scenes(&scenes),
+        };
+        let numba_s = numba_script
+            .ok_or_else(|| "no --numba-scenes script".to_string())
+            .and_then(|script| time_numba(script, &scenes, workers));
+        timings.push(SweepTiming {
+            label: label.to_string(),
+            points: scenes.len(),
+            woodpile_s,
+            numba_s,
+        });
+    }
+    Ok(timings)
+}
+
+/// The whole pipeline under `pipeline_dir` from nothing (every stage, figures included), s.
+pub fn time_whole_paper(pipeline_dir: &Path) -> Result<f64, String> {
+    let pipeline = Pipeline::load(pipeline_dir, KINDS).map_err(|e| e.to_string())?;
+    timed_run(&pipeline, Vec::new())
+}
+
+/// Every point's scenario of sweep stage `stage`, in grid order (every k-th with
+/// `max_points`).
+fn grid_scenes(
+    pipeline: &Pipeline,
+    stage: &str,
+    max_points: Option<usize>,
+) -> Result<Vec<Scenario>, String> {
+    let sweep = pipeline
+        .stage(stage)
+        .ok()
+        .and_then(|s| s.get::<Sweep>())
+        .ok_or_else(|| format!("no sweep stage `{stage}`"))?;
+    let count = point_count(&sweep.axes);
+    let every = max_points.map_or(1, |m| count.div_ceil(m.max(1)));
+    (0..count)
+        .step_by(every)
+        .map(|i| {
+            let scene = sweep.scene_with(&point(&sweep.axes, i), None);
+            scene.map(|s| s.scenario).map_err(|e| e.to_string())
+        })
+        .collect()
+}
+
+/// Runs stage `stage` alone into a fresh results tree, as `woodpile run` would: s.
+fn time_stage(pipeline: &Pipeline, stage: &str) -> Result<f64, String> {
+    timed_run(pipeline, vec![stage.to_string()])
+}
+
+/// Runs `targets` (all stages when empty) into a fresh scratch tree, removed afterwards: s.
+fn timed_run(pipeline: &Pipeline, targets: Vec<String>) -> Result<f64, String> {
+    let scratch = scratch_dir();
+    let options = RunOptions {
+        targets,
+        force: true,
+        dry_run: false,
+        results: scratch.join("results"),
+        figures: scratch.join("figures"),
+    };
+    let t0 = Instant::now();
+    let outcome = run(pipeline, &options, &Silent);
+    let seconds = t0.elapsed().as_secs_f64();
+    let _ = std::fs::remove_dir_all(&scratch);
+    outcome.map_err(|e| e.to_string())?;
+    Ok(seconds)
+}
+
+/// A scratch folder of this process's own.
+fn scratch_dir() -> PathBuf {
+    std::env::temp_dir().join(format!("woodpile-bench-sweeps-{}", std::process::id()))
+}
+
+/// woodpile's `simulate` over `scenes` on every core (the subsampled look, which runs no
+/// stage): s.
+fn time_scenes(scenes: &[Scenario]) -> f64 {
+    use rayon::prelude::*;
+    let t0 = Instant::now();
+    scenes.par_iter().for_each(|s| {
+        let _ = woodpile_sim::run::simulate(s, &mut ());
+    });
+    t0.elapsed().as_secs_f64()
+}
+
+/// The scene as the numba script reads it: `res` holds `[site, eps, kappa, p]` per resonator
+/// (constant couplings only).
+pub fn numba_scene(scene: &Scenario, dt: f64) -> Result<Value, String> {
+    let model = &scene.model;
+    let res = model
+        .resonators()
+        .iter()
+        .map(|r| match r.coupling {
+            Coupling::Constant(k) => Ok(json!([r.site, r.eps, k, r.p])),
+            _ => Err("the numba baseline takes constant couplings only".to_string()),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(json!({
+        "n": model.n_sites(),
+        "fixed": model.boundary() == Boundary::Fixed,
+        "striker": scene.impulse_site,
+        "velocity": scene.impulse_velocity,
+        "t_end": scene.t_end,
+        "dt": dt,
+        "lo": scene.region.lo(),
+        "hi": scene.region.hi(),
+        "res": res,
+    }))
+}
+
+/// The numba script over `scenes` at dt = 0.01, dealt round-robin to `workers` processes
+/// running at once: the slowest process's time (its compile excluded, as the script reports
+/// it), s.
+fn time_numba(script: &str, scenes: &[Scenario], workers: usize) -> Result<f64, String> {
+    let input = scenes
+        .iter()
+        .map(|s| numba_scene(s, 0.01))
+        .collect::<Result<Vec<_>, _>>()?;
+    let children = (0..workers)
+        .map(|w| {
+            let share: Vec<Value> = input.iter().skip(w).step_by(workers).cloned().collect();
+            spawn_numba(script, &share)
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut slowest_ms = 0.0f64;
+    for child in children {
+        let out = child.wait_with_output().map_err(|e| e.to_string())?;
+        if !out.status.success() {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            return Err(format!("{script} failed: {}", stderr.trim()));
+        }
+        let v: Value =
+            serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))?;
+        slowest_ms = slowest_ms.max(v["ms"].as_f64().ok_or("no ms")?);
+    }
+    Ok(slowest_ms / 1e3)
+}
+
+/// `python3 script 1` reading `scenes` on stdin, started.
+fn spawn_numba(script: &str, scenes: &[Value]) -> Result<std::process::Child, String> {
+    let mut child = Command::new("python3")
+        .args([script, "1"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("python3 {script}: {e}"))?;
+    let text = Value::Array(scenes.to_vec()).to_string();
+    let mut stdin = child.stdin.take().ok_or("no stdin")?;
+    stdin.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
+    Ok(child)
+}
