@@ -86,13 +86,17 @@ read-check: ## Open every result table with pyarrow, pandas and polars
 
 BASELINE := $(or $(CARGO_TARGET_DIR),target)/baseline
 
-bench: ## Speed: woodpile against the C and numba RK4 baselines in one run, batched against scalar scenes, then divan benchmarks
+bench: build ## Speed (PREVIOUS=old/woodpile adds it, same run): woodpile against the C and numba RK4 baselines in one run (standard scene, paper sample, the five sweeps whole, the whole paper cold), batched against scalar scenes
 	mkdir -p $(BASELINE)
 	gcc -O3 -march=x86-64-v3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
-	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py
+	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py --sweeps --whole-paper
 	$(CARGO) run --release -q -p woodpile-bench --example batch_lanes -- 16 0.215
 	$(MAKE) --no-print-directory unused-cost
+	@if [ -n "$(PREVIOUS)" ]; then \
+	  echo "this build against the previous release build $(PREVIOUS):"; \
+	  $(CARGO) run --release -q -p woodpile-bench --example unused_cost -- $(PREVIOUS) $(WOODPILE); \
+	fi
 	$(CARGO) bench -p woodpile-bench
 
 # The last commit before dissipation (dashpots, ground damping, soft ends, the energy ledger).

@@ -272,7 +272,8 @@ fn paper_level(per_sweep: usize, seed: u64, numba_script: Option<&str>) {
 /// The paper's sweeps against the numba script, and the whole paper when asked, as tables.
 fn paper_sweeps(numba_script: Option<&str>, max_points: Option<usize>, whole_paper: bool) {
     let pipeline = std::path::Path::new("pipeline");
-    let timings = match sweeps::time_sweeps(pipeline, numba_script, max_points) {
+    let scratch = sweeps::Scratch::new();
+    let timings = match sweeps::time_sweeps(pipeline, numba_script, max_points, &scratch) {
         Ok(timings) => timings,
         Err(e) => return eprintln!("sweep comparison skipped: {e}"),
     };
@@ -312,7 +313,7 @@ fn paper_sweeps(numba_script: Option<&str>, max_points: Option<usize>, whole_pap
         ratio(theirs, ours)
     );
     if whole_paper && max_points.is_none() {
-        match sweeps::time_whole_paper(pipeline) {
+        match sweeps::time_whole_paper(pipeline, &scratch) {
             Ok(s) => println!(
                 "\nthe whole paper (every stage and figure, cold): {s:.1} s; \
                  the numba sweeps alone / the whole paper = {}",

@@ -1,6 +1,9 @@
 //! The paper's five sweeps, whole, against the numba script in one run: the comparison the
 //! speed targets are stated in. woodpile runs each sweep stage as `woodpile run` does (every
-//! core, into an empty results tree, so no point is cached); the numba script
+//! core, into an empty results tree, so no point is cached). The trees are removed only at the
+//! end ([`Scratch`]): creating files just after deleting thousands makes ext4 search its
+//! inode tables for recently deleted ones, which cost a fresh F4 run 0.8 s of system time
+//! (1.6 s against 0.1 s); the numba script
 //! (`baseline/rk4_numba_scenes.py`, RK4 at dt = 0.01 on the full chain, as a researcher would
 //! write it) runs the same grid's scenes split over as many processes as there are cores. Then,
 //! optionally, the whole paper from a cold cache, against the numba sweeps' total.
@@ -42,6 +45,7 @@ pub fn time_sweeps(
     pipeline_dir: &Path,
     numba_script: Option<&str>,
     max_points: Option<usize>,
+    scratch: &Scratch,
 ) -> Result<Vec<SweepTiming>, String> {
     let pipeline = Pipeline::load(pipeline_dir, KINDS).map_err(|e| e.to_string())?;
     let workers = std::thread::available_parallelism().map_or(1, usize::from);
@@ -49,7 +53,7 @@ pub fn time_sweeps(
     for (stage, label) in SURVEY_SWEEPS {
         let scenes = grid_scenes(&pipeline, stage, max_points)?;
         let woodpile_s = match max_points {
-            None => time_stage(&pipeline, stage)?,
+            None => time_stage(&pipeline, stage, scratch)?,
             Some(_) => time_scenes(&scenes),
         };
         let numba_s = numba_script
@@ -66,9 +70,9 @@ pub fn time_sweeps(
 }
 
 /// The whole pipeline under `pipeline_dir` from nothing (every stage, figures included), s.
-pub fn time_whole_paper(pipeline_dir: &Path) -> Result<f64, String> {
+pub fn time_whole_paper(pipeline_dir: &Path, scratch: &Scratch) -> Result<f64, String> {
     let pipeline = Pipeline::load(pipeline_dir, KINDS).map_err(|e| e.to_string())?;
-    timed_run(&pipeline, Vec::new())
+    timed_run(&pipeline, Vec::new(), scratch)
 }
 
 /// Every point's scenario of sweep stage `stage`, in grid order (every k-th with
@@ -95,31 +99,59 @@ fn grid_scenes(
 }
 
 /// Runs stage `stage` alone into a fresh results tree, as `woodpile run` would: s.
-fn time_stage(pipeline: &Pipeline, stage: &str) -> Result<f64, String> {
-    timed_run(pipeline, vec![stage.to_string()])
+fn time_stage(pipeline: &Pipeline, stage: &str, scratch: &Scratch) -> Result<f64, String> {
+    timed_run(pipeline, vec![stage.to_string()], scratch)
 }
 
-/// Runs `targets` (all stages when empty) into a fresh scratch tree, removed afterwards: s.
-fn timed_run(pipeline: &Pipeline, targets: Vec<String>) -> Result<f64, String> {
-    let scratch = scratch_dir();
+/// Runs `targets` (all stages when empty) into a fresh tree of `scratch`: s.
+fn timed_run(pipeline: &Pipeline, targets: Vec<String>, scratch: &Scratch) -> Result<f64, String> {
+    let tree = scratch.fresh();
     let options = RunOptions {
         targets,
         force: true,
         dry_run: false,
-        results: scratch.join("results"),
-        figures: scratch.join("figures"),
+        results: tree.join("results"),
+        figures: tree.join("figures"),
     };
     let t0 = Instant::now();
-    let outcome = run(pipeline, &options, &Silent);
-    let seconds = t0.elapsed().as_secs_f64();
-    let _ = std::fs::remove_dir_all(&scratch);
-    outcome.map_err(|e| e.to_string())?;
-    Ok(seconds)
+    run(pipeline, &options, &Silent).map_err(|e| e.to_string())?;
+    Ok(t0.elapsed().as_secs_f64())
 }
 
-/// A scratch folder of this process's own.
-fn scratch_dir() -> PathBuf {
-    std::env::temp_dir().join(format!("woodpile-bench-sweeps-{}", std::process::id()))
+/// A folder of this process's own for the timed runs' trees, removed when dropped (after
+/// every timing, not between them).
+pub struct Scratch {
+    root: PathBuf,
+    made: std::cell::Cell<usize>,
+}
+
+impl Scratch {
+    /// An empty scratch folder in the system's temporary folder.
+    pub fn new() -> Scratch {
+        let root = std::env::temp_dir().join(format!("woodpile-bench-{}", std::process::id()));
+        Scratch {
+            root,
+            made: std::cell::Cell::new(0),
+        }
+    }
+
+    /// A path for a new tree, not used before.
+    fn fresh(&self) -> PathBuf {
+        self.made.set(self.made.get() + 1);
+        self.root.join(self.made.get().to_string())
+    }
+}
+
+impl Default for Scratch {
+    fn default() -> Self {
+        Scratch::new()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.root);
+    }
 }
 
 /// woodpile's `simulate` over `scenes` on every core (the subsampled look, which runs no
@@ -179,8 +211,7 @@ fn time_numba(script: &str, scenes: &[Scenario], workers: usize) -> Result<f64, 
             let stderr = String::from_utf8_lossy(&out.stderr);
             return Err(format!("{script} failed: {}", stderr.trim()));
         }
-        let v: Value =
-            serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))?;
+        let v: Value = serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))?;
         slowest_ms = slowest_ms.max(v["ms"].as_f64().ok_or("no ms")?);
     }
     Ok(slowest_ms / 1e3)
@@ -197,6 +228,8 @@ fn spawn_numba(script: &str, scenes: &[Value]) -> Result<std::process::Child, St
         .map_err(|e| format!("python3 {script}: {e}"))?;
     let text = Value::Array(scenes.to_vec()).to_string();
     let mut stdin = child.stdin.take().ok_or("no stdin")?;
-    stdin.write_all(text.as_bytes()).map_err(|e| e.to_string())?;
+    stdin
+        .write_all(text.as_bytes())
+        .map_err(|e| e.to_string())?;
     Ok(child)
 }
