@@ -67,7 +67,7 @@ pub struct ContactLaw {
     coefficient: Vec<f64>,
     /// δ_b for bonds 0..=S (0 without precompression).
     static_overlap: Vec<f64>,
-    /// F_b = a_b [δ_b]^α for bonds 0..=S.
+    /// F_b = a_b \[δ_b\]^α for bonds 0..=S.
     static_force: Vec<f64>,
 }
 

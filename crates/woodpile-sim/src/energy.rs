@@ -187,7 +187,7 @@ impl Held {
 }
 
 /// The potential of bond `bond` (numbering of [`crate::contact`]) at relative displacement
-/// `r`: the paper's (2/5) [r]_+^{5/2}, or the chain's [`crate::ContactLaw`].
+/// `r`: the paper's (2/5) \[r\]_+^{5/2}, or the chain's [`crate::ContactLaw`].
 fn bond_potential(model: &Model, bond: usize, r: f64) -> f64 {
     match model.contacts() {
         None => hertz_potential(r),

@@ -174,7 +174,7 @@ impl Model {
 
     /// [`Model::hertz_chain`] under a [`ContactLaw`]: each bond's force beyond its static one,
     /// a_b [δ_b + u_left − u_right]_+^α − F_b. A recorded bond force is the elastic part
-    /// a_b [c_b]_+^α, positive exactly while the contact is closed, as the contact-event scan
+    /// a_b \[c_b\]_+^α, positive exactly while the contact is closed, as the contact-event scan
     /// needs; the static part is constant over a step, so every quadrature integrates it exactly
     /// and the event correction may leave it out.
     #[inline(always)]

@@ -1,6 +1,6 @@
 //! Exact impulses of a Hertz contact that opens or closes inside a step.
 //!
-//! Why: the contact force F(d) = [d]_+^{3/2} has a kink at d = 0. A step that contains the
+//! Why: the contact force F(d) = \[d\]_+^{3/2} has a kink at d = 0. A step that contains the
 //! moment a contact closes or opens integrates (t - t*)_+^{3/2} with RK4's quadrature, which
 //! is only accurate to O(h^{5/2}); that single term is why every fixed-step method converges at
 //! order 2.5 on a Hertzian chain instead of its classical order. `rk4-contact` keeps RK4 for
@@ -156,7 +156,7 @@ pub(crate) fn first_crossing(path: &BondPath, h: f64, after: f64) -> Option<f64>
     })
 }
 
-/// `(∫_0^h F(d(s)) ds, ∫_0^h (h - s) F(d(s)) ds)` along the Hermite path, F = [d]_+^{3/2}.
+/// `(∫_0^h F(d(s)) ds, ∫_0^h (h - s) F(d(s)) ds)` along the Hermite path, F = \[d\]_+^{3/2}.
 pub(crate) fn path_integrals(path: &BondPath, h: f64) -> (f64, f64) {
     path_integrals_of(path, h, |d| d * d.sqrt())
 }

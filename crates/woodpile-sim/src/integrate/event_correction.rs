@@ -63,7 +63,7 @@ fn negligible<const S: usize>(stage_forces: [f64; S], end_force: f64) -> bool {
 }
 
 /// A bond's elastic force at the end of its path, and its impulse and moment along it: the
-/// paper's [d]_+^{3/2}, or the chain's [`ContactLaw`] (coefficient, exponent, and the static
+/// paper's \[d\]_+^{3/2}, or the chain's [`ContactLaw`] (coefficient, exponent, and the static
 /// overlap added to the path by [`bond_path`]).
 fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
     match model.contacts() {

@@ -61,7 +61,7 @@
 //!   marker (circle, square, triangle, diamond, cross), so every figure reads in greyscale.
 //! - `mark_halving = true` (in `[lines]`): a dashed vertical line where each curve first falls
 //!   to half its first value in the table's order (its lossless end, say), interpolated between
-//!   the samples around the crossing (in log x on positive x), labelled "<curve> halves".
+//!   the samples around the crossing (in log x on positive x), labelled "`<curve>` halves".
 //! - `z_range = "robust"` (the default of diverging maps: symmetric, to the 99th percentile of
 //!   |z|, said in the colour bar's label), `"full"` (the data's range) or `[lo, hi]`.
 //!

@@ -1,5 +1,5 @@
 //! Whether a measured number reproduces the paper's, and by how much it differs: what the
-//! report judges, apart from how [`super::markdown`] writes it.
+//! report judges, apart from how [`super::markdown`](mod@super::markdown) writes it.
 
 use super::measure::Measured;
 use super::Paper;
