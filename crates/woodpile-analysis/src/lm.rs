@@ -18,21 +18,23 @@ pub enum Form {
 }
 
 impl Form {
+    /// Every form under its stage-file name: the one table names are read from.
+    pub const OPTIONS: [(&'static str, Form); 2] = [("power", Form::Power), ("tanh", Form::Tanh)];
+
     /// The name used in stage files.
     pub fn name(self) -> &'static str {
-        match self {
-            Form::Power => "power",
-            Form::Tanh => "tanh",
-        }
+        Form::OPTIONS
+            .iter()
+            .find(|(_, f)| *f == self)
+            .map_or("", |(n, _)| n)
     }
 
-    /// Parses [`Form::name`].
+    /// The form called `name` in [`Form::OPTIONS`].
     pub fn from_name(name: &str) -> Option<Form> {
-        match name {
-            "power" => Some(Form::Power),
-            "tanh" => Some(Form::Tanh),
-            _ => None,
-        }
+        Form::OPTIONS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, f)| f)
     }
 
     /// f(x; p).

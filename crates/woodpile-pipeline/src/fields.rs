@@ -91,34 +91,34 @@ impl<'a> Fields<'a> {
 
     /// A key whose value is one of `options` (the names a stage file writes, each with the
     /// value it stands for), or `default` when absent (`None`: the key is required). The one
-    /// parser of every "one of these words" key, so each refusal reads alike:
-    /// `expected "a", "b" or "c", got "x"`.
+    /// parser of every "one of these words" key, so each refusal reads alike ([`pick`]).
     pub fn choice<T: Copy>(
         &mut self,
         key: &str,
         options: &[(&str, T)],
         default: Option<T>,
     ) -> Result<T, PipelineError> {
-        let given = match default {
-            Some(value) => match self.optional::<String>(key)? {
-                Some(text) => text,
-                None => return Ok(value),
-            },
-            None => self.required::<String>(key)?,
-        };
-        if let Some(&(_, value)) = options.iter().find(|(name, _)| *name == given) {
-            return Ok(value);
+        match (self.optional_choice(key, options)?, default) {
+            (Some(value), _) | (None, Some(value)) => Ok(value),
+            (None, None) => Err(self.error(
+                key,
+                format!("missing (expected {})", <String as FromToml>::EXPECTED),
+            )),
         }
-        let names: Vec<String> = options
-            .iter()
-            .map(|(name, _)| format!("\"{name}\""))
-            .collect();
-        let listed = match names.split_last() {
-            Some((last, [])) => last.clone(),
-            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
-            None => String::new(),
-        };
-        Err(self.error(key, format!("expected {listed}, got \"{given}\"")))
+    }
+
+    /// [`Fields::choice`] of a key that may be absent, with no default: `None` then.
+    pub fn optional_choice<T: Copy>(
+        &mut self,
+        key: &str,
+        options: &[(&str, T)],
+    ) -> Result<Option<T>, PipelineError> {
+        match self.optional::<String>(key)? {
+            None => Ok(None),
+            Some(given) => pick(options, &given)
+                .map(Some)
+                .map_err(|e| self.error(key, e)),
+        }
     }
 
     /// An optional `key = [lo, hi]` of finite numbers, the one parser of every range key:
@@ -265,4 +265,23 @@ impl FromToml for toml::Value {
     fn from_toml(value: toml::Value) -> Option<Self> {
         Some(value)
     }
+}
+
+/// The value of `options` named `given`, or the reason it is none of them:
+/// `expected "a", "b" or "c", got "x"`. Every "one of these words" value of a stage file is
+/// read by it (through [`Fields::choice`], or directly for the words of a list).
+pub fn pick<T: Copy>(options: &[(&str, T)], given: &str) -> Result<T, String> {
+    if let Some(&(_, value)) = options.iter().find(|(name, _)| *name == given) {
+        return Ok(value);
+    }
+    let names: Vec<String> = options
+        .iter()
+        .map(|(name, _)| format!("\"{name}\""))
+        .collect();
+    let listed = match names.split_last() {
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+        None => String::new(),
+    };
+    Err(format!("expected {listed}, got \"{given}\""))
 }

@@ -58,8 +58,13 @@ pub enum Dash {
 }
 
 impl Dash {
-    /// The names [`Dash::named`] accepts, for messages.
-    pub const NAMES: &'static str = "\"solid\", \"dashed\", \"dotted\" or \"dashdot\"";
+    /// Every dash under its stage-file name: the one table names are read from.
+    pub const OPTIONS: [(&'static str, Dash); 4] = [
+        ("solid", Dash::Solid),
+        ("dashed", Dash::Dashed),
+        ("dotted", Dash::Dotted),
+        ("dashdot", Dash::DashDot),
+    ];
 
     /// The on-off lengths in points (empty: solid).
     pub(crate) fn pattern(self) -> &'static [f64] {
@@ -71,15 +76,9 @@ impl Dash {
         }
     }
 
-    /// The dash called `name`: "solid", "dashed", "dotted" or "dashdot".
+    /// The dash called `name` in [`Dash::OPTIONS`].
     pub fn named(name: &str) -> Option<Dash> {
-        match name {
-            "solid" => Some(Dash::Solid),
-            "dashed" => Some(Dash::Dashed),
-            "dotted" => Some(Dash::Dotted),
-            "dashdot" => Some(Dash::DashDot),
-            _ => None,
-        }
+        named_in(&Dash::OPTIONS, name)
     }
 }
 
@@ -101,21 +100,19 @@ pub enum Marker {
 }
 
 impl Marker {
-    /// The names [`Marker::named`] accepts, for messages.
-    pub const NAMES: &'static str =
-        "\"none\", \"circle\", \"square\", \"triangle\", \"diamond\" or \"cross\"";
+    /// Every marker under its stage-file name: the one table names are read from.
+    pub const OPTIONS: [(&'static str, Marker); 6] = [
+        ("none", Marker::None),
+        ("circle", Marker::Circle),
+        ("square", Marker::Square),
+        ("triangle", Marker::Triangle),
+        ("diamond", Marker::Diamond),
+        ("cross", Marker::Cross),
+    ];
 
-    /// The marker called `name`: "none", "circle", "square", "triangle", "diamond" or "cross".
+    /// The marker called `name` in [`Marker::OPTIONS`].
     pub fn named(name: &str) -> Option<Marker> {
-        match name {
-            "none" => Some(Marker::None),
-            "circle" => Some(Marker::Circle),
-            "square" => Some(Marker::Square),
-            "triangle" => Some(Marker::Triangle),
-            "diamond" => Some(Marker::Diamond),
-            "cross" => Some(Marker::Cross),
-            _ => None,
-        }
+        named_in(&Marker::OPTIONS, name)
     }
 }
 
@@ -179,6 +176,11 @@ fn interpolate(anchors: &[(u8, u8, u8)], t: f64) -> RGBColor {
     let (a, b) = (anchors[i], anchors[i + 1]);
     let mix = |p: u8, q: u8| (p as f64 + (q as f64 - p as f64) * f).round() as u8;
     RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// The value called `name` in a table of (name, value) options.
+pub(crate) fn named_in<T: Copy>(options: &[(&str, T)], name: &str) -> Option<T> {
+    options.iter().find(|(n, _)| *n == name).map(|&(_, v)| v)
 }
 
 #[cfg(test)]

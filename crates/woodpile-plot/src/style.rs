@@ -120,27 +120,25 @@ impl Corner {
 }
 
 impl Legend {
-    /// Every name [`Legend::named`] accepts, for messages.
-    pub const NAMES: &'static str = "\"best\", \"upper left\", \"upper center\", \"upper right\", \"lower left\", \"lower center\", \"lower right\", \"center left\", \"center right\", \"outside right\", \"below\" or \"none\"";
+    /// Every placement under its stage-file name: the one table names are read from.
+    pub const OPTIONS: [(&'static str, Legend); 12] = [
+        ("best", Legend::Best),
+        ("upper left", Legend::Inside(Corner::UpperLeft)),
+        ("upper center", Legend::Inside(Corner::UpperCenter)),
+        ("upper right", Legend::Inside(Corner::UpperRight)),
+        ("lower left", Legend::Inside(Corner::LowerLeft)),
+        ("lower center", Legend::Inside(Corner::LowerCenter)),
+        ("lower right", Legend::Inside(Corner::LowerRight)),
+        ("center left", Legend::Inside(Corner::CenterLeft)),
+        ("center right", Legend::Inside(Corner::CenterRight)),
+        ("outside right", Legend::OutsideRight),
+        ("below", Legend::Below),
+        ("none", Legend::None),
+    ];
 
-    /// The placement called `name` (as in [`Legend::NAMES`]).
+    /// The placement called `name` in [`Legend::OPTIONS`].
     pub fn named(name: &str) -> Option<Legend> {
-        let corner = |c| Some(Legend::Inside(c));
-        match name {
-            "best" => Some(Legend::Best),
-            "upper left" => corner(Corner::UpperLeft),
-            "upper center" => corner(Corner::UpperCenter),
-            "upper right" => corner(Corner::UpperRight),
-            "lower left" => corner(Corner::LowerLeft),
-            "lower center" => corner(Corner::LowerCenter),
-            "lower right" => corner(Corner::LowerRight),
-            "center left" => corner(Corner::CenterLeft),
-            "center right" => corner(Corner::CenterRight),
-            "outside right" => Some(Legend::OutsideRight),
-            "below" => Some(Legend::Below),
-            "none" => Some(Legend::None),
-            _ => None,
-        }
+        crate::colour::named_in(&Legend::OPTIONS, name)
     }
 }
 

@@ -88,13 +88,7 @@ impl FitStage {
             let mut f = fields.nested(&format!("model[{i}]"), table);
             let name: String = f.required("name")?;
             let y: String = f.required("y")?;
-            let form_name: String = f.required("form")?;
-            let form = Form::from_name(&form_name).ok_or_else(|| {
-                f.error(
-                    "form",
-                    format!("unknown form `{form_name}` (forms: power, tanh)"),
-                )
-            })?;
+            let form = f.choice("form", &Form::OPTIONS, None)?;
             let start = f.take("start");
             let start = triple(&f, "start", start)?
                 .ok_or_else(|| f.error("start", "missing (expected [A, B, C])"))?;

@@ -3,8 +3,8 @@
 //! `impl Kind`. The engine (`woodpile-pipeline`: the DAG, keys, status, runs, the point cache,
 //! tables) knows none of them: it is handed [`KINDS`].
 //!
-//! A new kind is one module here and one line in [`KINDS`] (docs/stage-kinds.md, "Adding a
-//! kind").
+//! A new kind is one module here and one line in [`KINDS`]: docs/adding-a-kind.md walks through
+//! one.
 #![warn(missing_docs)]
 
 use std::sync::Arc;

@@ -70,12 +70,7 @@ const MAX_EVALUATIONS: usize = 120;
 
 impl Optimize {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Optimize> {
-        let column: String = fields
-            .optional("column")?
-            .unwrap_or_else(|| Fraction::Trapped.column().into());
-        let Some(column) = Fraction::named(&column) else {
-            return Err(fields.error("column", format!("expected one of {}", Fraction::listed())));
-        };
+        let column = fields.choice("column", &Fraction::OPTIONS, Some(Fraction::Trapped))?;
         let over: Vec<String> = fields.required("over")?;
         if over.is_empty() {
             return Err(fields.error("over", "name at least one axis"));

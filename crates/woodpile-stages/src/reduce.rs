@@ -52,14 +52,7 @@ impl Reduce {
             None => None,
             Some(table) => {
                 let mut m = fields.nested("maximize", table);
-                let column: String = m
-                    .optional("column")?
-                    .unwrap_or_else(|| Fraction::Trapped.column().into());
-                let Some(column) = Fraction::named(&column) else {
-                    return Err(
-                        m.error("column", format!("expected one of {}", Fraction::listed()))
-                    );
-                };
+                let column = m.choice("column", &Fraction::OPTIONS, Some(Fraction::Trapped))?;
                 let over: Vec<String> = m.required("over")?;
                 if over.is_empty() {
                     return Err(m.error("over", "name at least one axis"));

@@ -25,6 +25,14 @@ impl Fraction {
         Fraction::Transmitted,
     ];
 
+    /// Every fraction under its column's name, the name a stage file gives it: the one table
+    /// names are read from.
+    pub const OPTIONS: [(&'static str, Fraction); 3] = [
+        (sweep::TRAPPED, Fraction::Trapped),
+        (sweep::REFLECTED, Fraction::Reflected),
+        (sweep::TRANSMITTED, Fraction::Transmitted),
+    ];
+
     /// Its column name.
     pub fn column(self) -> &'static str {
         match self {
@@ -32,11 +40,6 @@ impl Fraction {
             Fraction::Reflected => sweep::REFLECTED,
             Fraction::Transmitted => sweep::TRANSMITTED,
         }
-    }
-
-    /// The fraction whose column is `name`.
-    pub fn named(name: &str) -> Option<Fraction> {
-        Fraction::ALL.into_iter().find(|f| f.column() == name)
     }
 
     /// Its value among (reflected, transmitted, trapped).
@@ -47,11 +50,6 @@ impl Fraction {
             Fraction::Transmitted => transmitted,
         }
     }
-
-    /// `["E_tr", "R", "T"]`, for messages.
-    pub fn listed() -> String {
-        format!("{:?}", Fraction::ALL.map(Fraction::column))
-    }
 }
 
 #[cfg(test)]
@@ -60,11 +58,10 @@ mod tests {
 
     #[test]
     fn fractions_round_trip_through_their_names() {
-        for f in Fraction::ALL {
-            assert_eq!(Fraction::named(f.column()), Some(f));
+        for (name, f) in Fraction::OPTIONS {
+            assert_eq!(f.column(), name);
         }
-        assert_eq!(Fraction::named("E"), None);
-        assert_eq!(Fraction::listed(), r#"["E_tr", "R", "T"]"#);
+        assert_eq!(Fraction::OPTIONS.map(|(_, f)| f), Fraction::ALL);
         assert_eq!(Fraction::Reflected.of(0.1, 0.2, 0.3), 0.1);
     }
 }

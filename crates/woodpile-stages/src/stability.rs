@@ -35,7 +35,7 @@ use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD}
 use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
 
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::fields::{pick, Fields};
 use woodpile_pipeline::kind::{Context, Kind};
 use woodpile_pipeline::table::Columns;
 use woodpile_pipeline::Output;
@@ -76,21 +76,15 @@ impl Stability {
         }
         let names: Vec<String> = fields.required("methods")?;
         let mut methods = Vec::new();
+        let fixed: Vec<(&str, Method)> = Method::ALL
+            .into_iter()
+            .filter(|m| !m.is_adaptive())
+            .map(|m| (m.name(), m))
+            .collect();
         for name in names {
-            match Method::from_name(&name) {
-                Some(m) if !m.is_adaptive() => methods.push(m),
-                _ => {
-                    let fixed: Vec<&str> = Method::ALL
-                        .iter()
-                        .filter(|m| !m.is_adaptive())
-                        .map(|m| m.name())
-                        .collect();
-                    return Err(fields.error(
-                        "methods",
-                        format!("`{name}` is not a fixed-step method ({})", fixed.join(", ")),
-                    ));
-                }
-            }
+            let method = pick(&fixed, &name)
+                .map_err(|e| fields.error("methods", format!("a fixed-step method: {e}")))?;
+            methods.push(method);
         }
         let vary = fields.choice("vary", &[("eps", Vary::Eps), ("p", Vary::P)], None)?;
         let values: Vec<f64> = fields.required("values")?;

@@ -97,14 +97,12 @@ fn parse_method(fields: &Fields<'_>, i: usize, entry: toml::Value) -> Result<Vec
         return Err(fields.error(&key, "expected a table"));
     };
     let mut f = fields.nested(&key, table);
-    let name: String = f.required("name")?;
-    let choice = match name.as_str() {
-        "auto" => MethodChoice::Auto,
-        other => MethodChoice::Named(
-            Method::from_name(other)
-                .ok_or_else(|| f.error("name", format!("unknown method `{other}`")))?,
-        ),
-    };
+    let options = MethodChoice::options();
+    let choice = f.choice("name", &options, None)?;
+    let name = options
+        .iter()
+        .find(|(_, c)| *c == choice)
+        .map_or("", |(n, _)| n);
     let adaptive = match choice {
         MethodChoice::Auto => true,
         MethodChoice::Named(m) => m.is_adaptive(),
@@ -122,7 +120,7 @@ fn parse_method(fields: &Fields<'_>, i: usize, entry: toml::Value) -> Result<Vec
     Ok(values
         .into_iter()
         .map(|v| Setting {
-            method: name.clone(),
+            method: name.to_string(),
             method_index: i,
             choice,
             accuracy: match adaptive {
@@ -215,7 +213,7 @@ impl WorkPrecision {
         Ok(Output::table(
             rows_frame(&rows)?,
             json!({
-                "reference": {"method": "dop853", "tolerance": self.reference_tolerance},
+                "reference": {"method": Method::Dop853.name(), "tolerance": self.reference_tolerance},
                 "references": references,
                 "repeats": self.repeats,
                 "machine": machine(),

@@ -41,19 +41,17 @@ pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
         sample_every: None,
     });
     let t_end = positive("run.t_end", run.t_end.unwrap_or(DEFAULT_T_END))?;
-    let method = match run.method.as_deref().unwrap_or("auto") {
-        "auto" => MethodChoice::Auto,
-        name => MethodChoice::Named(Method::from_name(name).ok_or_else(|| {
-            let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
-            invalid(
-                "run.method",
-                format!(
-                    "unknown method \"{name}\"; expected \"auto\" or one of {}",
-                    names.join(", ")
-                ),
-            )
-        })?),
-    };
+    let name = run.method.as_deref().unwrap_or("auto");
+    let method = MethodChoice::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+        invalid(
+            "run.method",
+            format!(
+                "unknown method \"{name}\"; expected \"auto\" or one of {}",
+                names.join(", ")
+            ),
+        )
+    })?;
     let tolerance = positive("run.tolerance", run.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
     if tolerance > MAX_TOLERANCE {
         return Err(invalid(

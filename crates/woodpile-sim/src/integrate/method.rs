@@ -234,6 +234,24 @@ pub enum MethodChoice {
     Named(Method),
 }
 
+impl MethodChoice {
+    /// `"auto"` and every method, under the names scene and stage files give them: the one
+    /// table a method's name is read from.
+    pub fn options() -> Vec<(&'static str, MethodChoice)> {
+        std::iter::once(("auto", MethodChoice::Auto))
+            .chain(Method::ALL.map(|m| (m.name(), MethodChoice::Named(m))))
+            .collect()
+    }
+
+    /// The choice called `name` (`"auto"` or a method's name).
+    pub fn from_name(name: &str) -> Option<MethodChoice> {
+        MethodChoice::options()
+            .into_iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, c)| c)
+    }
+}
+
 /// What accuracy the caller asked for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Accuracy {

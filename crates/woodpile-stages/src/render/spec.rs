@@ -318,8 +318,8 @@ fn parse_series_styles(f: &mut Fields<'_>) -> Result<Vec<CurveStyle>> {
         };
         let mut s = outer.nested(&name, t);
         let colour = named(&mut s, "colour", hex_colour, "\"#rrggbb\"")?;
-        let dash = named(&mut s, "dash", Dash::named, Dash::NAMES)?;
-        let marker = named(&mut s, "marker", Marker::named, Marker::NAMES)?;
+        let dash = s.optional_choice("dash", &Dash::OPTIONS)?;
+        let marker = s.optional_choice("marker", &Marker::OPTIONS)?;
         let label = s.optional::<String>("label")?;
         if let Some(l) = &label {
             markup(l).map_err(|reason| s.error("label", reason))?;

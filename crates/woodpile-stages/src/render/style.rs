@@ -56,15 +56,7 @@ impl StyleSpec {
         }
         let dpi = bounded(&mut f, "dpi", 50.0, 1200.0)?.unwrap_or(300.0);
         let font_pt = bounded(&mut f, "font_pt", 4.0, 24.0)?.unwrap_or(8.0);
-        let legend = match f.optional::<String>("legend")? {
-            None => Legend::Best,
-            Some(name) => Legend::named(&name).ok_or_else(|| {
-                f.error(
-                    "legend",
-                    format!("expected {}, got \"{name}\"", Legend::NAMES),
-                )
-            })?,
-        };
+        let legend = f.choice("legend", &Legend::OPTIONS, Some(Legend::Best))?;
         let spec = StyleSpec {
             width_mm,
             height_mm,
