@@ -59,11 +59,10 @@ pub enum Dash {
 
 impl Dash {
     /// Every dash under its stage-file name: the one table names are read from.
+    #[rustfmt::skip]
     pub const OPTIONS: [(&'static str, Dash); 4] = [
-        ("solid", Dash::Solid),
-        ("dashed", Dash::Dashed),
-        ("dotted", Dash::Dotted),
-        ("dashdot", Dash::DashDot),
+        ("solid", Dash::Solid), ("dashed", Dash::Dashed),
+        ("dotted", Dash::Dotted), ("dashdot", Dash::DashDot),
     ];
 
     /// The on-off lengths in points (empty: solid).
@@ -101,13 +100,10 @@ pub enum Marker {
 
 impl Marker {
     /// Every marker under its stage-file name: the one table names are read from.
+    #[rustfmt::skip]
     pub const OPTIONS: [(&'static str, Marker); 6] = [
-        ("none", Marker::None),
-        ("circle", Marker::Circle),
-        ("square", Marker::Square),
-        ("triangle", Marker::Triangle),
-        ("diamond", Marker::Diamond),
-        ("cross", Marker::Cross),
+        ("none", Marker::None), ("circle", Marker::Circle), ("square", Marker::Square),
+        ("triangle", Marker::Triangle), ("diamond", Marker::Diamond), ("cross", Marker::Cross),
     ];
 
     /// The marker called `name` in [`Marker::OPTIONS`].
