@@ -159,7 +159,7 @@ pub enum SimError {
         dt: f64,
         /// What failed at that step: the estimate, the energy drift, or the pair not being in
         /// its asymptotic regime.
-        why: String,
+        why: Refusal,
         /// The finest run the ladder made, unverified: what a caller may keep, marked so.
         finest: Option<Box<Unverified>>,
     },
@@ -245,6 +245,96 @@ impl StepSetBy {
             StepSetBy::Tolerance => "the tolerance",
             StepSetBy::Resonator(_) => "the fastest resonator's frequency",
             StepSetBy::Contacts => "the chain's stiffest contact",
+        }
+    }
+}
+
+/// Why `auto`'s ladder did not accept the finest step it tried: the typed reason a
+/// [`SimError::NotConverged`] carries, and the sentence its message says.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Refusal {
+    /// No rung has run yet.
+    NoRunKeptEnergy,
+    /// The fine run itself blew up or lost its energy.
+    BlewUp(Box<SimError>),
+    /// The run at twice the step blew up: no pair.
+    NoPair,
+    /// The pair's estimate is above what it must meet.
+    Estimate {
+        /// The Richardson estimate.
+        estimate: f64,
+        /// What it had to be at most.
+        accept: f64,
+        /// The tolerance asked for.
+        tol: f64,
+    },
+    /// The fine run drifts in energy beyond what the tolerance allows.
+    Drift {
+        /// The largest relative drift seen.
+        drift: f64,
+        /// What the tolerance allows.
+        limit: f64,
+    },
+    /// The estimate would pass, but the changes do not shrink as the method's order says.
+    NotAsymptotic {
+        /// The estimate that would have passed.
+        estimate: f64,
+        /// The change between the two runs before.
+        before: f64,
+        /// The change between the last two.
+        after: f64,
+    },
+    /// The pair agreed, but a run off the ladder (1.5 dt) does not.
+    OffLadder {
+        /// The estimate from the run off the ladder.
+        estimate: f64,
+        /// What it had to be at most.
+        accept: f64,
+        /// The tolerance asked for.
+        tol: f64,
+    },
+    /// The estimate is so far above what it must meet that the halvings left cannot bring it
+    /// there, even falling as fast as an accepted pair's changes may.
+    OutOfReach {
+        /// The Richardson estimate.
+        estimate: f64,
+        /// What it had to be at most.
+        accept: f64,
+        /// The tolerance asked for.
+        tol: f64,
+        /// Halvings the ladder had left.
+        halvings_left: u32,
+        /// The most the estimate could fall per halving.
+        factor: f64,
+    },
+}
+
+impl std::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Refusal::NoRunKeptEnergy => write!(f, "no run kept its energy"),
+            Refusal::BlewUp(ref e) => write!(f, "the run blew up or lost energy ({e})"),
+            Refusal::NoPair => write!(f, "the run at twice the step blew up, so there is no pair to compare"),
+            Refusal::Estimate { estimate, accept, tol } => write!(
+                f,
+                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e})"
+            ),
+            Refusal::Drift { drift, limit } => write!(
+                f,
+                "the energy drifts by {drift:.2e}, more than the {limit:.1e} the tolerance allows"
+            ),
+            Refusal::NotAsymptotic { estimate, before, after } => write!(
+                f,
+                "the error estimate {estimate:.2e} would pass, but the runs are not in their asymptotic regime (the change between runs went from {before:.2e} to {after:.2e} when the step halved, not by the factor the method's order gives), so the estimate cannot be trusted"
+            ),
+            Refusal::OffLadder { estimate, accept, tol } => write!(
+                f,
+                "the pair agreed, but a run at 1.5 times the step differs by an estimated {estimate:.2e}, above the {accept:.1e} it must meet (tolerance {tol:.1e}): the error jumps with the step"
+            ),
+            Refusal::OutOfReach { estimate, accept, tol, halvings_left, factor } => write!(
+                f,
+                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e}), and the {halvings_left} halving(s) left could not bring it there even if it fell {factor:.0} times per halving, the most an accepted pair's change may fall: refused at once rather than after them"
+            ),
         }
     }
 }

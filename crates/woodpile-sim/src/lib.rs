@@ -37,5 +37,5 @@ pub mod units;
 
 pub use contact::ContactLaw;
 pub use damping::{Damping, DashpotLaw};
-pub use error::{ModelError, OverBudget, SimError, StepSetBy, Unverified};
+pub use error::{ModelError, OverBudget, Refusal, SimError, StepSetBy, Unverified};
 pub use model::{Boundary, Coupling, End, Model, Resonator};

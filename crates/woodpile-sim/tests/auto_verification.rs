@@ -11,7 +11,7 @@ use woodpile_sim::testing::{
     audit_scene_at, chain_audit_scene, fixed_dt, paper_scene, reference_fractions, tolerance, Lcg,
     PaperDefect, AUDIT_REFERENCE_DT,
 };
-use woodpile_sim::SimError;
+use woodpile_sim::{Refusal, SimError};
 
 /// Asserts that `auto` on `scene` converges within `tol` of the `rk4-contact` reference at
 /// the step `reference_dt`.
@@ -196,6 +196,38 @@ fn assert_within_audit_reference_or_refused(scene: Scenario, tol: f64, what: &st
         }
         Err(SimError::NotConverged { .. }) => {}
         Err(e) => panic!("{what}: {e}"),
+    }
+}
+
+/// A refusal says why in a type, not only in words: a short chain at a tolerance no double
+/// can verify is refused with `Refusal::OutOfReach` (or the estimate it could not meet), and
+/// keeps its finest run, marked unverified.
+#[test]
+fn a_refusal_carries_its_reason_typed() {
+    let model = Model::new(
+        21,
+        Boundary::Fixed,
+        vec![Resonator::constant(10, 0.5, 1.0, 1)],
+    );
+    let scene = Scenario {
+        model: model.unwrap(),
+        impulse_site: 4,
+        impulse_velocity: 1.0,
+        t_end: 12.0,
+        region: Region::new(9, 11, 21).unwrap(),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(1e-15),
+        sample_every: 1.0,
+    };
+    match simulate(&scene, &mut ()) {
+        Err(SimError::NotConverged { why, finest, .. }) => {
+            assert!(
+                matches!(why, Refusal::OutOfReach { .. } | Refusal::Estimate { .. }),
+                "{why:?}"
+            );
+            assert!(finest.is_some());
+        }
+        other => panic!("expected a refusal, got {other:?}"),
     }
 }
 

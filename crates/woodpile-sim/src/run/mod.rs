@@ -11,7 +11,7 @@
 pub mod budget;
 
 use crate::energy::{Fractions, Region};
-use crate::error::SimError;
+use crate::error::{Refusal, SimError};
 use crate::integrate::{
     Accuracy, CancelOnly, MethodChoice, Observer, Plan, Stats, BLOW_UP_DRIFT, DRIFT_PER_TOL,
 };
@@ -195,7 +195,7 @@ fn verified<O: Observer + ?Sized>(
         tolerance: ladder.tol,
         estimate: ladder.estimate,
         dt: 2.0 * ladder.dt,
-        why: why.to_string(),
+        why,
         finest,
     })
 }
@@ -208,76 +208,6 @@ enum Rung {
     Refine(Refusal),
     /// Not verified, and no step the ladder has left can be: refuse now, for this reason.
     GiveUp(Refusal),
-}
-
-/// Why a rung did not accept: the reason a refusal reports for the finest step tried.
-#[derive(Debug, Clone, PartialEq)]
-enum Refusal {
-    /// No rung has run yet.
-    NoRunKeptEnergy,
-    /// The fine run itself blew up or lost its energy.
-    BlewUp(String),
-    /// The run at twice the step blew up: no pair.
-    NoPair,
-    /// The pair's estimate is above what it must meet.
-    Estimate {
-        estimate: f64,
-        accept: f64,
-        tol: f64,
-    },
-    /// The fine run drifts in energy beyond what the tolerance allows.
-    Drift { drift: f64, limit: f64 },
-    /// The estimate would pass, but the changes do not shrink as the method's order says.
-    NotAsymptotic {
-        estimate: f64,
-        before: f64,
-        after: f64,
-    },
-    /// The pair agreed, but a run off the ladder (1.5 dt) does not.
-    OffLadder {
-        estimate: f64,
-        accept: f64,
-        tol: f64,
-    },
-    /// The estimate is so far above what it must meet that the halvings left cannot bring it
-    /// there, even falling as fast as an accepted pair's changes may.
-    OutOfReach {
-        estimate: f64,
-        accept: f64,
-        tol: f64,
-        halvings_left: u32,
-        factor: f64,
-    },
-}
-
-impl std::fmt::Display for Refusal {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match *self {
-            Refusal::NoRunKeptEnergy => write!(f, "no run kept its energy"),
-            Refusal::BlewUp(ref e) => write!(f, "the run blew up or lost energy ({e})"),
-            Refusal::NoPair => write!(f, "the run at twice the step blew up, so there is no pair to compare"),
-            Refusal::Estimate { estimate, accept, tol } => write!(
-                f,
-                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e})"
-            ),
-            Refusal::Drift { drift, limit } => write!(
-                f,
-                "the energy drifts by {drift:.2e}, more than the {limit:.1e} the tolerance allows"
-            ),
-            Refusal::NotAsymptotic { estimate, before, after } => write!(
-                f,
-                "the error estimate {estimate:.2e} would pass, but the runs are not in their asymptotic regime (the change between runs went from {before:.2e} to {after:.2e} when the step halved, not by the factor the method's order gives), so the estimate cannot be trusted"
-            ),
-            Refusal::OffLadder { estimate, accept, tol } => write!(
-                f,
-                "the pair agreed, but a run at 1.5 times the step differs by an estimated {estimate:.2e}, above the {accept:.1e} it must meet (tolerance {tol:.1e}): the error jumps with the step"
-            ),
-            Refusal::OutOfReach { estimate, accept, tol, halvings_left, factor } => write!(
-                f,
-                "the error estimate {estimate:.2e} is above the {accept:.1e} it must meet (tolerance {tol:.1e}), and the {halvings_left} halving(s) left could not bring it there even if it fell {factor:.0} times per halving, the most an accepted pair's change may fall: refused at once rather than after them"
-            ),
-        }
-    }
 }
 
 /// The ladder's state between rungs: the step, the run at twice it, the change between the
@@ -344,7 +274,7 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
             Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
                 self.step_down(None, None);
-                return Ok(Rung::Refine(Refusal::BlewUp(e.to_string())));
+                return Ok(Rung::Refine(Refusal::BlewUp(Box::new(e))));
             }
             Err(e) => return Err(e),
         };
