@@ -226,6 +226,30 @@ impl Context<'_> {
         Ok(woodpile_points::layout::best_path(self.results, name))
     }
 
+    /// This stage's own output manifest from its previous run, if a readable one is there:
+    /// what a kind checks before it replaces a file of its own.
+    pub fn previous_manifest(&self) -> Option<Manifest> {
+        table::read_manifest(&output_path(self.results, self.name()))
+            .ok()
+            .flatten()
+    }
+
+    /// The first `limit` bytes of `path`, one of the files this stage declares, as they are
+    /// on disk now (`None`: absent, not a regular file, or unreadable): read without following
+    /// a link, as every read of the tree is.
+    pub fn existing_head(&self, path: &Path, limit: usize) -> Option<Vec<u8>> {
+        let declared = self
+            .stage
+            .spec
+            .files(self.name(), self.results, self.figures);
+        if !declared.iter().any(|p| p == path) {
+            return None;
+        }
+        let mut bytes = woodpile_points::regular::read(path, 1 << 26).ok()?;
+        bytes.truncate(limit);
+        Some(bytes)
+    }
+
     /// Writes `bytes` to `path`, one of the files this stage declares besides its table
     /// ([`Kind::files`]), atomically. The one door through which a kind writes: a file it did
     /// not declare is refused (its checksum would not be recorded, so `status` could not see

@@ -42,9 +42,8 @@ use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
-use woodpile_pipeline::table::{self, rows_frame, Cell, Row};
+use woodpile_pipeline::table::{rows_frame, Cell, Row};
 use woodpile_pipeline::Output;
-use woodpile_points::layout::output_path;
 
 pub use woodpile_pipeline::table::Match;
 
@@ -203,25 +202,19 @@ impl Report {
     /// and those that carry its generated mark near the top (what a run killed between the
     /// Markdown and the table, or a damaged table, leaves: never a stuck stage). That the path
     /// stays inside the project on disk is `Context::write_file`'s check.
-    fn check_owned(&self, stage: &str, path: &Path, results: &Path) -> Result<()> {
+    fn check_owned(&self, ctx: &Context<'_>, path: &Path) -> Result<()> {
+        let stage = ctx.name();
         if std::fs::symlink_metadata(path).is_err() {
             return Ok(());
         }
-        let previous = table::read_manifest(&output_path(results, stage))
-            .ok()
-            .flatten();
+        let previous = ctx.previous_manifest();
         let named = previous.is_some_and(|m| m.summary["markdown"] == self.markdown.as_str());
-        let marked = woodpile_points::regular::read(path, 1 << 26)
-            .ok()
-            .and_then(|bytes| {
-                let head = &bytes[..bytes.len().min(4096)];
-                String::from_utf8_lossy(head)
-                    .lines()
-                    .take(5)
-                    .any(|line| line == generated_mark(stage))
-                    .then_some(())
-            })
-            .is_some();
+        let marked = ctx.existing_head(path, 4096).is_some_and(|head| {
+            String::from_utf8_lossy(&head)
+                .lines()
+                .take(5)
+                .any(|line| line == generated_mark(stage))
+        });
         if named || marked {
             Ok(())
         } else {
@@ -272,7 +265,7 @@ impl Report {
         }
         let text = markdown(stage, self, &evaluated);
         let path = self.markdown_path(results);
-        self.check_owned(stage, &path, results)?;
+        self.check_owned(ctx, &path)?;
         ctx.write_file(&path, text.as_bytes())?;
         let reproduced = evaluated
             .iter()
