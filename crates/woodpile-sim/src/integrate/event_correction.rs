@@ -10,8 +10,8 @@ use super::contact_event::{
     damped_path_integrals, first_crossing, first_switch, path_integrals, path_integrals_of,
     BondPath,
 };
+use super::contact_scan::{block_changes, block_of, changes_contact};
 use crate::contact::ContactLaw;
-use crate::damped_force::BondRecord;
 use crate::model::{Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
@@ -47,15 +47,6 @@ fn apply(model: &Model, corrections: &[Correction], (new_q, new_v): (&mut [f64],
             new_q[i] += moment * inv_mass[i];
         }
     }
-}
-
-/// Whether a bond's contact changed state during a step: its stage forces and end overlap do
-/// not all agree on "touching". Bonds that stay open (the whole quiet chain) or stay closed
-/// (smooth force) need no correction.
-#[inline(always)]
-pub(crate) fn changes_contact<const S: usize>(stage_forces: [f64; S], d_end: f64) -> bool {
-    let touching = stage_forces.iter().filter(|&&f| f > 0.0).count() + usize::from(d_end > 0.0);
-    touching > 0 && touching <= S
 }
 
 fn negligible<const S: usize>(stage_forces: [f64; S], end_force: f64) -> bool {
@@ -111,9 +102,9 @@ fn damped_force(model: &Model, bond: usize) -> impl Fn(f64, f64) -> (f64, f64) +
 #[derive(Debug, Clone)]
 pub(crate) struct ContactEvents<const S: usize> {
     /// The bond forces of each stage, written by [`Model::accelerations_recording`].
-    stage_force: [Vec<f64>; S],
+    pub(super) stage_force: [Vec<f64>; S],
     /// The bonds' dashpot power of each stage (empty for a conservative chain).
-    stage_power: [Vec<f64>; S],
+    pub(super) stage_power: [Vec<f64>; S],
     quadrature: Quadrature<S>,
     /// The corrections of the last step.
     pending: Vec<Correction>,
@@ -174,7 +165,7 @@ impl<const S: usize> ContactEvents<S> {
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
     /// contact opened or closed during the step of size `h` from `start` to `end` (states
     /// `[q, q']`, the end not yet corrected).
-    fn correct(
+    pub(super) fn correct(
         &mut self,
         model: &Model,
         (start, end): (&[f64], &mut [f64]),
@@ -437,194 +428,5 @@ fn bond_path(
             ..path
         },
         _ => path,
-    }
-}
-
-/// `slice` (of length `N`) as an array reference, so that loops over it need no bounds checks.
-#[inline(always)]
-fn block_of<const N: usize>(slice: &[f64]) -> &[f64; N] {
-    slice.try_into().expect("a block of the requested length")
-}
-
-/// Which bonds of a block changed contact during the step, as a bit mask (bit i: bond i). A
-/// bond's end overlap is `left - right`, its stage forces are `forces[s]`; "touching" is a
-/// positive value, and a change is some but not all of them touching. Lane-wise minima and
-/// maxima by compare-and-select (not `f64::min`, whose NaN handling blocks packed
-/// instructions; a NaN state is caught by the driver), then one packed compare per bound.
-#[inline(always)]
-fn block_changes<const S: usize, const N: usize>(
-    left: &[f64; N],
-    right: &[f64; N],
-    forces: [&[f64; N]; S],
-) -> u32 {
-    let mut low = [0.0; N];
-    for i in 0..N {
-        low[i] = left[i] - right[i];
-    }
-    let mut high = low;
-    for f in &forces {
-        for i in 0..N {
-            low[i] = if f[i] < low[i] { f[i] } else { low[i] };
-            high[i] = if f[i] > high[i] { f[i] } else { high[i] };
-        }
-    }
-    let mut mask = 0;
-    for i in 0..N {
-        mask |= u32::from((high[i] > 0.0) & (low[i] <= 0.0)) << i;
-    }
-    mask
-}
-
-/// What the hand-written fixed-step steppers ([`super::Rk4Fused`], [`super::Rkn4`]) keep
-/// beside their stage derivatives: the position of the next force evaluation, the new state
-/// being assembled, the evaluations spent, and, for the `-contact` variant, each stage's bond
-/// forces. One constructor serves a method and its `-contact` variant.
-#[derive(Debug, Clone)]
-pub(crate) struct FixedStepScratch<const S: usize> {
-    pub q_stage: Vec<f64>,
-    pub y_new: Vec<f64>,
-    pub evals: u64,
-    pub contact: Option<ContactEvents<S>>,
-    /// The plain method's name and its `-contact` variant's.
-    names: [&'static str; 2],
-}
-
-impl<const S: usize> FixedStepScratch<S> {
-    /// Scratch for states of `model`; contact events are kept when `quadrature` (the method's
-    /// quadrature of a bond force) is given.
-    pub fn new(model: &Model, names: [&'static str; 2], quadrature: Option<Quadrature<S>>) -> Self {
-        let n = model.n_dof();
-        Self {
-            q_stage: vec![0.0; n],
-            y_new: vec![0.0; model.state_len()],
-            evals: 0,
-            contact: quadrature.map(|q| ContactEvents::new(model, q)),
-            names,
-        }
-    }
-
-    /// The method's name: the `-contact` one when contact events are kept.
-    pub fn name(&self) -> &'static str {
-        self.names[usize::from(self.contact.is_some())]
-    }
-}
-
-/// The velocities a Nyström method passes to [`stage_accelerations`]: none, since its forces
-/// depend on positions only. [`super::Plan::choose`] never gives such a method a dissipative
-/// model, the one kind that would read them.
-pub(crate) const NYSTROM_VELOCITIES: &[f64] = &[];
-
-/// Stage `stage`'s accelerations `acc` at positions `q` (and velocities `v`, which only a
-/// dissipative model reads), recording every bond force into `contact` when a contact-event
-/// method keeps them. Returns the stage's dissipated power (0 for a conservative chain).
-/// Inlined into each method's stage loop, as it was before the dissipative branch existed.
-#[inline(always)]
-pub(crate) fn stage_accelerations<const S: usize>(
-    model: &Model,
-    contact: Option<&mut ContactEvents<S>>,
-    (q, v, acc): (&[f64], &[f64], &mut [f64]),
-    (t, stage): (f64, usize),
-    window: Window,
-) -> f64 {
-    if model.is_dissipative() {
-        let record = contact.map(|c| BondRecord {
-            force: &mut c.stage_force[stage],
-            power: &mut c.stage_power[stage],
-        });
-        return damped_accelerations(model, record, (q, v, acc), t, window);
-    }
-    match contact {
-        None => model.accelerations_in(t, q, acc, window),
-        Some(c) => model.accelerations_recording(t, q, acc, window, &mut c.stage_force[stage]),
-    }
-    0.0
-}
-
-/// [`stage_accelerations`] of a dissipative chain, recording into the stage's bond record.
-/// Kept out of line: the conservative methods' stage loops inline [`stage_accelerations`],
-/// and should not carry this path's code.
-#[inline(never)]
-#[cold]
-fn damped_accelerations(
-    model: &Model,
-    record: Option<BondRecord<'_>>,
-    (q, v, acc): (&[f64], &[f64], &mut [f64]),
-    t: f64,
-    window: Window,
-) -> f64 {
-    model.damped_recording(t, (q, v), acc, window, record)
-}
-
-/// Ends a step of a method that can correct contact events: corrects `y_new` (the new state,
-/// `[q, q']`) if `contact` events are kept, then copies it into `y` over `window`.
-pub(crate) fn finish_step<const S: usize>(
-    contact: Option<&mut ContactEvents<S>>,
-    model: &Model,
-    (y, y_new): (&mut [f64], &mut [f64]),
-    h: f64,
-    window: Window,
-) {
-    if let Some(contact) = contact {
-        contact.correct(model, (y, y_new), h, window);
-    }
-    copy_window(model, (y, y_new), window);
-}
-
-/// Copies the new state `y_new` into `y` over `window` (states `[q, q']`).
-pub(crate) fn copy_window(model: &Model, (y, y_new): (&mut [f64], &[f64]), window: Window) {
-    let n = model.n_dof();
-    let (new_q, new_v) = y_new.split_at(n);
-    let (q, v) = y.split_at_mut(n);
-    for r in window.dof_ranges(model) {
-        q[r.clone()].copy_from_slice(&new_q[r.clone()]);
-        v[r.clone()].copy_from_slice(&new_v[r]);
-    }
-    if model.is_dissipative() {
-        v[n] = new_v[n];
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn contact_changes_are_detected_only_at_sign_changes() {
-        assert!(!changes_contact([0.0; 4], 0.0));
-        assert!(!changes_contact([1.0, 2.0, 2.0, 1.0], 0.5));
-        assert!(changes_contact([0.0, 0.1, 0.1, 0.2], 0.3));
-        assert!(changes_contact([0.1, 0.1, 0.1, 0.2], -0.3));
-        assert!(changes_contact([0.0, 0.0, 0.1], 0.0));
-        assert!(!changes_contact([0.1, 0.2, 0.1], 0.1));
-    }
-
-    #[test]
-    fn the_block_test_agrees_with_the_scalar_one() {
-        // Every pattern of touching (positive), just-open (zero) and open (negative) values
-        // over three stage forces and the end overlap, four bonds to a block.
-        let values: [f64; 3] = [-0.5, 0.0, 0.7];
-        let mut bonds: Vec<([f64; 3], f64)> = Vec::new();
-        // All 81 patterns, the first three again to fill the last block.
-        for code in (0..84).map(|c| c % 81) {
-            let pick = |k: u32| values[(code / 3usize.pow(k)) % 3];
-            bonds.push((
-                [pick(0).max(0.0), pick(1).max(0.0), pick(2).max(0.0)],
-                pick(3),
-            ));
-        }
-        for block in bonds.chunks_exact(4) {
-            let right = [0.0f64; 4];
-            let left: [f64; 4] = std::array::from_fn(|i| block[i].1);
-            let stage: [[f64; 4]; 3] =
-                std::array::from_fn(|s| std::array::from_fn(|i| block[i].0[s]));
-            let mask = block_changes(&left, &right, [&stage[0], &stage[1], &stage[2]]);
-            for (i, (forces, d_end)) in block.iter().enumerate() {
-                assert_eq!(
-                    mask >> i & 1 == 1,
-                    changes_contact(*forces, *d_end),
-                    "{forces:?} {d_end}"
-                );
-            }
-        }
     }
 }

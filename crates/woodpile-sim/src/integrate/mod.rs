@@ -16,6 +16,7 @@
 
 mod active_sites;
 mod contact_event;
+mod contact_scan;
 mod dop853;
 mod event_correction;
 mod method;
@@ -23,6 +24,7 @@ mod rk;
 mod rk4_fused;
 mod rkn;
 mod rkn4;
+mod stage_step;
 mod symplectic;
 
 pub use active_sites::ActiveSites;

@@ -11,7 +11,8 @@
 //! contact opened or closed by the integral along the bond's path ([`super::contact_event`]).
 
 use super::contact_event::rk4_quadrature;
-use super::event_correction::{finish_step, stage_accelerations, FixedStepScratch, Quadrature};
+use super::event_correction::Quadrature;
+use super::stage_step::{finish_step, stage_accelerations, FixedStepScratch};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 

@@ -19,9 +19,8 @@
 //! *located*: the step is cut short at the first moment any contact of the window opens or
 //! closes, so that no step contains a kink, and the next step starts there.
 
-use super::event_correction::{
-    copy_window, finish_step, stage_accelerations, ContactEvents, Quadrature, NYSTROM_VELOCITIES,
-};
+use super::event_correction::{ContactEvents, Quadrature};
+use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
 

@@ -22,9 +22,8 @@
 //! where the tableau stepper takes 6.7 ms (1.18x; best of 15, `cargo run --release -p
 //! woodpile-bench --example nystrom4`).
 
-use super::event_correction::{
-    finish_step, stage_accelerations, FixedStepScratch, Quadrature, NYSTROM_VELOCITIES,
-};
+use super::event_correction::Quadrature;
+use super::stage_step::{finish_step, stage_accelerations, FixedStepScratch, NYSTROM_VELOCITIES};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
 
