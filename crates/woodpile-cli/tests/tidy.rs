@@ -1,5 +1,5 @@
 //! The tree as ARCHITECTURE.md describes it, checked so that it stays true: every source file
-//! is named in the code map, no module imports another in a circle, functions stay short,
+//! is named in the code map, no module imports another in a circle, files and functions stay short,
 //! and rustdoc finds every intra-doc link. A newcomer reads the map and the module docs first;
 //! these tests keep them from going stale.
 #![allow(clippy::unwrap_used)]
@@ -335,6 +335,28 @@ fn no_module_imports_another_in_a_circle() {
     assert!(
         cycles.is_empty(),
         "modules that import themselves through others: {cycles:?}"
+    );
+}
+
+/// Most lines a source file may hold, tests included: past this a file does more than one job
+/// (split it into a folder of modules, as `model/` and `optimize/` are).
+const MAX_FILE_LINES: usize = 500;
+
+#[test]
+fn no_source_file_runs_over_500_lines() {
+    let mut long = Vec::new();
+    for (krate, root) in source_roots() {
+        for file in rust_files(&root) {
+            let lines = std::fs::read_to_string(&file).unwrap().lines().count();
+            if lines > MAX_FILE_LINES {
+                let rel = file.strip_prefix(&root).unwrap().display().to_string();
+                long.push(format!("{krate}: {rel} ({lines} lines)"));
+            }
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "files over {MAX_FILE_LINES} lines: {long:#?}"
     );
 }
 

@@ -212,12 +212,9 @@ fn a_refusal_carries_its_reason_typed() {
     let scene = Scenario {
         model: model.unwrap(),
         impulse_site: 4,
-        impulse_velocity: 1.0,
         t_end: 12.0,
         region: Region::new(9, 11, 21).unwrap(),
-        method: MethodChoice::Auto,
-        accuracy: tolerance(1e-15),
-        sample_every: 1.0,
+        ..paper_scene(&[], MethodChoice::Auto, tolerance(1e-15))
     };
     match simulate(&scene, &mut ()) {
         Err(SimError::NotConverged { why, finest, .. }) => {

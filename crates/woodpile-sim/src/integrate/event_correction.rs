@@ -149,7 +149,7 @@ impl<const S: usize> ContactEvents<S> {
         self.events
     }
 
-    /// Whether the last [`finish_step`] corrected any bond (then the end state is not the one
+    /// Whether the last [`finish_step`](super::stage_step::finish_step) corrected any bond (then the end state is not the one
     /// the method's last stage saw).
     pub fn corrected_last_step(&self) -> bool {
         !self.pending.is_empty()

@@ -221,7 +221,7 @@ const FACTS: [Facts; 8] = [
 /// The method a scene asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MethodChoice {
-    /// Let [`Plan::choose`] pick.
+    /// Let [`Plan::choose`](super::Plan::choose) pick.
     Auto,
     /// Use this method.
     Named(Method),

@@ -18,7 +18,7 @@ mod active_sites;
 mod contact_event;
 mod contact_scan;
 mod dop853;
-mod drive;
+mod driver;
 mod event_correction;
 mod method;
 mod plan;
@@ -31,7 +31,7 @@ mod symplectic;
 
 pub use active_sites::ActiveSites;
 pub use dop853::Dop853;
-pub use drive::{drive, intervals, END_ARRIVAL_SPEED};
+pub use driver::{drive, intervals, END_ARRIVAL_SPEED};
 pub use method::{Method, MethodChoice};
 pub use plan::{
     Accuracy, Plan, AUTO_METHOD, BLOW_UP_DRIFT, DISSIPATIVE_AUTO_METHOD, DRIFT_PER_TOL,
@@ -104,7 +104,7 @@ pub trait Observer {
 
     /// Whether whoever asked for the run no longer wants it (Ctrl-C in a Python session, a
     /// sweep being stopped). Asked at every sample, so a run stops within one sample
-    /// interval with [`SimError::Cancelled`] instead of running to `t_end`.
+    /// interval with [`SimError::Cancelled`](crate::SimError::Cancelled) instead of running to `t_end`.
     fn cancelled(&self) -> bool {
         false
     }
@@ -151,7 +151,7 @@ pub enum StepControl {
     },
     /// The stepper's own error control; the driver only enforces `h_min`.
     Adaptive {
-        /// Steps below this are a [`SimError::StepUnderflow`].
+        /// Steps below this are a [`SimError::StepUnderflow`](crate::SimError::StepUnderflow).
         h_min: f64,
     },
 }

@@ -5,7 +5,7 @@
 //! `2 dt`, estimates the finer run's error by Richardson's rule for the method's observed order q
 //! (3 for `rkn6-contact`, auto's method), |F(dt) - F(2 dt)| / (2^q - 1), and
 //! accepts when that estimate is at most half the tolerance (less with a nonlinear resonator:
-//! [`ladder::Strictness`]); otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
+//! [`accepted_estimate`]); otherwise it halves `dt` and compares again. Stiff scenes (small eps, large p) thus get the steps they need
 //! without a stiffness model having to foresee them.
 
 pub mod budget;

@@ -54,7 +54,6 @@ use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
-use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{Context, Kind, PointsAt};
 use woodpile_pipeline::Output;
 use woodpile_points::layout::best_path;
@@ -63,6 +62,7 @@ use woodpile_points::{PointResult, PointStore};
 use crate::schema::Fraction;
 
 mod evaluate;
+mod keys;
 mod search;
 mod space;
 mod trials;
@@ -71,7 +71,7 @@ pub use space::{Layout, Range, Resonator, Sites, Space, Values};
 
 pub use search::Search;
 
-use space::{parse_space, round_sig, GENES};
+use space::{round_sig, GENES};
 
 /// Differential evolution's population: a design's budget is at least one generation.
 const POPULATION: usize = DifferentialEvolution::POPULATION;
@@ -118,84 +118,6 @@ struct Evaluated {
 type Start = (Search, Vec<f64>, f64);
 
 impl Design {
-    pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Design> {
-        let positive_int = |fields: &mut Fields<'_>, key: &str, default: Option<i64>| {
-            let value = match (fields.optional::<i64>(key)?, default) {
-                (Some(v), _) => v,
-                (None, Some(d)) => d,
-                (None, None) => return Err(fields.error(key, "is required")),
-            };
-            if !(0..=1_000_000).contains(&value) {
-                return Err(fields.error(key, "expected an integer from 0 to 1000000"));
-            }
-            Ok(value as usize)
-        };
-        let seed = fields.required::<i64>("seed")? as u64;
-        let budget = positive_int(fields, "budget", None)?;
-        if budget < POPULATION {
-            return Err(fields.error("budget", format!("at least {POPULATION} evaluations")));
-        }
-        let refine = positive_int(fields, "refine", Some(0))?;
-        let objectives = Fraction::ALL.map(|f| (f.column(), f));
-        let objective = fields.choice("objective", &objectives, None)?;
-        let maximise = fields.choice("goal", &[("max", true), ("min", false)], Some(true))?;
-        let verify_tolerance = fields.optional::<f64>("verify_tolerance")?.unwrap_or(1e-8);
-        let robustness = match fields.optional::<toml::Table>("robustness")? {
-            None => None,
-            Some(table) => {
-                let mut f = fields.nested("robustness", table);
-                let samples = positive_int(&mut f, "samples", None)?;
-                let spreads: Vec<f64> = f.required("spreads")?;
-                if spreads.iter().any(|s| !(0.0..1.0).contains(s)) {
-                    return Err(f.error("spreads", "expected fractions in [0, 1)"));
-                }
-                f.finish()?;
-                Some((samples, spreads))
-            }
-        };
-        let Some(space) = fields.optional::<toml::Table>("space")? else {
-            return Err(fields.error("space", "is required"));
-        };
-        let space = parse_space(fields.nested("space", space))?;
-        let each_resonator = parse_each_resonator(fields)?;
-        let template: toml::Table = fields.required("scene")?;
-        if template.contains_key("defect") {
-            return Err(fields.error(
-                "scene.defect",
-                "the design places the defects: leave them out",
-            ));
-        }
-        let region = template
-            .get("fractions")
-            .and_then(|f| f.get("region"))
-            .is_some();
-        if !region {
-            return Err(fields.error(
-                "scene.fractions.region",
-                "is required: the trap's region must not move with the design",
-            ));
-        }
-        let design = Design {
-            seed,
-            budget,
-            refine,
-            objective,
-            maximise,
-            verify_tolerance,
-            robustness,
-            space,
-            template,
-            each_resonator,
-            file: fields.file().to_path_buf(),
-        };
-        // The extremes of the space must make valid scenes: catch a bad template now.
-        let dimension = design.space.dimension();
-        for corner in [0.0, 1.0 - 1e-12] {
-            design.scene(&design.space.decode(&vec![corner; dimension]), None)?;
-        }
-        Ok(design)
-    }
-
     /// The stage: the searches, their refinement, the robustness study around the best design,
     /// then the best design inside the space verified and written as a scene file.
     pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {
@@ -493,21 +415,5 @@ impl Kind for Design {
 
     fn files(&self, stage: &str, results: &Path, _: &Path) -> Vec<PathBuf> {
         vec![best_path(results, stage)]
-    }
-}
-
-/// `each_resonator`: defect keys laid on every resonator the design places, but none of the
-/// keys the design sets itself.
-fn parse_each_resonator(fields: &mut Fields<'_>) -> Result<toml::Table> {
-    let each: toml::Table = fields.optional("each_resonator")?.unwrap_or_default();
-    match ["site", "eps", "kappa", "p"]
-        .into_iter()
-        .find(|k| each.contains_key(*k))
-    {
-        Some(placed) => Err(fields.error(
-            &format!("each_resonator.{placed}"),
-            "the design sets each resonator's site, eps, kappa and p",
-        )),
-        None => Ok(each),
     }
 }
