@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use woodpile_points::rows::{columns, Cell, Column, Row};
 use woodpile_scene::Scene;
-use woodpile_sim::run::{simulate, Outcome};
+use woodpile_sim::simulation::{simulate, Outcome};
 
 use crate::interrupt::{internal_message, Watch};
 

@@ -11,7 +11,7 @@ use woodpile_scene::report::{cost_note, simulate_report, unverified_report};
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
-use woodpile_sim::run::{simulate as run, Outcome, Scenario};
+use woodpile_sim::simulation::{simulate as run, Outcome, Scenario};
 use woodpile_sim::SimError;
 
 use crate::interrupt::{on_this_thread, Clock, Watch};

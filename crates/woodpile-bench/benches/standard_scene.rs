@@ -4,7 +4,7 @@
 
 use woodpile_bench::{fixed, run};
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::run::run_with_plan;
+use woodpile_sim::simulation::run_with_plan;
 use woodpile_sim::testing::fixed_dt;
 
 fn main() {

@@ -15,8 +15,8 @@ use std::time::Instant;
 use woodpile_bench::on_two_cores;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::MethodChoice;
-use woodpile_sim::run::simulate;
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::simulate;
+use woodpile_sim::simulation::Scenario;
 use woodpile_sim::testing::{
     paper_scene, reference_dt, reference_fractions, tolerance, PaperDefect,
 };

@@ -33,7 +33,7 @@ use woodpile_bench::on_two_cores;
 use woodpile_sim::energy::Fractions;
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::Coupling;
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{
     audit_scene, chain_audit_scene, damped_audit_scene, fixed_dt, tolerance, Lcg,
     AUDIT_REFERENCE_DT as REFERENCE_DT,

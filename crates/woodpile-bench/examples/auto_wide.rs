@@ -15,7 +15,7 @@
 
 use woodpile_bench::on_two_cores;
 use woodpile_sim::integrate::{Method, MethodChoice};
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{
     fixed_dt, random_scene, reference_dt, reference_fractions, tolerance, Lcg, SceneRanges,
 };

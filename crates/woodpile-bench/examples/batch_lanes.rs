@@ -26,7 +26,7 @@ use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::force::hertz_force;
 use woodpile_sim::integrate::{ContactMode, Rkn, RknTableau, DPRKN6};
 use woodpile_sim::model::{Boundary, Coupling};
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::Scenario;
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;
 

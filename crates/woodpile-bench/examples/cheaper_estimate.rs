@@ -21,7 +21,7 @@ use woodpile_bench::on_two_cores;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::Fractions;
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::run::{accepted_estimate, auto_first_step, simulate, Scenario};
+use woodpile_sim::simulation::{accepted_estimate, auto_first_step, simulate, Scenario};
 use woodpile_sim::testing::{audit_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT};
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;

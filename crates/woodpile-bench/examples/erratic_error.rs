@@ -13,7 +13,7 @@
 use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{Method, MethodChoice, Observer};
 use woodpile_sim::model::Model;
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
 
 /// Every sampled state.

@@ -22,7 +22,7 @@ use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{
     ContactMode, Method, MethodChoice, Rk4Fused, Rkn, RknTableau, Stepper, DPRKN6, NYSTROM4,
 };
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{fitted_order, fixed_dt, tolerance};
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;

@@ -11,8 +11,8 @@
 use woodpile_bench::on_two_cores;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::{Method, MethodChoice};
-use woodpile_sim::run::simulate;
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::simulate;
+use woodpile_sim::simulation::Scenario;
 use woodpile_sim::testing::fixed_dt;
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;

@@ -9,7 +9,7 @@ pub mod sweeps;
 use woodpile_sim::integrate::{
     drive, Accuracy, DriveConfig, Method, MethodChoice, Stats, StepControl, Stepper,
 };
-use woodpile_sim::run::{simulate, Outcome, Scenario};
+use woodpile_sim::simulation::{simulate, Outcome, Scenario};
 use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
 use woodpile_sim::SimError;
 

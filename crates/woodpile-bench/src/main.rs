@@ -26,7 +26,7 @@ use std::time::Instant;
 use serde_json::Value;
 use woodpile_bench::{fixed, paper, run, standard_scene, sweeps};
 use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::run::{run_with_plan, Scenario};
+use woodpile_sim::simulation::{run_with_plan, Scenario};
 use woodpile_sim::testing::{fixed_dt, tolerance};
 
 struct Row {

@@ -13,7 +13,7 @@ use woodpile_stages::KINDS;
 use serde_json::Value;
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::Fractions;
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance};
 use woodpile_stages::sampling::sampled_scenes;
 

@@ -19,7 +19,7 @@ use woodpile_pipeline::grid::{point, point_count};
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::model::{Boundary, Coupling};
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::Scenario;
 use woodpile_stages::sampling::SURVEY_SWEEPS;
 use woodpile_stages::sweep::Sweep;
 use woodpile_stages::KINDS;
@@ -160,7 +160,7 @@ fn time_scenes(scenes: &[Scenario]) -> f64 {
     use rayon::prelude::*;
     let t0 = Instant::now();
     scenes.par_iter().for_each(|s| {
-        let _ = woodpile_sim::run::simulate(s, &mut ());
+        let _ = woodpile_sim::simulation::simulate(s, &mut ());
     });
     t0.elapsed().as_secs_f64()
 }

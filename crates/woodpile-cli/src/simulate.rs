@@ -14,7 +14,7 @@ use woodpile_scene::report::{cost_note, simulate_report, unverified_report, wall
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
-use woodpile_sim::run::simulate;
+use woodpile_sim::simulation::simulate;
 use woodpile_sim::SimError;
 
 use crate::Failure;

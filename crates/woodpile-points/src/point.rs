@@ -6,7 +6,7 @@ use woodpile_scene::Scene;
 use woodpile_sim::integrate::Observer;
 use woodpile_sim::integrate::StepControl;
 use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::run::{simulate, Outcome, Scenario};
+use woodpile_sim::simulation::{simulate, Outcome, Scenario};
 use woodpile_sim::{Model, SimError};
 
 use crate::canonical::{code_version, scene_json, Key};

@@ -4,7 +4,7 @@
 
 use serde_json::{json, Value};
 use woodpile_sim::integrate::MethodChoice;
-use woodpile_sim::run::{budget, Outcome};
+use woodpile_sim::simulation::{budget, Outcome};
 
 use crate::Scene;
 

@@ -13,7 +13,7 @@ use woodpile_scene::Scene;
 use woodpile_sim::energy::{total_energy, total_momentum};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::observe::SiteField;
-use woodpile_sim::run::simulate;
+use woodpile_sim::simulation::simulate;
 
 fn scene(toml: &str) -> Scene {
     woodpile_scene::parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
@@ -151,7 +151,7 @@ defect = [{ site = 0, eps = 1.0 }]
     let model = &scene.scenario.model;
     let mut y = model.rest_state();
     let plan = Plan::choose(model, MethodChoice::Named(Method::Rkn6Contact), fixed(0.01)).unwrap();
-    plan.run(model, &mut y, 20.0, 1.0, &mut ()).unwrap();
+    plan.integrate(model, &mut y, 20.0, 1.0, &mut ()).unwrap();
     assert!(y.iter().all(|&x| x == 0.0), "the rest state moved");
 }
 
@@ -245,12 +245,13 @@ fn a_precompressed_dimer_vibrates_at_its_band_edges() {
             fixed(period / steps),
         )
         .unwrap();
-        plan.run(model, &mut y, period, period, &mut ()).unwrap();
+        plan.integrate(model, &mut y, period, period, &mut ())
+            .unwrap();
         let worst = (0..n).map(|i| (y[i] - start[i]).abs()).fold(0.0, f64::max);
         assert!(worst < 1e-3 * amplitude, "mode {moving}: off by {worst:e}");
         // Half a period later each site is at the opposite extreme.
         let mut y = start.clone();
-        plan.run(model, &mut y, 0.5 * period, 0.5 * period, &mut ())
+        plan.integrate(model, &mut y, 0.5 * period, 0.5 * period, &mut ())
             .unwrap();
         let worst = (0..n).map(|i| (y[i] + start[i]).abs()).fold(0.0, f64::max);
         assert!(

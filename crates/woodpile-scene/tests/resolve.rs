@@ -175,7 +175,7 @@ fn long_runs_are_forecast_before_they_start() {
     )
     .unwrap();
     assert_eq!(woodpile_scene::report::cost_note(&named), None);
-    let f = woodpile_sim::run::budget::forecast(&long.scenario).unwrap();
+    let f = woodpile_sim::simulation::budget::forecast(&long.scenario).unwrap();
     // The first rung is a coarse run (half the fine one's steps) and a fine one; the ladder
     // adds fine runs of 2, 4, ..., 64 times its steps: (0.5 + 127) / 1.5 = 85 first rungs.
     assert!((f.whole_ladder_s / f.first_rung_s - 85.0).abs() < 1e-9);

@@ -14,7 +14,7 @@
 use std::time::Instant;
 
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
-use woodpile_sim::run::{simulate, Outcome};
+use woodpile_sim::simulation::{simulate, Outcome};
 use woodpile_sim::testing::{paper_scene, PaperDefect};
 
 fn run(eps: f64, method: MethodChoice, accuracy: Accuracy) -> (Outcome, f64) {

@@ -221,7 +221,7 @@ pub enum OverBudget {
     Samples {
         /// How many.
         samples: f64,
-        /// The most a run may keep (`run::budget::MAX_SAMPLES`).
+        /// The most a run may keep (`simulation::budget::MAX_SAMPLES`).
         limit: u64,
     },
     /// Too many steps.

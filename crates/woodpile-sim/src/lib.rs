@@ -14,8 +14,8 @@
 //! - [`integrate`]: the steppers (RK4, Störmer–Verlet, symplectic compositions, DOP853) and the
 //!   single driver that owns the time loop, sampling and failure detection.
 //! - [`observe`]: sampled time series of the fractions and the space-time velocity field.
-//! - [`run`]: "simulate a scene, return its fractions" as one function.
-//! - [`run::budget`]: what a run will cost, so an endless one is refused before it starts.
+//! - [`simulation`]: "simulate a scene, return its fractions" as one function.
+//! - [`simulation::budget`]: what a run will cost, so an endless one is refused before it starts.
 //! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
 #![warn(missing_docs)]
 
@@ -29,8 +29,8 @@ pub mod integrate;
 pub mod model;
 pub mod observe;
 pub mod rods;
-pub mod run;
 pub mod simd;
+pub mod simulation;
 #[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod units;

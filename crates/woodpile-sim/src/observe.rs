@@ -12,7 +12,7 @@
 use crate::energy::{energy_density, kinetic_density, Fractions, Region};
 use crate::integrate::{intervals, Observer};
 use crate::model::Model;
-use crate::run::Scenario;
+use crate::simulation::Scenario;
 
 /// Which energy a [`FractionSeries`] splits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -300,10 +300,10 @@ impl Observer for SiteField {
 mod tests {
     use super::*;
     use crate::integrate::{Accuracy, Method, MethodChoice};
-    use crate::run::simulate;
+    use crate::simulation::simulate;
     use crate::testing::{paper_scene, PaperDefect};
 
-    fn scene() -> crate::run::Scenario {
+    fn scene() -> crate::simulation::Scenario {
         let accuracy = Accuracy {
             tolerance: 1e-6,
             tolerance_explicit: true,

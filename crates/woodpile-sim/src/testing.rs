@@ -12,7 +12,7 @@ use crate::energy::{Fractions, Region};
 use crate::error::SimError;
 use crate::integrate::{Accuracy, Method, MethodChoice};
 use crate::model::{Boundary, Coupling, Model, Resonator};
-use crate::run::{simulate, Scenario};
+use crate::simulation::{simulate, Scenario};
 
 /// Half-width N of the paper's chains (sites -N..N).
 pub const PAPER_N: usize = 100;

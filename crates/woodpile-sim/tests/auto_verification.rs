@@ -6,7 +6,7 @@
 use woodpile_sim::energy::Region;
 use woodpile_sim::integrate::{Method, MethodChoice, Plan, AUTO_METHOD};
 use woodpile_sim::model::{Boundary, Coupling, Model, Resonator};
-use woodpile_sim::run::{auto_first_step, simulate, Scenario};
+use woodpile_sim::simulation::{auto_first_step, simulate, Scenario};
 use woodpile_sim::testing::{
     audit_scene_at, chain_audit_scene, fixed_dt, paper_scene, reference_fractions, tolerance, Lcg,
     PaperDefect, AUDIT_REFERENCE_DT,

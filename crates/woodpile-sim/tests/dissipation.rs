@@ -7,7 +7,7 @@ use woodpile_sim::energy::{total_momentum, Region};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::model::{Boundary, End, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
+use woodpile_sim::simulation::{run_with_plan, simulate, Outcome, Scenario};
 use woodpile_sim::testing::{fitted_order, fixed_dt, tolerance};
 use woodpile_sim::{Damping, DashpotLaw, SimError};
 

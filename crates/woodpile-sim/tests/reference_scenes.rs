@@ -5,7 +5,7 @@
 
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::Coupling;
-use woodpile_sim::run::simulate;
+use woodpile_sim::simulation::simulate;
 use woodpile_sim::testing::{paper_scene, tolerance, PaperDefect};
 
 struct Reference {

@@ -2,7 +2,7 @@
 //! and of the tests that `auto` meets its tolerance on scenes no calibration chose. The grids
 //! are read from the stage files, so a survey follows the sweeps as they are defined.
 
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::Scenario;
 use woodpile_sim::testing::Lcg;
 
 use woodpile_pipeline::error::{PipelineError, Result};

@@ -28,7 +28,7 @@ use serde_json::json;
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::observe::SpaceTimeField;
-use woodpile_sim::run::simulate;
+use woodpile_sim::simulation::simulate;
 
 use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};

@@ -32,7 +32,7 @@ use rayon::prelude::*;
 use serde_json::json;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
-use woodpile_sim::run::{auto_first_step, run_with_plan, simulate, Scenario};
+use woodpile_sim::simulation::{auto_first_step, run_with_plan, simulate, Scenario};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::{pick, Fields};

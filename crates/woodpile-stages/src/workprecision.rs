@@ -32,7 +32,7 @@ use std::time::Instant;
 use serde_json::json;
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
-use woodpile_sim::run::{run_with_plan, simulate, Outcome, Scenario};
+use woodpile_sim::simulation::{run_with_plan, simulate, Outcome, Scenario};
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;

@@ -194,7 +194,7 @@ fn mutated_scene_files_load_or_are_refused_naming_file_and_key() {
                 loaded += 1;
                 // A scene that loads is within the simulator's budgets.
                 assert!(
-                    woodpile_sim::run::budget::check(&scene.scenario).is_ok(),
+                    woodpile_sim::simulation::budget::check(&scene.scenario).is_ok(),
                     "case {case}: loaded a scene beyond budget:\n{mutant}"
                 );
             }

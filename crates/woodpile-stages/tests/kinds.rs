@@ -251,7 +251,7 @@ fn a_design_stage_finds_verifies_and_writes_its_best_design() {
     let best = p.results().join("trap.best.toml");
     let scene = woodpile_scene::load(&best).unwrap();
     assert_eq!(scene.region_paper, [-1, 4]);
-    let again = woodpile_sim::run::simulate(&scene.scenario, &mut ()).unwrap();
+    let again = woodpile_sim::simulation::simulate(&scene.scenario, &mut ()).unwrap();
     assert_eq!(Some(again.fractions.trapped), e_tr[verified]);
 
     let points = count_files(&points_dir(&p.results()));

@@ -75,7 +75,7 @@ fn a_design_at_fixed_sites_writes_the_best_design_any_search_found() {
     assert!(summary["baseline_beat_optimiser"].is_boolean());
     // The best file is that design and runs as it is.
     let best = woodpile_scene::load(&p.results().join("trap.best.toml")).unwrap();
-    let out = woodpile_sim::run::simulate(&best.scenario, &mut ()).unwrap();
+    let out = woodpile_sim::simulation::simulate(&best.scenario, &mut ()).unwrap();
     assert_eq!(out.fractions.trapped, e_tr[verified].unwrap());
 }
 
@@ -198,6 +198,6 @@ starts = 2
     assert!(summary["starts_agree"].is_boolean() && summary["sharp"].is_boolean());
     assert_eq!(summary["box"][0]["hi"], 3.0);
     let best = woodpile_scene::load(&p.results().join("best.best.toml")).unwrap();
-    let out = woodpile_sim::run::simulate(&best.scenario, &mut ()).unwrap();
+    let out = woodpile_sim::simulation::simulate(&best.scenario, &mut ()).unwrap();
     assert_eq!(out.fractions.trapped, summary["refined"].as_f64().unwrap());
 }

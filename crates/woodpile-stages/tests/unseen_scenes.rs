@@ -11,7 +11,7 @@ use woodpile_stages::KINDS;
 
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::integrate::MethodChoice;
-use woodpile_sim::run::{simulate, Scenario};
+use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{reference_dt, reference_fractions, tolerance};
 use woodpile_stages::sampling::sampled_sweep_scenes;
 

@@ -19,7 +19,7 @@ mod run;
 
 use woodpile_sim::energy::Region;
 use woodpile_sim::model::Model;
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::Scenario;
 use woodpile_sim::units::Scales;
 
 use crate::raw;

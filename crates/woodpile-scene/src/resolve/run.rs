@@ -3,7 +3,7 @@
 
 use woodpile_sim::integrate::MAX_STEPS;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
-use woodpile_sim::run::Scenario;
+use woodpile_sim::simulation::Scenario;
 use woodpile_sim::SimError;
 use woodpile_sim::{OverBudget, StepSetBy};
 
@@ -142,7 +142,7 @@ pub(crate) fn region(
 /// Refuses a scene whose run could never finish within the simulator's budgets, naming the key
 /// that makes it so (`t_end` when even the largest step of any method would be too many).
 pub(crate) fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Result<(), Invalid> {
-    let error = match woodpile_sim::run::budget::check(scenario) {
+    let error = match woodpile_sim::simulation::budget::check(scenario) {
         Ok(()) => return Ok(()),
         Err(SimError::OverBudget(over)) => over,
         Err(e @ SimError::VelocityForces { .. }) => {

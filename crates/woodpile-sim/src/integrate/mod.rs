@@ -158,7 +158,7 @@ pub enum StepControl {
 
 /// Most steps (accepted plus rejected) one run may take: about a minute of one core on the
 /// paper's chain. [`drive`] enforces it (as `DriveConfig::max_steps`, which plans set to it);
-/// `run::budget::check` refuses a run that would exceed it before it starts.
+/// `simulation::budget::check` refuses a run that would exceed it before it starts.
 pub const MAX_STEPS: u64 = 50_000_000;
 
 /// Everything the driver needs besides the model, stepper and state.

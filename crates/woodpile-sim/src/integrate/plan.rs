@@ -68,7 +68,7 @@ const MAX_OMEGA_DT: f64 = 0.5;
 
 impl Plan {
     /// Resolves `choice` and `accuracy` for `model`. For [`MethodChoice::Auto`] this is the
-    /// first (finest) plan of the verification ladder run by [`crate::run::simulate`].
+    /// first (finest) plan of the verification ladder run by [`crate::simulation::simulate`].
     pub fn choose(
         model: &Model,
         choice: MethodChoice,
@@ -195,7 +195,7 @@ impl Plan {
 
     /// Runs the plan: builds the stepper for `model` and drives `y` to `t_end`, working only on
     /// the sites the wave has reached.
-    pub fn run<O: Observer + ?Sized>(
+    pub fn integrate<O: Observer + ?Sized>(
         &self,
         model: &Model,
         y: &mut [f64],
@@ -203,12 +203,12 @@ impl Plan {
         sample_every: f64,
         observer: &mut O,
     ) -> Result<Stats, SimError> {
-        self.run_model(model, y, (t_end, sample_every), observer, true)
+        self.integrate_model(model, y, (t_end, sample_every), observer, true)
     }
 
-    /// [`Plan::run`], choosing whether to skip the sites at rest (`active_window`) or to work
+    /// [`Plan::integrate`], choosing whether to skip the sites at rest (`active_window`) or to work
     /// on the full chain. Both give the same bits; the full model is for tests and benchmarks.
-    pub fn run_model<O: Observer + ?Sized>(
+    pub fn integrate_model<O: Observer + ?Sized>(
         &self,
         model: &Model,
         y: &mut [f64],

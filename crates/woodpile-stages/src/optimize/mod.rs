@@ -27,7 +27,7 @@
 use std::path::{Path, PathBuf};
 
 use serde_json::json;
-use woodpile_sim::run::Outcome;
+use woodpile_sim::simulation::Outcome;
 
 use crate::reduce::Reduce;
 use crate::sweep::Sweep;

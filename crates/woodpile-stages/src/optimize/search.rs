@@ -3,7 +3,7 @@
 
 use std::cell::RefCell;
 
-use woodpile_sim::run::{simulate, Outcome};
+use woodpile_sim::simulation::{simulate, Outcome};
 
 use super::Optimize;
 use crate::sweep::Sweep;

@@ -156,7 +156,7 @@ pub fn run_with_plan<O: Observer + ?Sized>(
     let mut y = model.rest_state();
     model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)?;
     let e_initial = crate::energy::total_energy(model, 0.0, &y);
-    let stats = plan.run_model(
+    let stats = plan.integrate_model(
         model,
         &mut y,
         (scenario.t_end, scenario.sample_every),
