@@ -286,13 +286,18 @@ fn paper_sweeps(numba_script: Option<&str>, max_points: Option<usize>, whole_pap
         "\nthe paper's sweeps, {how}; numba RK4 dt = 0.01 on the full chain in {cores} \
          processes; both on {cores} cores, in this run\n"
     );
-    println!("| sweep | points | woodpile s | numba s | numba / woodpile |");
-    println!("|---|---|---|---|---|");
+    println!("| sweep | points | woodpile s | numba s | numba / woodpile | numba's largest difference from woodpile |");
+    println!("|---|---|---|---|---|---|");
     let (mut ours, mut theirs) = (0.0, Some(0.0));
     for t in &timings {
         let numba = t.numba_s.as_ref().ok().copied();
+        let differs = match (t.numba_worst, t.numba_failed) {
+            (None, _) => "–".to_string(),
+            (Some(d), 0) => format!("{d:.1e}"),
+            (Some(d), failed) => format!("{d:.1e} ({failed} not finite)"),
+        };
         println!(
-            "| {} | {} | {:.1} | {} | {} |",
+            "| {} | {} | {:.1} | {} | {} | {differs} |",
             t.label,
             t.points,
             t.woodpile_s,
@@ -308,7 +313,7 @@ fn paper_sweeps(numba_script: Option<&str>, max_points: Option<usize>, whole_pap
     let ratio = |n: Option<f64>, w: f64| n.map_or("–".into(), |n| format!("{:.2}x", n / w));
     let shown = theirs.map_or("–".into(), |n| format!("{n:.1}"));
     println!(
-        "| all five | {} | {ours:.1} | {shown} | {} |",
+        "| all five | {} | {ours:.1} | {shown} | {} | |",
         timings.iter().map(|t| t.points).sum::<usize>(),
         ratio(theirs, ours)
     );

@@ -36,7 +36,15 @@ pub struct SweepTiming {
     /// The numba script's wall time over the same scenes on every core, s; or why it did
     /// not run.
     pub numba_s: Result<f64, String>,
+    /// The largest difference of R, T or E_tr between the script's answer and woodpile's
+    /// (whose own error is within the sweep's tolerance), over the points both answered.
+    pub numba_worst: Option<f64>,
+    /// Points the script answered with a non-finite number.
+    pub numba_failed: usize,
 }
+
+/// A point's final fractions (R, T, E_tr), or `None` where the run failed.
+type Shares = Option<[f64; 3]>;
 
 /// The paper's sweeps ([`SURVEY_SWEEPS`]: F4, F5, F6, F7 coarse, F7 fine) under
 /// `pipeline_dir`, each timed on both sides; `max_points` (when given) keeps every k-th point
@@ -52,18 +60,25 @@ pub fn time_sweeps(
     let mut timings = Vec::new();
     for (stage, label) in SURVEY_SWEEPS {
         let scenes = grid_scenes(&pipeline, stage, max_points)?;
-        let woodpile_s = match max_points {
+        let (woodpile_s, ours) = match max_points {
             None => time_stage(&pipeline, stage, scratch)?,
             Some(_) => time_scenes(&scenes),
         };
-        let numba_s = numba_script
+        let numba = numba_script
             .ok_or_else(|| "no --numba-scenes script".to_string())
             .and_then(|script| time_numba(script, &scenes, workers));
+        let theirs = numba
+            .as_ref()
+            .map(|(_, shares)| shares.as_slice())
+            .unwrap_or(&[]);
+        let (numba_worst, numba_failed) = disagreement(&ours, theirs);
         timings.push(SweepTiming {
             label: label.to_string(),
             points: scenes.len(),
             woodpile_s,
-            numba_s,
+            numba_s: numba.map(|(seconds, _)| seconds),
+            numba_worst,
+            numba_failed,
         });
     }
     Ok(timings)
@@ -72,7 +87,7 @@ pub fn time_sweeps(
 /// The whole pipeline under `pipeline_dir` from nothing (every stage, figures included), s.
 pub fn time_whole_paper(pipeline_dir: &Path, scratch: &Scratch) -> Result<f64, String> {
     let pipeline = Pipeline::load(pipeline_dir, KINDS).map_err(|e| e.to_string())?;
-    timed_run(&pipeline, Vec::new(), scratch)
+    timed_run(&pipeline, Vec::new(), &scratch.fresh())
 }
 
 /// Every point's scenario of sweep stage `stage`, in grid order (every k-th with
@@ -98,14 +113,62 @@ fn grid_scenes(
         .collect()
 }
 
-/// Runs stage `stage` alone into a fresh results tree, as `woodpile run` would: s.
-fn time_stage(pipeline: &Pipeline, stage: &str, scratch: &Scratch) -> Result<f64, String> {
-    timed_run(pipeline, vec![stage.to_string()], scratch)
+/// Runs stage `stage` alone into a fresh results tree, as `woodpile run` would: s, and each
+/// point's final fractions from its table.
+fn time_stage(
+    pipeline: &Pipeline,
+    stage: &str,
+    scratch: &Scratch,
+) -> Result<(f64, Vec<Shares>), String> {
+    let tree = scratch.fresh();
+    let seconds = timed_run(pipeline, vec![stage.to_string()], &tree)?;
+    let table = tree.join("results").join(format!("{stage}.parquet"));
+    Ok((seconds, final_shares(&table)?))
 }
 
-/// Runs `targets` (all stages when empty) into a fresh tree of `scratch`: s.
-fn timed_run(pipeline: &Pipeline, targets: Vec<String>, scratch: &Scratch) -> Result<f64, String> {
-    let tree = scratch.fresh();
+/// Each point's fractions at its last sample, from a sweep table, by point.
+fn final_shares(table: &Path) -> Result<Vec<Shares>, String> {
+    use woodpile_points::rows::sweep;
+    let frame = woodpile_pipeline::table::read(table).map_err(|e| e.to_string())?;
+    let column =
+        |name| woodpile_pipeline::table::f64_column(&frame, name).map_err(|e| e.to_string());
+    let (point, t) = (column(sweep::POINT)?, column(sweep::TIME)?);
+    let shares = [sweep::REFLECTED, sweep::TRANSMITTED, sweep::TRAPPED].map(column);
+    let [r, tr, e] = shares;
+    let (r, tr, e) = (r?, tr?, e?);
+    let points = point.iter().flatten().fold(0.0f64, |m, &p| m.max(p + 1.0)) as usize;
+    let mut last: Vec<(f64, Shares)> = vec![(f64::NEG_INFINITY, None); points];
+    for k in 0..point.len() {
+        let (Some(p), Some(time)) = (point[k], t[k]) else {
+            continue;
+        };
+        let slot = &mut last[p as usize];
+        if time > slot.0 {
+            *slot = (time, r[k].zip(tr[k]).zip(e[k]).map(|((a, b), c)| [a, b, c]));
+        }
+    }
+    Ok(last.into_iter().map(|(_, shares)| shares).collect())
+}
+
+/// The largest difference of any fraction between `ours` and `theirs` over the points both
+/// answered with finite numbers, and how many of `theirs` are not finite.
+fn disagreement(ours: &[Shares], theirs: &[[f64; 3]]) -> (Option<f64>, usize) {
+    let failed = theirs
+        .iter()
+        .filter(|s| !s.iter().all(|x| x.is_finite()))
+        .count();
+    let worst = ours
+        .iter()
+        .zip(theirs)
+        .filter_map(|(o, t)| o.map(|o| (o, t)))
+        .filter(|(_, t)| t.iter().all(|x| x.is_finite()))
+        .map(|(o, t)| (0..3).map(|k| (o[k] - t[k]).abs()).fold(0.0, f64::max))
+        .reduce(f64::max);
+    (worst, failed)
+}
+
+/// Runs `targets` (all stages when empty) into the tree `tree`: s.
+fn timed_run(pipeline: &Pipeline, targets: Vec<String>, tree: &Path) -> Result<f64, String> {
     let options = RunOptions {
         targets,
         force: true,
@@ -155,14 +218,19 @@ impl Drop for Scratch {
 }
 
 /// woodpile's `simulate` over `scenes` on every core (the subsampled look, which runs no
-/// stage): s.
-fn time_scenes(scenes: &[Scenario]) -> f64 {
+/// stage): s, and each scene's fractions.
+fn time_scenes(scenes: &[Scenario]) -> (f64, Vec<Shares>) {
     use rayon::prelude::*;
     let t0 = Instant::now();
-    scenes.par_iter().for_each(|s| {
-        let _ = woodpile_sim::simulation::simulate(s, &mut ());
-    });
-    t0.elapsed().as_secs_f64()
+    let shares = scenes
+        .par_iter()
+        .map(|s| {
+            let out = woodpile_sim::simulation::simulate(s, &mut ()).ok()?;
+            let f = out.fractions;
+            Some([f.reflected, f.transmitted, f.trapped])
+        })
+        .collect();
+    (t0.elapsed().as_secs_f64(), shares)
 }
 
 /// The scene as the numba script reads it: `res` holds `[site, eps, kappa, p]` per resonator
@@ -192,8 +260,12 @@ pub fn numba_scene(scene: &Scenario, dt: f64) -> Result<Value, String> {
 
 /// The numba script over `scenes` at dt = 0.01, dealt round-robin to `workers` processes
 /// running at once: the slowest process's time (its compile excluded, as the script reports
-/// it), s.
-fn time_numba(script: &str, scenes: &[Scenario], workers: usize) -> Result<f64, String> {
+/// it), s, and every scene's fractions in `scenes`' order.
+fn time_numba(
+    script: &str,
+    scenes: &[Scenario],
+    workers: usize,
+) -> Result<(f64, Vec<[f64; 3]>), String> {
     let input = scenes
         .iter()
         .map(|s| numba_scene(s, 0.01))
@@ -205,7 +277,8 @@ fn time_numba(script: &str, scenes: &[Scenario], workers: usize) -> Result<f64, 
         })
         .collect::<Result<Vec<_>, _>>()?;
     let mut slowest_ms = 0.0f64;
-    for child in children {
+    let mut shares = vec![[f64::NAN; 3]; scenes.len()];
+    for (w, child) in children.into_iter().enumerate() {
         let out = child.wait_with_output().map_err(|e| e.to_string())?;
         if !out.status.success() {
             let stderr = String::from_utf8_lossy(&out.stderr);
@@ -213,8 +286,13 @@ fn time_numba(script: &str, scenes: &[Scenario], workers: usize) -> Result<f64, 
         }
         let v: Value = serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))?;
         slowest_ms = slowest_ms.max(v["ms"].as_f64().ok_or("no ms")?);
+        let answers = v["fractions"].as_array().ok_or("no fractions")?;
+        for (k, f) in answers.iter().enumerate() {
+            let get = |key: &str| f[key].as_f64().unwrap_or(f64::NAN);
+            shares[w + k * workers] = [get("R"), get("T"), get("E_tr")];
+        }
     }
-    Ok(slowest_ms / 1e3)
+    Ok((slowest_ms / 1e3, shares))
 }
 
 /// `python3 script 1` reading `scenes` on stdin, started.
