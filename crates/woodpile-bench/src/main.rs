@@ -120,8 +120,18 @@ fn main() {
         paper_level(per_sweep, seed, option("--numba-scenes").as_deref());
     }
     if args.iter().any(|a| a == "--sweeps") {
-        let points = option("--sweep-points").and_then(|n| n.parse().ok());
+        let points = match option("--sweep-points").map(|n| n.parse::<usize>()) {
+            None => None,
+            Some(Ok(n)) if n > 0 => Some(n),
+            Some(_) => {
+                eprintln!("--sweep-points takes a whole number above 0");
+                std::process::exit(2);
+            }
+        };
         let whole = args.iter().any(|a| a == "--whole-paper");
+        if whole && points.is_some() {
+            eprintln!("note: --whole-paper is not run with --sweep-points (a quick look)");
+        }
         paper_sweeps(option("--numba-scenes").as_deref(), points, whole);
     }
 }
@@ -292,7 +302,8 @@ fn paper_sweeps(numba_script: Option<&str>, max_points: Option<usize>, whole_pap
     for t in &timings {
         let numba = t.numba_s.as_ref().ok().copied();
         let differs = match (t.numba_worst, t.numba_failed) {
-            (None, _) => "–".to_string(),
+            (None, 0) => "–".to_string(),
+            (None, failed) => format!("none finite ({failed} not finite)"),
             (Some(d), 0) => format!("{d:.1e}"),
             (Some(d), failed) => format!("{d:.1e} ({failed} not finite)"),
         };

@@ -233,10 +233,16 @@ fn time_scenes(scenes: &[Scenario]) -> (f64, Vec<Shares>) {
     (t0.elapsed().as_secs_f64(), shares)
 }
 
-/// The scene as the numba script reads it: `res` holds `[site, eps, kappa, p]` per resonator
-/// (constant couplings only).
+/// The scene as the numba script reads it: `res` holds `[site, eps, kappa, p]` per resonator.
+/// The script knows the paper's chain only (unit masses, Hertz contacts, walls or free ends,
+/// no damping, constant couplings): any other scene is refused, not misread.
 pub fn numba_scene(scene: &Scenario, dt: f64) -> Result<Value, String> {
     let model = &scene.model;
+    let plain_ends = matches!(model.boundary(), Boundary::Fixed | Boundary::Free);
+    let unit_masses = (0..model.n_sites()).all(|i| model.site_mass(i) == 1.0);
+    if !plain_ends || !unit_masses || model.contacts().is_some() || model.is_dissipative() {
+        return Err("the numba baseline takes the paper's chain only".to_string());
+    }
     let res = model
         .resonators()
         .iter()
@@ -270,29 +276,48 @@ fn time_numba(
         .iter()
         .map(|s| numba_scene(s, 0.01))
         .collect::<Result<Vec<_>, _>>()?;
-    let children = (0..workers)
+    let workers = workers.clamp(1, input.len().max(1));
+    let started: Vec<_> = (0..workers)
         .map(|w| {
             let share: Vec<Value> = input.iter().skip(w).step_by(workers).cloned().collect();
             spawn_numba(script, &share)
         })
-        .collect::<Result<Vec<_>, _>>()?;
+        .collect();
+    // Every started process is waited for before any error is reported: none is left running
+    // beside the next sweep's timing.
+    let outputs: Vec<Result<Value, String>> = started
+        .into_iter()
+        .map(|child| child.and_then(|c| finished(script, c)))
+        .collect();
     let mut slowest_ms = 0.0f64;
     let mut shares = vec![[f64::NAN; 3]; scenes.len()];
-    for (w, child) in children.into_iter().enumerate() {
-        let out = child.wait_with_output().map_err(|e| e.to_string())?;
-        if !out.status.success() {
-            let stderr = String::from_utf8_lossy(&out.stderr);
-            return Err(format!("{script} failed: {}", stderr.trim()));
-        }
-        let v: Value = serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))?;
+    for (w, output) in outputs.into_iter().enumerate() {
+        let v = output?;
         slowest_ms = slowest_ms.max(v["ms"].as_f64().ok_or("no ms")?);
         let answers = v["fractions"].as_array().ok_or("no fractions")?;
+        let expected = (w..scenes.len()).step_by(workers).count();
+        if answers.len() != expected {
+            return Err(format!(
+                "{script}: {} answers for {expected} scenes",
+                answers.len()
+            ));
+        }
         for (k, f) in answers.iter().enumerate() {
             let get = |key: &str| f[key].as_f64().unwrap_or(f64::NAN);
             shares[w + k * workers] = [get("R"), get("T"), get("E_tr")];
         }
     }
     Ok((slowest_ms / 1e3, shares))
+}
+
+/// The JSON line a started script printed, or why it failed (its stderr).
+fn finished(script: &str, child: std::process::Child) -> Result<Value, String> {
+    let out = child.wait_with_output().map_err(|e| e.to_string())?;
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        return Err(format!("{script} failed: {}", stderr.trim()));
+    }
+    serde_json::from_slice(&out.stdout).map_err(|e| format!("{script}: {e}"))
 }
 
 /// `python3 script 1` reading `scenes` on stdin, started.
@@ -306,8 +331,12 @@ fn spawn_numba(script: &str, scenes: &[Value]) -> Result<std::process::Child, St
         .map_err(|e| format!("python3 {script}: {e}"))?;
     let text = Value::Array(scenes.to_vec()).to_string();
     let mut stdin = child.stdin.take().ok_or("no stdin")?;
-    stdin
-        .write_all(text.as_bytes())
-        .map_err(|e| e.to_string())?;
+    if let Err(e) = stdin.write_all(text.as_bytes()) {
+        // The script died before reading its scenes: its own message says why.
+        drop(stdin);
+        return Err(finished(script, child)
+            .err()
+            .unwrap_or_else(|| e.to_string()));
+    }
     Ok(child)
 }

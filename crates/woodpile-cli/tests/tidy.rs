@@ -66,9 +66,10 @@ fn section_on<'a>(map: &'a str, krate: &str) -> &'a str {
         return "";
     };
     let body = &map[start + heading.len()..];
-    let end = body
-        .find("\n### ")
-        .or_else(|| body.find("\n## "))
+    let end = [body.find("\n### "), body.find("\n## ")]
+        .into_iter()
+        .flatten()
+        .min()
         .unwrap_or(body.len());
     &body[..end]
 }
@@ -156,10 +157,12 @@ fn the_layering_table_is_the_crate_graph() {
         .collect();
     manifests.push(repo().join("python/Cargo.toml"));
     let mut wrong = Vec::new();
+    let mut seen = BTreeSet::new();
     for manifest in manifests {
         let text: toml::Table = std::fs::read_to_string(&manifest).unwrap().parse().unwrap();
         let name = text["package"]["name"].as_str().unwrap();
         let short = name.trim_start_matches("woodpile-").to_string();
+        seen.insert(short.clone());
         let actual = workspace_dependencies(&manifest);
         match table.get(&short) {
             Some(said) if *said == actual => {}
@@ -168,6 +171,12 @@ fn the_layering_table_is_the_crate_graph() {
             )),
         }
     }
+    wrong.extend(
+        table
+            .keys()
+            .filter(|k| !seen.contains(*k))
+            .map(|k| format!("woodpile-{k}: in the table, but no such crate")),
+    );
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
@@ -255,7 +264,8 @@ fn without_space_in_groups(code: &str) -> String {
 /// itself), each as its segments.
 fn expand_use(tree: &str) -> Vec<Vec<String>> {
     let tree = tree.trim_end_matches([',', ';']);
-    let Some(open) = tree.find("::{").map(|k| k + 2).or_else(|| tree.find('{')) else {
+    // The first brace opens this level's group: `a::{b, c::{d}}` or, after `crate::`, `{a, b}`.
+    let Some(open) = tree.find('{') else {
         let path: Vec<String> = tree
             .split("::")
             .filter(|s| !s.is_empty() && *s != "self")
@@ -264,6 +274,7 @@ fn expand_use(tree: &str) -> Vec<Vec<String>> {
         return vec![path];
     };
     let head: Vec<String> = tree[..open]
+        .trim_end_matches("::")
         .split("::")
         .filter(|s| !s.is_empty())
         .map(String::from)
@@ -280,6 +291,17 @@ fn expand_use(tree: &str) -> Vec<Vec<String>> {
         }
     }
     out
+}
+
+/// The `use` reader expands nested groups, after `crate::` as after a path.
+#[test]
+fn use_groups_are_expanded_whole() {
+    let paths = |tree: &str| -> Vec<String> {
+        expand_use(tree).into_iter().map(|p| p.join("::")).collect()
+    };
+    assert_eq!(paths("{a::{b,c},d}"), ["", "a", "a::b", "a::c", "d"]);
+    assert_eq!(paths("x::{y,z::{w}}"), ["x", "x::y", "x::z", "x::z::w"]);
+    assert_eq!(paths("a::b;"), ["a::b"]);
 }
 
 /// `a, b::{c, d}, e` split at its top-level commas.

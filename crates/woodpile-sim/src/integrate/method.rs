@@ -230,7 +230,7 @@ pub enum MethodChoice {
 impl Method {
     /// The fixed step the calibrated error model predicts for `tol`, before any resonator
     /// caps it (never above 0.25).
-    pub(crate) fn calibrated_dt(self, tol: f64) -> f64 {
+    pub(super) fn calibrated_dt(self, tol: f64) -> f64 {
         let em = &self.facts().error;
         (tol / em.coef).powf(1.0 / em.order).min(0.25)
     }

@@ -58,11 +58,7 @@ pub(crate) fn stage_accelerations<const S: usize>(
     window: Window,
 ) -> f64 {
     if model.is_dissipative() {
-        let record = contact.map(|c| BondRecord {
-            force: &mut c.stage_force[stage],
-            power: &mut c.stage_power[stage],
-        });
-        return damped_accelerations(model, record, (q, v, acc), t, window);
+        return damped_accelerations(model, (contact, stage), (q, v, acc), t, window);
     }
     match contact {
         None => model.accelerations_in(t, q, acc, window),
@@ -76,13 +72,17 @@ pub(crate) fn stage_accelerations<const S: usize>(
 /// and should not carry this path's code.
 #[inline(never)]
 #[cold]
-fn damped_accelerations(
+fn damped_accelerations<const S: usize>(
     model: &Model,
-    record: Option<BondRecord<'_>>,
+    (contact, stage): (Option<&mut ContactEvents<S>>, usize),
     (q, v, acc): (&[f64], &[f64], &mut [f64]),
     t: f64,
     window: Window,
 ) -> f64 {
+    let record = contact.map(|c| BondRecord {
+        force: &mut c.stage_force[stage],
+        power: &mut c.stage_power[stage],
+    });
     model.damped_recording(t, (q, v), acc, window, record)
 }
 

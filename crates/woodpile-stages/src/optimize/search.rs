@@ -31,8 +31,8 @@ pub(super) struct OptimumRow {
 /// One optimisation over a sweep's box: the searched axes, their bounds and the simulations
 /// made so far (each point once, for the rows and the best file).
 pub(super) struct Search<'a> {
-    pub(super) optimize: &'a Optimize,
-    pub(super) stage: &'a str,
+    optimize: &'a Optimize,
+    stage: &'a str,
     pub(super) sweep: &'a Sweep,
     /// The searched axes (indices into the sweep's axes).
     pub(super) searched: Vec<usize>,
