@@ -95,7 +95,7 @@ bench: build ## Speed (PREVIOUS=old/woodpile adds it, same run): woodpile agains
 	$(MAKE) --no-print-directory unused-cost
 	@if [ -n "$(PREVIOUS)" ]; then \
 	  echo "this build against the previous release build $(PREVIOUS):"; \
-	  $(CARGO) run --release -q -p woodpile-bench --example unused_cost -- $(PREVIOUS) $(WOODPILE); \
+	  $(CARGO) run --release -q -p woodpile-bench --example unused_cost -- $(PREVIOUS) $(WOODPILE) 15 --numbers-may-differ; \
 	fi
 	$(CARGO) bench -p woodpile-bench
 
