@@ -76,17 +76,36 @@ fn notes(stages: &[(&str, &str)]) -> tempfile::TempDir {
     dir
 }
 
-fn run_all(dir: &Path) -> woodpile_pipeline::Result<Pipeline> {
-    let pipeline = Pipeline::load(&dir.join("pipeline"), KINDS)?;
-    let options = RunOptions {
+/// A run of every stage of the project in `dir`, into its own results and figures.
+fn options(dir: &Path) -> RunOptions {
+    RunOptions {
         targets: Vec::new(),
         force: false,
         dry_run: false,
         results: dir.join("results"),
         figures: dir.join("figures"),
-    };
+    }
+}
+
+fn run_all(dir: &Path) -> woodpile_pipeline::Result<Pipeline> {
+    let pipeline = Pipeline::load(&dir.join("pipeline"), KINDS)?;
+    let options = options(dir);
     run(&pipeline, &options, &Silent)?;
     Ok(pipeline)
+}
+
+/// Runs every stage and names the ones that ran (the rest were fresh).
+fn ran(dir: &Path) -> Vec<String> {
+    let pipeline = Pipeline::load(&dir.join("pipeline"), KINDS).unwrap();
+    let options = options(dir);
+    let steps = run(&pipeline, &options, &Silent).unwrap();
+    let mut names: Vec<String> = steps
+        .into_iter()
+        .filter(|s| s.runs)
+        .map(|s| s.stage)
+        .collect();
+    names.sort();
+    names
 }
 
 fn state_of(dir: &Path, pipeline: &Pipeline) -> State {
@@ -254,4 +273,49 @@ fn non_regular_files_in_results_are_damaged_never_read() {
     run_all(dir.path()).unwrap();
     assert_eq!(state_of(dir.path(), &pipeline), State::Fresh);
     assert!(std::fs::symlink_metadata(&table).unwrap().is_file());
+}
+
+/// A second run does nothing; an edited stage runs again with exactly what reads it, and a
+/// stage apart from it stays fresh.
+#[test]
+fn a_second_run_does_nothing_and_an_edit_reruns_exactly_its_dependents() {
+    let dir = notes(&[
+        ("first", "text = \"a\""),
+        ("second", "text = \"b\"\ninputs = [\"first\"]"),
+        ("apart", "text = \"c\""),
+    ]);
+    assert_eq!(ran(dir.path()), ["apart", "first", "second"]);
+    assert!(ran(dir.path()).is_empty());
+    let edit = |name: &str, body: &str| {
+        let stage = format!("kind = \"note\"\n{body}\n");
+        std::fs::write(dir.path().join(format!("pipeline/{name}.toml")), stage).unwrap();
+    };
+    edit("second", "text = \"b2\"\ninputs = [\"first\"]");
+    assert_eq!(ran(dir.path()), ["second"]);
+    edit("first", "text = \"a2\"");
+    assert_eq!(ran(dir.path()), ["first", "second"]);
+}
+
+/// Stage files may sit in folders below the pipeline's; the same name twice is an error that
+/// names both files.
+#[test]
+fn stages_in_folders_load_and_a_name_twice_is_an_error() {
+    let dir = project("text = \"hello\"");
+    let folder = dir.path().join("pipeline/f1");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::write(folder.join("other.toml"), "kind = \"note\"\ntext = \"x\"\n").unwrap();
+    let pipeline = Pipeline::load(&dir.path().join("pipeline"), KINDS).unwrap();
+    assert_eq!(pipeline.stages().len(), 2);
+    assert!(pipeline
+        .stage("other")
+        .unwrap()
+        .file
+        .ends_with("f1/other.toml"));
+    std::fs::write(folder.join("note.toml"), "kind = \"note\"\ntext = \"y\"\n").unwrap();
+    let e = Pipeline::load(&dir.path().join("pipeline"), KINDS).unwrap_err();
+    let e = e.to_string();
+    assert!(
+        e.contains("defined twice") && e.contains("f1/note.toml"),
+        "{e}"
+    );
 }

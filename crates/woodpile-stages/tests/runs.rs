@@ -351,31 +351,6 @@ fn grids_too_large_to_plan_are_refused_at_load_with_their_size() {
     assert!(e.contains("sweep.toml") && e.contains("GB"), "{e}");
 }
 
-/// Stage files may sit in folders (one per figure); a stage is named by its stem wherever it
-/// lies, so the same name twice is an error naming both files.
-#[test]
-fn stages_in_folders_load_and_a_name_twice_is_an_error() {
-    let p = Project::new(&[("at_end", REDUCE)]);
-    let folder = p.pipeline().join("f1");
-    std::fs::create_dir_all(&folder).unwrap();
-    std::fs::write(folder.join("sweep.toml"), SWEEP).unwrap();
-    let pipeline = p.load();
-    assert_eq!(pipeline.stages().len(), 2);
-    assert!(pipeline
-        .stage("sweep")
-        .unwrap()
-        .file
-        .ends_with("f1/sweep.toml"));
-    std::fs::write(p.pipeline().join("sweep.toml"), SWEEP).unwrap();
-    let e = Pipeline::load(&p.pipeline(), KINDS)
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.contains("defined twice") && e.contains("f1/sweep.toml"),
-        "{e}"
-    );
-}
-
 /// The kinds are listed once: the unknown-kind error names every one of them.
 #[test]
 fn an_unknown_kind_lists_every_kind() {
