@@ -149,7 +149,7 @@ pub enum SimError {
         max_steps: u64,
     },
     /// `auto` could not verify the tolerance by step halving.
-    #[error("method auto could not verify tolerance {tolerance:.1e}: at its finest step, dt = {dt:.3e}, {why}; use a looser tolerance, or a named method with a step of your choosing (method = \"rkn6-contact\", or \"rk4-contact\" with damping, and dt = ...), whose result is not verified")]
+    #[error("method auto could not verify tolerance {tolerance:.1e}: at its finest step, dt = {dt:.3e}, {why}; use a looser tolerance, or a named method with a step of your choosing (method = \"erkn6-contact\", or \"rk4-contact\" with damping, and dt = ...), whose result is not verified")]
     NotConverged {
         /// Requested tolerance.
         tolerance: f64,

@@ -31,7 +31,7 @@
 use rayon::prelude::*;
 use serde_json::json;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan, AUTO_METHOD};
+use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::simulation::{auto_first_step, run_with_plan, simulate, Scenario};
 
 use woodpile_pipeline::error::{PipelineError, Result};
@@ -187,6 +187,7 @@ impl Stability {
             scene,
             e_ref,
             auto_dt,
+            auto_method: auto_plan.method.name(),
         })
     }
 
@@ -201,9 +202,10 @@ impl Stability {
             scene,
             e_ref,
             auto_dt,
+            auto_method,
         } = reference;
         let method = self.methods[m];
-        let omega = scene.scenario.model.max_linear_omega();
+        let omega = scene.scenario.model.max_linear_omega(false);
         // A step in the map's own x unit (dt or dt·ω) as a dt, and back.
         let to_dt = |step: f64| match self.steps_are_dt_omega {
             true => step / omega,
@@ -224,7 +226,12 @@ impl Stability {
             self.tolerance,
             simulated,
         );
-        let bound = (omega > 0.0).then_some(method.stability_limit() / omega);
+        // A method that integrates the resonator exactly has no bound on it.
+        let stepped = scene
+            .scenario
+            .model
+            .max_linear_omega(method.integrates_harmonic_exactly());
+        let bound = (stepped > 0.0).then_some(method.stability_limit() / stepped);
         Run {
             method: method.name(),
             method_index: m as i64,
@@ -234,6 +241,7 @@ impl Stability {
             dt_omega: (omega > 0.0).then_some(dt * omega),
             bound,
             auto_dt: *auto_dt,
+            auto_method,
             // The bound and auto's step in the map's own x unit, for the overlay lines.
             bound_step: bound.map(to_step),
             auto_step: to_step(*auto_dt),
@@ -249,7 +257,7 @@ impl Stability {
         // `auto` runs its method at `auto_dt` or shorter: none of those steps may be unstable.
         let auto_unstable = runs
             .iter()
-            .filter(|r| r.method == AUTO_METHOD.name() && r.status == 2 && r.dt <= r.auto_dt)
+            .filter(|r| r.method == r.auto_method && r.status == 2 && r.dt <= r.auto_dt)
             .count();
         json!({
             "runs": runs.len(),
@@ -312,6 +320,8 @@ struct Reference {
     scene: woodpile_scene::Scene,
     e_ref: f64,
     auto_dt: f64,
+    /// The method `auto` runs on the scene (`erkn6-contact` where a resonator is harmonic).
+    auto_method: &'static str,
 }
 
 /// Runs `method` at step `dt` with no drift guard and classifies it: 2 if the state becomes
@@ -369,6 +379,8 @@ struct Run {
     dt_omega: Option<f64>,
     bound: Option<f64>,
     auto_dt: f64,
+    /// The method `auto` runs at `auto_dt` on this value's scene.
+    auto_method: &'static str,
     /// The linear bound in the map's step unit (dt·ω or dt).
     bound_step: Option<f64>,
     /// `auto`'s first step in the map's step unit.

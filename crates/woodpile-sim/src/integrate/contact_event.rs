@@ -165,6 +165,35 @@ pub(crate) fn path_integrals(path: &BondPath, h: f64) -> (f64, f64) {
 /// a power d^α (α ≥ 1) as d closes: under the smoothing substitution the integrand then goes
 /// like x^{2α}, smooth enough for the 16-point rule.
 pub(crate) fn path_integrals_of(path: &BondPath, h: f64, force: impl Fn(f64) -> f64) -> (f64, f64) {
+    let [impulse, moment] = weighted_path_integrals(path, h, force, |x| [1.0, 1.0 - x]);
+    (impulse * h, moment * h * h)
+}
+
+/// [`path_integrals_of`] for a bond whose member hosts a resonator integrated exactly
+/// (`erkn6-contact`, θ = ω h > 0): the variation-of-constants weights of the pair's fast mode,
+/// `(∫_0^h cos(ω (h − s)) F ds, ∫_0^h sin(ω (h − s)) / ω F ds)`.
+pub(crate) fn oscillating_path_integrals(
+    path: &BondPath,
+    h: f64,
+    theta: f64,
+    force: impl Fn(f64) -> f64,
+) -> (f64, f64) {
+    let weights = |x: f64| {
+        let phase = theta * (1.0 - x);
+        [phase.cos(), phase.sin() / theta]
+    };
+    let [impulse, moment] = weighted_path_integrals(path, h, force, weights);
+    (impulse * h, moment * h * h)
+}
+
+/// `∫_0^1 w_k(x) F(d(x h)) dx` for the weights `weights(x)` along the Hermite path, on the
+/// pieces where the overlap is positive.
+fn weighted_path_integrals<const K: usize>(
+    path: &BondPath,
+    h: f64,
+    force: impl Fn(f64) -> f64,
+    weights: impl Fn(f64) -> [f64; K],
+) -> [f64; K] {
     let cubic = Cubic::hermite(path, h);
     // Break points: 0, the critical points, 1; then the roots inside each monotone piece.
     let (knots, n_knots) = cubic.monotone_knots();
@@ -182,7 +211,7 @@ pub(crate) fn path_integrals_of(path: &BondPath, h: f64, force: impl Fn(f64) -> 
     points[n_points] = 1.0;
     n_points += 1;
 
-    let (mut impulse, mut moment) = (0.0, 0.0);
+    let mut sums = [0.0; K];
     for span in points[..n_points].windows(2) {
         let (a, b) = (span[0], span[1]);
         if !(b > a) || !(cubic.at(0.5 * (a + b)) > 0.0) {
@@ -193,11 +222,12 @@ pub(crate) fn path_integrals_of(path: &BondPath, h: f64, force: impl Fn(f64) -> 
             let xi = a + (b - a) * smooth;
             let jacobian = 6.0 * x * (1.0 - x) * (b - a);
             let f = force(cubic.at(xi).max(0.0));
-            impulse += w * jacobian * f;
-            moment += w * jacobian * (1.0 - xi) * f;
+            for (sum, weight) in sums.iter_mut().zip(weights(xi)) {
+                *sum += w * jacobian * weight * f;
+            }
         }
     }
-    (impulse * h, moment * h * h)
+    sums
 }
 
 /// [`path_integrals_of`] for a contact with a dashpot: `force(c, ċ)` gives the bond's total

@@ -7,10 +7,11 @@
 //! forces, as an impulse `h Σ b_i F_i` and a position change `h² Σ b̄_i F_i`.
 
 use super::contact_event::{
-    damped_path_integrals, first_crossing, first_switch, path_integrals, path_integrals_of,
-    BondPath,
+    damped_path_integrals, first_crossing, first_switch, oscillating_path_integrals,
+    path_integrals, path_integrals_of, BondPath,
 };
 use super::contact_scan::{block_changes, block_of, changes_contact};
+use super::exact_resonator::{ExactResonators, HostOf};
 use crate::contact::ContactLaw;
 use crate::model::{Model, Window};
 
@@ -85,6 +86,57 @@ fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, 
     }
 }
 
+/// A conservative bond's impulse and moment along its path under the fast-mode weights of a
+/// host whose resonator is integrated exactly ([`oscillating_path_integrals`]).
+fn oscillating_bond_integrals(
+    model: &Model,
+    bond: usize,
+    path: &BondPath,
+    h: f64,
+    theta: f64,
+) -> (f64, f64) {
+    match model.contacts() {
+        None => oscillating_path_integrals(path, h, theta, |d| d * d.sqrt()),
+        Some(law) => {
+            let a = law.coefficient(bond);
+            let (impulse, moment) = oscillating_path_integrals(path, h, theta, |d| law.power(d));
+            (a * impulse, a * moment)
+        }
+    }
+}
+
+/// The part of a bond's correction that reaches a host's fast mode in an extended Nyström step
+/// (`erkn6-contact`, [`ExactResonators`]). The plain correction (impulse − quadrature) acts on
+/// the host as on any site; the fast mode's share of the force is integrated with the
+/// variation-of-constants weights instead, so this adds the difference of the two
+/// corrections, (weighted integral − weighted quadrature) − (plain correction), along the fast
+/// mode. `sign` is −1 for the bond's left member, +1 for its right.
+fn fast_mode_correction<const S: usize>(
+    model: &Model,
+    (bond, path, stage): (usize, &BondPath, [f64; S]),
+    h: f64,
+    (plain_impulse, plain_moment): (f64, f64),
+    (pair, sign): (HostOf<S>, f64),
+) -> FastModeCorrection {
+    let (impulse, moment) = oscillating_bond_integrals(model, bond, path, h, pair.theta);
+    let weigh = |w: &[f64; S]| w.iter().zip(&stage).map(|(w, f)| w * f).sum::<f64>();
+    let extra_impulse = (impulse - h * weigh(&pair.b_velocity)) - plain_impulse;
+    let extra_moment = (moment - h * h * weigh(&pair.b_position)) - plain_moment;
+    FastModeCorrection {
+        sites: [pair.host, pair.resonator],
+        velocity: pair.share.map(|s| sign * extra_impulse * s),
+        position: pair.share.map(|s| sign * extra_moment * s),
+    }
+}
+
+/// A fast-mode correction: added to the host's and its resonator's velocity and position.
+#[derive(Debug, Clone, Copy)]
+struct FastModeCorrection {
+    sites: [usize; 2],
+    velocity: [f64; 2],
+    position: [f64; 2],
+}
+
 /// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the
 /// path integrals and the switch search take them (the path is of the total overlap; the
 /// force law takes the relative displacement, without the static overlap).
@@ -108,6 +160,8 @@ pub(crate) struct ContactEvents<const S: usize> {
     quadrature: Quadrature<S>,
     /// The corrections of the last step.
     pending: Vec<Correction>,
+    /// Their parts along the fast modes of exactly integrated resonators.
+    pending_fast: Vec<FastModeCorrection>,
     /// A dissipative chain's corrected bonds and the energy each dissipated along its path.
     corrected: Vec<(usize, f64)>,
     /// Bonds corrected so far.
@@ -137,6 +191,7 @@ impl<const S: usize> ContactEvents<S> {
             stage_power: std::array::from_fn(|_| vec![0.0; powers]),
             quadrature,
             pending: Vec::new(),
+            pending_fast: Vec::new(),
             events: 0,
             changed: Vec::new(),
             carried: Vec::new(),
@@ -164,13 +219,14 @@ impl<const S: usize> ContactEvents<S> {
 
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
     /// contact opened or closed during the step of size `h` from `start` to `end` (states
-    /// `[q, q']`, the end not yet corrected).
+    /// `[q, q']`, the end not yet corrected). Bonds at the host of an `exact` resonator are
+    /// corrected along its fast mode too ([`fast_mode_correction`]).
     pub(super) fn correct(
         &mut self,
         model: &Model,
         (start, end): (&[f64], &mut [f64]),
         h: f64,
-        window: Window,
+        (window, exact): (Window, Option<&ExactResonators<S>>),
     ) {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
@@ -198,6 +254,21 @@ impl<const S: usize> ContactEvents<S> {
             let (impulse, moment, lost) = bond_integrals(model, bond, &path, h);
             let (q0, q1) = quadrature(stage, h);
             pending.push((left, right, impulse - q0, moment - q1));
+            if let Some(exact) = exact {
+                for (member, sign) in [(left, -1.0), (right, 1.0)] {
+                    if let Some(pair) = member.and_then(|site| exact.host(site)) {
+                        let plain = (impulse - q0, moment - q1);
+                        let fast = (bond, &path, stage);
+                        self.pending_fast.push(fast_mode_correction(
+                            model,
+                            fast,
+                            h,
+                            plain,
+                            (pair, sign),
+                        ));
+                    }
+                }
+            }
             if model.is_dissipative() {
                 let powers = std::array::from_fn(|s| self.stage_power[s][bond]);
                 dissipated += lost - quadrature(powers, h).0;
@@ -209,6 +280,12 @@ impl<const S: usize> ContactEvents<S> {
             new_v[n] += dissipated;
         }
         apply(model, &pending, (new_q, new_v));
+        for fast in self.pending_fast.drain(..) {
+            for k in 0..2 {
+                new_v[fast.sites[k]] += fast.velocity[k];
+                new_q[fast.sites[k]] += fast.position[k];
+            }
+        }
         if model.is_dissipative() {
             self.refine(model, (start, end), h, (&mut pending, &mut corrected));
         }

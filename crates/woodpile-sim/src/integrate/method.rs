@@ -15,6 +15,11 @@ pub enum Method {
     /// Dormand, El-Mikkawy and Prince's six-stage Runge–Kutta–Nyström method of order 6
     /// (`integrate::rkn`) with the same exact contact events.
     Rkn6Contact,
+    /// `rkn6-contact` with every harmonic resonator (linear, constant κ, alone on its host)
+    /// integrated exactly: the extended Nyström step of `integrate::exact_resonator`, whose
+    /// accuracy does not depend on the resonator's frequency. `auto`'s method on a chain with
+    /// such a resonator.
+    Erkn6Contact,
     /// Störmer–Verlet, order 2, symplectic, fixed step.
     Verlet,
     /// Triple-jump composition of Verlet, order 4, symplectic, fixed step.
@@ -27,11 +32,12 @@ pub enum Method {
 
 impl Method {
     /// Every method, in a stable order (the order of [`FACTS`]).
-    pub const ALL: [Method; 8] = [
+    pub const ALL: [Method; 9] = [
         Method::Rk4,
         Method::Rk4Contact,
         Method::Rkn4Contact,
         Method::Rkn6Contact,
+        Method::Erkn6Contact,
         Method::Verlet,
         Method::Yoshida4,
         Method::Yoshida6,
@@ -80,6 +86,12 @@ impl Method {
             .filter(|m| m.takes_velocity_forces())
     }
 
+    /// Whether the method integrates harmonic resonators exactly ([`crate::Model::is_harmonic`]),
+    /// so that their frequency caps none of its steps.
+    pub fn integrates_harmonic_exactly(self) -> bool {
+        self == Method::Erkn6Contact
+    }
+
     /// Largest dt * omega for which the method is stable on the linear oscillator
     /// x'' = -omega^2 x (its stability interval on the imaginary axis for RK; HLW Section I.5 for
     /// compositions), used to keep fixed steps safe for stiff resonators.
@@ -115,7 +127,7 @@ struct ErrorModel {
 }
 
 /// One row per method, in the order of [`Method::ALL`] (a test checks it).
-const FACTS: [Facts; 8] = [
+const FACTS: [Facts; 9] = [
     Facts {
         name: "rk4",
         order: 4,
@@ -167,6 +179,20 @@ const FACTS: [Facts; 8] = [
         // puts the first step at 0.1 for tolerance 1e-6, where the worst measured error is
         // 2.3e-7, and 0.215 for 1e-5: a smaller first step costs more evaluations over the
         // surveys at 1e-5 and 1e-6, where the sweeps run, and a larger one more halvings.
+        error: ErrorModel {
+            coef: 1e-3,
+            order: 3.0,
+        },
+    },
+    Facts {
+        name: "erkn6-contact",
+        order: 6,
+        adaptive: false,
+        velocity_forces: false,
+        // Its harmonic resonators are exact at any step; this bounds the others (nonlinear or
+        // ramped), which it integrates as `rkn6-contact` does.
+        stability_limit: 1.0,
+        // As `rkn6-contact`'s, which it is wherever no harmonic resonator vibrates.
         error: ErrorModel {
             coef: 1e-3,
             order: 3.0,
@@ -261,7 +287,7 @@ mod tests {
     use crate::model::Model;
 
     /// Every method's row of facts, its name in scene files, and the stepper a plan builds for
-    /// it, which reports the same name: one table of names, checked for all eight.
+    /// it, which reports the same name: one table of names, checked for all nine.
     #[test]
     fn every_method_has_its_own_row_of_facts() {
         let names = [
@@ -269,6 +295,7 @@ mod tests {
             "rk4-contact",
             "rkn4-contact",
             "rkn6-contact",
+            "erkn6-contact",
             "verlet",
             "yoshida4",
             "yoshida6",

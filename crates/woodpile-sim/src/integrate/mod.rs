@@ -20,6 +20,7 @@ mod contact_scan;
 mod dop853;
 mod driver;
 mod event_correction;
+mod exact_resonator;
 mod method;
 mod plan;
 mod rk;

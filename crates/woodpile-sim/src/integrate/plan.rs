@@ -56,6 +56,11 @@ pub const DRIFT_PER_TOL: f64 = 100.0;
 /// `rk4-contact` did at tolerances 1e-5 to 1e-7, with no scene missing its tolerance.
 pub const AUTO_METHOD: Method = Method::Rkn6Contact;
 
+/// The method `auto` verifies on a chain with a harmonic resonator ([`Model::is_harmonic`]):
+/// [`AUTO_METHOD`] with those resonators integrated exactly, so that their frequency no longer
+/// caps the step (docs/methods.md, "Harmonic resonators integrated exactly").
+pub const HARMONIC_AUTO_METHOD: Method = Method::Erkn6Contact;
+
 /// The method `auto` verifies on a dissipative chain, whose dashpots make the forces depend
 /// on velocities, which the Nyström methods cannot take: RK4 with exact contact events, each
 /// event bond's force (spring, dashpot and clip) integrated along its path
@@ -65,6 +70,13 @@ pub const DISSIPATIVE_AUTO_METHOD: Method = Method::Rk4Contact;
 /// Largest omega * dt `auto` and tolerance-driven fixed steps accept for the fastest linear
 /// resonator: keeps its phase accurate, not merely stable.
 const MAX_OMEGA_DT: f64 = 0.5;
+
+/// Largest omega * dt for a harmonic resonator that the method integrates exactly
+/// ([`Method::integrates_harmonic_exactly`]): its free vibration is exact at any step, but the
+/// contact forces its host feels are sampled at the stages, and a coarse run at twice this
+/// step must stay clear of omega * dt = 2 pi, where those samples alias (a p = 1, eps = 0.05,
+/// kappa = 10 scene drifts by 2e-4 there and is within 2e-6 at 6.0 and 1.2e-7 at pi).
+const MAX_HARMONIC_OMEGA_DT: f64 = 2.0;
 
 impl Plan {
     /// Resolves `choice` and `accuracy` for `model`. For [`MethodChoice::Auto`] this is the
@@ -90,6 +102,7 @@ impl Plan {
         let method = match choice {
             MethodChoice::Named(m) => m,
             MethodChoice::Auto if model.is_dissipative() => DISSIPATIVE_AUTO_METHOD,
+            MethodChoice::Auto if model.has_harmonic_resonator() => HARMONIC_AUTO_METHOD,
             MethodChoice::Auto => AUTO_METHOD,
         };
         if model.is_dissipative() && !method.takes_velocity_forces() {
@@ -135,12 +148,14 @@ impl Plan {
     /// The fixed step predicted to reach `tol` with `method` on `model`: the calibrated error
     /// model, capped so that the fastest linear resonator is resolved and never above 0.25.
     pub fn dt_for(model: &Model, method: Method, tol: f64) -> f64 {
-        let omega = model.max_linear_omega();
+        let exact = method.integrates_harmonic_exactly();
+        let omega = model.max_linear_omega(exact);
         let resolved = if omega > 0.0 {
             MAX_OMEGA_DT / omega
         } else {
             f64::INFINITY
-        };
+        }
+        .min(Self::harmonic_dt(model, method));
         let stable = if omega > 0.0 {
             0.9 * method.stability_limit() / omega
         } else {
@@ -165,13 +180,54 @@ impl Plan {
     ///
     /// A chain under a [`crate::ContactLaw`] is held to the same bound on its stiffest
     /// contact ([`Model::max_contact_omega`]); the paper's chain has none and is not capped.
-    pub fn resolving_dt(model: &Model, energy: f64) -> f64 {
+    pub fn resolving_dt(model: &Model, method: Method, energy: f64) -> f64 {
         let omega = model
-            .max_resonator_omega(energy)
+            .max_resonator_omega(energy, method.integrates_harmonic_exactly())
             .max(model.max_contact_omega(energy))
             .max(model.max_dissipation_rate(energy));
+        let resolved = if omega > 0.0 {
+            MAX_OMEGA_DT / omega
+        } else {
+            f64::INFINITY
+        };
+        resolved.min(Self::harmonic_dt(model, method))
+    }
+
+    /// The step resonator `j` of `model` allows `method` in a motion of total energy `energy`:
+    /// what [`Plan::resolving_dt`] takes the smallest of, resonator by resonator (to say which
+    /// one set a step).
+    pub fn resonator_dt(model: &Model, method: Method, j: usize, energy: f64) -> f64 {
+        let r = &model.resonators()[j];
+        let omega = r.omega_within(model.site_mass(r.site), energy);
+        let cap = match method.integrates_harmonic_exactly() && model.is_harmonic(j) {
+            true => MAX_HARMONIC_OMEGA_DT,
+            false => MAX_OMEGA_DT,
+        };
+        if omega > 0.0 {
+            cap / omega
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The step the stiffest contact of `model` allows in a motion of total energy `energy`
+    /// (infinite for the paper's chain, [`Model::max_contact_omega`]).
+    pub fn contact_dt(model: &Model, energy: f64) -> f64 {
+        let omega = model.max_contact_omega(energy);
         if omega > 0.0 {
             MAX_OMEGA_DT / omega
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The cap a method that integrates harmonic resonators exactly keeps on them
+    /// ([`MAX_HARMONIC_OMEGA_DT`]); none for other methods, which resolve them by
+    /// [`MAX_OMEGA_DT`].
+    fn harmonic_dt(model: &Model, method: Method) -> f64 {
+        let omega = model.max_harmonic_omega();
+        if method.integrates_harmonic_exactly() && omega > 0.0 {
+            MAX_HARMONIC_OMEGA_DT / omega
         } else {
             f64::INFINITY
         }
@@ -235,6 +291,10 @@ impl Plan {
             Method::Rk4Contact => Box::new(Rk4Fused::with_contact_events(model)),
             Method::Rkn4Contact => Box::new(Rkn4::with_contact_events(model)),
             Method::Rkn6Contact => Box::new(Rkn::new(model, DPRKN6, ContactMode::Corrected)),
+            Method::Erkn6Contact => Box::new(
+                Rkn::new(model, DPRKN6, ContactMode::Corrected)
+                    .with_exact_resonators(model, Method::Erkn6Contact.name()),
+            ),
             Method::Verlet => Box::new(SymplecticStepper::new(model, VERLET)),
             Method::Yoshida4 => Box::new(SymplecticStepper::new(model, YOSHIDA4)),
             Method::Yoshida6 => Box::new(SymplecticStepper::new(model, YOSHIDA6)),

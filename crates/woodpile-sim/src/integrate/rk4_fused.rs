@@ -147,7 +147,7 @@ impl Rk4Fused {
     fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
         let s = &mut self.scratch;
         finish_step(
-            s.contact.as_mut(),
+            (s.contact.as_mut(), None),
             model,
             (y, &mut s.y_new),
             span.h,

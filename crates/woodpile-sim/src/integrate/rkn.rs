@@ -20,6 +20,7 @@
 //! closes, so that no step contains a kink, and the next step starts there.
 
 use super::event_correction::{ContactEvents, Quadrature};
+use super::exact_resonator::{ExactResonators, NystromWeights};
 use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
@@ -161,6 +162,10 @@ pub struct Rkn<const S: usize> {
     /// was FSAL and no contact correction moved its end state.
     last_stage_current: bool,
     contact: Option<ContactEvents<S>>,
+    /// The harmonic resonators integrated exactly (`erkn6-contact`), if any.
+    exact: Option<ExactResonators<S>>,
+    /// The name when they are (the tableau's names otherwise).
+    exact_name: Option<&'static str>,
 }
 
 impl<const S: usize> Rkn<S> {
@@ -179,7 +184,29 @@ impl<const S: usize> Rkn<S> {
             last_stage_current: false,
             contact: (mode != ContactMode::Plain)
                 .then(|| ContactEvents::new(model, tableau.quadrature)),
+            exact: None,
+            exact_name: None,
         }
+    }
+
+    /// The same method with `model`'s harmonic resonators integrated exactly (the extended
+    /// Nyström step, [`super::exact_resonator`]), under the name `name`. A model without one
+    /// steps as the plain method.
+    pub fn with_exact_resonators(mut self, model: &Model, name: &'static str) -> Self {
+        let t = self.tableau;
+        assert!(
+            self.fsal,
+            "{}: an exact resonator step needs an FSAL tableau",
+            t.names[0]
+        );
+        let weights = NystromWeights {
+            c: t.c,
+            b: t.b,
+            b_prime: t.b_prime,
+        };
+        self.exact = ExactResonators::of(model, weights);
+        self.exact_name = Some(name);
+        self
     }
 
     /// Steps cut short at a contact event (located mode), or bonds corrected (corrected mode).
@@ -205,6 +232,10 @@ impl<const S: usize> Rkn<S> {
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);
         let tab = self.tableau;
+        let sites = (window.lo, window.hi);
+        if let Some(exact) = self.exact.as_mut() {
+            exact.prepare(h);
+        }
         for i in 0..S {
             if i > 0 {
                 for r in ranges.clone() {
@@ -223,6 +254,9 @@ impl<const S: usize> Rkn<S> {
                             }
                         }
                     }
+                }
+                if let Some(exact) = &self.exact {
+                    exact.shift_stage(i, (q, v), &self.a, &mut self.q_stage, sites);
                 }
             }
             if i == 0 && self.last_stage_current {
@@ -243,6 +277,9 @@ impl<const S: usize> Rkn<S> {
                 (t + tab.c[i] * h, i),
                 window,
             );
+            if let Some(exact) = &self.exact {
+                exact.to_forcing(qs, &mut self.a[i], sites);
+            }
         }
         let (new_q, new_v) = self.y_new.split_at_mut(n);
         for r in ranges {
@@ -275,6 +312,9 @@ impl<const S: usize> Rkn<S> {
                     }
                 }
             }
+        }
+        if let Some(exact) = &self.exact {
+            exact.shift_velocity((q, v), &self.a, new_v, sites);
         }
     }
 
@@ -312,7 +352,8 @@ impl<const S: usize> Rkn<S> {
 
 impl<const S: usize> Stepper for Rkn<S> {
     fn name(&self) -> &'static str {
-        self.tableau.names[self.mode as usize]
+        self.exact_name
+            .unwrap_or(self.tableau.names[self.mode as usize])
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
@@ -322,7 +363,8 @@ impl<const S: usize> Stepper for Rkn<S> {
             ContactMode::Plain | ContactMode::Corrected => {
                 self.raw_step(model, t, y, h, window);
                 let mut y_new = std::mem::take(&mut self.y_new);
-                finish_step(self.contact.as_mut(), model, (y, &mut y_new), h, window);
+                let events = (self.contact.as_mut(), self.exact.as_ref());
+                finish_step(events, model, (y, &mut y_new), h, window);
                 self.y_new = y_new;
                 self.last_stage_current = self.fsal
                     && !self

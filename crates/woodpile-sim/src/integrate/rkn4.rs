@@ -131,7 +131,13 @@ impl Stepper for Rkn4 {
                 nv[i] = v0[i] + (bv1 * a1[i] + bv2 * a2[i] + bv3 * a3[i]);
             }
         }
-        finish_step(s.contact.as_mut(), model, (y, &mut s.y_new), h, window);
+        finish_step(
+            (s.contact.as_mut(), None),
+            model,
+            (y, &mut s.y_new),
+            h,
+            window,
+        );
         StepOutcome::Accepted { h_next: h }
     }
 

@@ -3,6 +3,7 @@
 //! steppers, and the end of a step (correct, then copy the new state back over the window).
 
 use super::event_correction::{ContactEvents, Quadrature};
+use super::exact_resonator::ExactResonators;
 use crate::damped_force::BondRecord;
 use crate::model::{Model, Window};
 
@@ -87,16 +88,17 @@ fn damped_accelerations<const S: usize>(
 }
 
 /// Ends a step of a method that can correct contact events: corrects `y_new` (the new state,
-/// `[q, q']`) if `contact` events are kept, then copies it into `y` over `window`.
+/// `[q, q']`) if `contact` events are kept (along the fast modes of `exact` resonators too),
+/// then copies it into `y` over `window`.
 pub(crate) fn finish_step<const S: usize>(
-    contact: Option<&mut ContactEvents<S>>,
+    (contact, exact): (Option<&mut ContactEvents<S>>, Option<&ExactResonators<S>>),
     model: &Model,
     (y, y_new): (&mut [f64], &mut [f64]),
     h: f64,
     window: Window,
 ) {
     if let Some(contact) = contact {
-        contact.correct(model, (y, y_new), h, window);
+        contact.correct(model, (y, y_new), h, (window, exact));
     }
     copy_window(model, (y, y_new), window);
 }

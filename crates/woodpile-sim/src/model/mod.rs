@@ -234,21 +234,55 @@ impl Model {
 
     /// The fastest linear resonator frequency omega = sqrt(kappa (1/m + 1/eps)): the stiffness
     /// scale that bounds explicit steps (dt * omega must stay below a method's stability limit).
-    pub fn max_linear_omega(&self) -> f64 {
-        self.resonators
-            .iter()
+    /// With `skip_harmonic`, over the resonators a method that integrates harmonic ones exactly
+    /// ([`Model::is_harmonic`]) still steps through.
+    pub fn max_linear_omega(&self, skip_harmonic: bool) -> f64 {
+        self.stepped_resonators(skip_harmonic)
             .map(|r| r.linear_omega(self.site_mass(r.site)))
             .fold(0.0, f64::max)
     }
 
     /// The fastest resonator frequency a motion of total energy `energy` can reach
     /// ([`Resonator::omega_within`]): equal to [`Model::max_linear_omega`] when every resonator
-    /// is linear, and a bound on the stiffest moment of a nonlinear one.
-    pub fn max_resonator_omega(&self, energy: f64) -> f64 {
-        self.resonators
-            .iter()
+    /// is linear, and a bound on the stiffest moment of a nonlinear one. `skip_harmonic` as
+    /// there.
+    pub fn max_resonator_omega(&self, energy: f64, skip_harmonic: bool) -> f64 {
+        self.stepped_resonators(skip_harmonic)
             .map(|r| r.omega_within(self.site_mass(r.site), energy))
             .fold(0.0, f64::max)
+    }
+
+    /// The fastest harmonic resonator's frequency ([`Model::is_harmonic`]), 0 without one.
+    pub fn max_harmonic_omega(&self) -> f64 {
+        (0..self.resonators.len())
+            .filter(|&j| self.is_harmonic(j))
+            .map(|j| self.resonators[j].linear_omega(self.site_mass(self.resonators[j].site)))
+            .fold(0.0, f64::max)
+    }
+
+    /// The resonators, without the harmonic ones when `skip_harmonic`.
+    fn stepped_resonators(&self, skip_harmonic: bool) -> impl Iterator<Item = &Resonator> {
+        (0..self.resonators.len())
+            .filter(move |&j| !(skip_harmonic && self.is_harmonic(j)))
+            .map(|j| &self.resonators[j])
+    }
+
+    /// Whether resonator `j` is harmonic: linear (p = 1), its coupling a constant κ > 0, on a
+    /// conservative chain, and the only resonator of its host. Its pair with the host is then
+    /// a linear oscillator of one frequency that `erkn6-contact` integrates exactly.
+    pub fn is_harmonic(&self, j: usize) -> bool {
+        let r = &self.resonators[j];
+        let alone = self.resonators.iter().filter(|o| o.site == r.site).count() == 1;
+        r.p == 1
+            && !r.coupling.is_time_dependent()
+            && r.coupling.max_value() > 0.0
+            && !self.dissipative
+            && alone
+    }
+
+    /// Whether any resonator is harmonic ([`Model::is_harmonic`]).
+    pub fn has_harmonic_resonator(&self) -> bool {
+        (0..self.resonators.len()).any(|j| self.is_harmonic(j))
     }
 
     /// The fastest a contact of a chain under a [`ContactLaw`] vibrates in a motion of total
@@ -384,7 +418,7 @@ mod tests {
         assert!(cubic.omega_within(1.0, 2.0) > cubic.omega_within(1.0, 0.5));
         let model = Model::new(5, Boundary::Fixed, vec![linear, res(3, 1.0, 3)]).unwrap();
         let fastest = linear.linear_omega(1.0).max(expected);
-        assert_eq!(model.max_resonator_omega(0.5), fastest);
+        assert_eq!(model.max_resonator_omega(0.5, false), fastest);
     }
 
     #[test]

@@ -9,7 +9,7 @@
 
 use super::{auto_first_step, Scenario};
 use crate::error::{OverBudget, StepSetBy};
-use crate::integrate::{intervals, MethodChoice, Plan, MAX_STEPS};
+use crate::integrate::{intervals, Method, MethodChoice, Plan, MAX_STEPS};
 use crate::SimError;
 
 /// Seconds one step of one site costs `auto` on a chain whose moving window spans it, as
@@ -82,22 +82,22 @@ pub fn check(scenario: &Scenario) -> Result<(), SimError> {
     let (dt, set_by) = match (scenario.method, plan.dt()) {
         (MethodChoice::Auto, _) => {
             let dt = auto_first_step(scenario, &plan);
-            (dt, cause(scenario, dt, for_tolerance))
+            (dt, cause(scenario, plan.method, dt, for_tolerance))
         }
         (MethodChoice::Named(_), Some(dt)) if scenario.accuracy.dt.is_some() => (dt, StepSetBy::Dt),
-        (MethodChoice::Named(_), Some(dt)) => (dt, cause(scenario, dt, for_tolerance)),
+        (MethodChoice::Named(_), Some(dt)) => (dt, cause(scenario, plan.method, dt, for_tolerance)),
         // An adaptive method cannot step past its stability limit on the fastest resonator.
         (MethodChoice::Named(method), None) => {
             let energy = scenario.impact_energy();
             let omega = model
-                .max_resonator_omega(energy)
+                .max_resonator_omega(energy, false)
                 .max(model.max_contact_omega(energy));
             let dt = if omega > 0.0 {
                 method.stability_limit() / omega
             } else {
                 f64::INFINITY
             };
-            (dt, cause(scenario, dt, f64::INFINITY))
+            (dt, cause(scenario, plan.method, dt, f64::INFINITY))
         }
     };
     let steps = (scenario.t_end / dt).max(intervals(scenario.t_end, scenario.sample_every) as f64);
@@ -115,23 +115,19 @@ pub fn check(scenario: &Scenario) -> Result<(), SimError> {
 }
 
 /// Whether `dt` is the tolerance's step (`for_tolerance`) or a resonator's cap, and which.
-fn cause(scenario: &Scenario, dt: f64, for_tolerance: f64) -> StepSetBy {
+fn cause(scenario: &Scenario, method: Method, dt: f64, for_tolerance: f64) -> StepSetBy {
     if dt >= for_tolerance * (1.0 - 1e-12) {
         return StepSetBy::Tolerance;
     }
     let energy = scenario.impact_energy();
     let model = &scenario.model;
-    if model.max_contact_omega(energy) >= model.max_resonator_omega(energy) {
-        return StepSetBy::Contacts;
-    }
-    let fastest = model
-        .resonators()
-        .iter()
-        .enumerate()
-        .map(|(i, r)| (i, r.omega_within(model.site_mass(r.site), energy)))
-        .max_by(|a, b| a.1.total_cmp(&b.1));
-    match fastest {
-        Some((i, _)) => StepSetBy::Resonator(i),
-        None => StepSetBy::Tolerance,
+    // The resonator whose cap is the smallest: a harmonic one that `method` integrates
+    // exactly is capped less tightly than one it steps through.
+    let tightest = (0..model.resonators().len())
+        .map(|j| (j, Plan::resonator_dt(model, method, j, energy)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    match tightest {
+        Some((j, cap)) if cap < Plan::contact_dt(model, energy) => StepSetBy::Resonator(j),
+        _ => StepSetBy::Contacts,
     }
 }

@@ -131,6 +131,7 @@ fn step_checked<O: Observer + ?Sized>(
 pub fn auto_first_step(scenario: &Scenario, plan: &Plan) -> f64 {
     plan.dt().unwrap_or(0.01).min(Plan::resolving_dt(
         &scenario.model,
+        plan.method,
         scenario.impact_energy(),
     ))
 }
