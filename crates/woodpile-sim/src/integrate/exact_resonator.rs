@@ -29,19 +29,9 @@
 //! method keeps the tableau's order conditions; for any θ the free vibration (g = 0) and a
 //! constant forcing are integrated exactly.
 
+use super::contact_event::{oscillating_path_integrals, BondPath};
+use super::erkn_weights::{pair_step, NystromWeights, PairStep};
 use crate::model::Model;
-
-/// What the extended step needs of a Nyström tableau ending on the force at the new position
-/// (FSAL): its nodes and both weight vectors.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct NystromWeights<const S: usize> {
-    /// Stage times.
-    pub c: [f64; S],
-    /// Position weights (times h²), also the last stage's row.
-    pub b: [f64; S],
-    /// Velocity weights (times h).
-    pub b_prime: [f64; S],
-}
 
 /// One host site and its harmonic resonator.
 #[derive(Debug, Clone, Copy)]
@@ -57,36 +47,35 @@ struct Pair {
     mode: [f64; 2],
 }
 
-/// A pair's coefficient changes for one step size h, θ = ω h: what the ERKN step adds to the
-/// plain tableau's, as multiples of the fast mode.
-#[derive(Debug, Clone, Copy)]
-struct PairStep<const S: usize> {
-    theta: f64,
-    /// Stage i: φ0(c_i²θ²) − 1 (times the stretch) and c_i h (φ1(c_i²θ²) − 1) (times its rate).
-    stage_q: [f64; S],
-    stage_p: [f64; S],
-    /// h² (ā_ij(θ²) − a_ij).
-    stage_g: [[f64; S]; S],
-    /// The new velocity: −θ sin θ / h, cos θ − 1 and h (b_i(θ²) − b_i(0)).
-    velocity_q: f64,
-    velocity_p: f64,
-    velocity_g: [f64; S],
-    /// The weight functions at θ² themselves (unscaled), for the contact correction: the new
-    /// velocity's b_i and the new position's b̄_i.
-    b_velocity: [f64; S],
-    b_position: [f64; S],
-}
-
 /// The harmonic pairs of a model and their coefficients for the step size last prepared.
 #[derive(Debug, Clone)]
 pub(crate) struct ExactResonators<const S: usize> {
     tableau: NystromWeights<S>,
-    pairs: Vec<Pair>,
+    /// Each pair with its coefficients and its state in the step being taken, side by side:
+    /// the stage loop reads all three.
+    pairs: Vec<Oscillator<S>>,
     /// Each site's pair, if it hosts one: the contact correction asks per corrected bond.
     pair_of_site: Vec<Option<usize>>,
-    steps: Vec<PairStep<S>>,
-    /// The step size `steps` are for.
+    /// The step size the coefficients are for.
     h: f64,
+}
+
+/// One pair: its constants, its coefficients for the step size, and the step being taken.
+#[derive(Debug, Clone)]
+struct Oscillator<const S: usize> {
+    pair: Pair,
+    step: PairStep<S>,
+    now: PairNow<S>,
+}
+
+/// A pair in the step being taken: whether its host is in the window, its stretch u − v and
+/// rate at the step's start, and its share of each stage's forcing (g_host − g_resonator).
+#[derive(Debug, Clone, Copy)]
+struct PairNow<const S: usize> {
+    active: bool,
+    stretch: f64,
+    rate: f64,
+    forcing: [f64; S],
 }
 
 impl<const S: usize> ExactResonators<S> {
@@ -98,7 +87,7 @@ impl<const S: usize> ExactResonators<S> {
             tableau.c[S - 1] == 1.0,
             "an exact resonator step needs an FSAL tableau"
         );
-        let pairs: Vec<Pair> = (0..model.resonators().len())
+        let pairs: Vec<Oscillator<S>> = (0..model.resonators().len())
             .filter(|&j| model.is_harmonic(j))
             .map(|j| {
                 let r = model.resonators()[j];
@@ -107,105 +96,120 @@ impl<const S: usize> ExactResonators<S> {
                 let inv_eps = 1.0 / r.eps;
                 let omega_squared = kappa * (inv_host_mass + inv_eps);
                 let scale = kappa / omega_squared;
-                Pair {
+                let pair = Pair {
                     host: r.site,
                     resonator: model.n_sites() + j,
                     kappa,
                     inv_host_mass,
-
                     omega: omega_squared.sqrt(),
                     mode: [scale * inv_host_mass, -scale * inv_eps],
+                };
+                let now = PairNow {
+                    active: false,
+                    stretch: 0.0,
+                    rate: 0.0,
+                    forcing: [0.0; S],
+                };
+                Oscillator {
+                    pair,
+                    step: pair_step(&tableau, 0.0, 1.0),
+                    now,
                 }
             })
             .collect();
         let mut pair_of_site = vec![None; model.n_sites()];
-        for (k, pair) in pairs.iter().enumerate() {
-            pair_of_site[pair.host] = Some(k);
+        for (k, o) in pairs.iter().enumerate() {
+            pair_of_site[o.pair.host] = Some(k);
         }
-        (!pairs.is_empty()).then(|| Self {
+        (!pairs.is_empty()).then_some(Self {
             tableau,
             pairs,
             pair_of_site,
-            steps: Vec::new(),
             h: f64::NAN,
         })
     }
 
     /// Makes the coefficients those of step size `h` (computed only when it changed).
-    pub fn prepare(&mut self, h: f64) {
+    fn prepare(&mut self, h: f64) {
         if h == self.h {
             return;
         }
         self.h = h;
-        let tableau = self.tableau;
-        self.steps = self
-            .pairs
-            .iter()
-            .map(|p| pair_step(&tableau, p.omega * h, h))
-            .collect();
+        for o in &mut self.pairs {
+            o.step = pair_step(&self.tableau, o.pair.omega * h, h);
+        }
     }
 
-    /// Turns stage accelerations `acc` (of positions `q`) into the forcing g: each pair's spring
-    /// force taken out of its host's acceleration, and its resonator's set to zero (a
-    /// resonator feels its spring only). Pairs whose host is outside `lo..=hi` are at rest.
+    /// Starts a step of size `h` from `(q, p)` on the sites `lo..=hi`: prepares the
+    /// coefficients and notes each pair's stretch and its rate (a pair whose host is outside
+    /// the window is at rest and takes no part).
     #[inline(always)]
-    pub fn to_forcing(&self, q: &[f64], acc: &mut [f64], (lo, hi): (usize, usize)) {
-        for p in &self.pairs {
-            if p.host < lo || p.host > hi {
-                continue;
+    pub fn begin_step(&mut self, h: f64, (q, p): (&[f64], &[f64]), (lo, hi): (usize, usize)) {
+        self.prepare(h);
+        for o in &mut self.pairs {
+            let (host, resonator) = (o.pair.host, o.pair.resonator);
+            o.now.active = host >= lo && host <= hi;
+            if o.now.active {
+                o.now.stretch = q[host] - q[resonator];
+                o.now.rate = p[host] - p[resonator];
             }
-            acc[p.host] += p.kappa * (q[p.host] - q[p.resonator]) * p.inv_host_mass;
-            acc[p.resonator] = 0.0;
+        }
+    }
+
+    /// Turns stage `i`'s accelerations `acc` (of positions `q`) into the forcing g: each
+    /// pair's spring force taken out of its host's acceleration, and its resonator's set to
+    /// zero (a resonator feels its spring only). Keeps the pair's share of g for the shifts.
+    #[inline(always)]
+    pub fn remove_springs(&mut self, i: usize, q: &[f64], acc: &mut [f64]) {
+        for o in &mut self.pairs {
+            if o.now.active {
+                let (host, resonator) = (o.pair.host, o.pair.resonator);
+                acc[host] += o.pair.kappa * (q[host] - q[resonator]) * o.pair.inv_host_mass;
+                acc[resonator] = 0.0;
+                o.now.forcing[i] = acc[host] - acc[resonator];
+            }
+        }
+    }
+
+    /// Stage `to`'s forcing is stage `from`'s (a stage the next step reuses, FSAL).
+    pub fn reuse_stage(&mut self, from: usize, to: usize) {
+        for o in &mut self.pairs {
+            o.now.forcing[to] = o.now.forcing[from];
         }
     }
 
     /// Adds stage `i`'s shift along each pair's fast mode to the stage position `q_stage`
-    /// (already the plain tableau's), from the step's start (`q`, `p`) and the forcings `g` of
-    /// the stages before it.
+    /// (already the plain tableau's), from the step's start and the forcings of the stages
+    /// before it.
     #[inline(always)]
-    pub fn shift_stage(
-        &self,
-        i: usize,
-        (q, p): (&[f64], &[f64]),
-        g: &[Vec<f64>; S],
-        q_stage: &mut [f64],
-        (lo, hi): (usize, usize),
-    ) {
-        for (pair, step) in self.pairs.iter().zip(&self.steps) {
-            if pair.host < lo || pair.host > hi {
-                continue;
+    pub fn shift_stage(&self, i: usize, q_stage: &mut [f64]) {
+        for o in &self.pairs {
+            if o.now.active {
+                let (step, now) = (&o.step, &o.now);
+                let mut shift = step.stage_q[i] * now.stretch + step.stage_p[i] * now.rate;
+                for (weight, g) in step.stage_g[i][..i].iter().zip(&now.forcing) {
+                    shift += weight * g;
+                }
+                q_stage[o.pair.host] += shift * o.pair.mode[0];
+                q_stage[o.pair.resonator] += shift * o.pair.mode[1];
             }
-            let stretch = |x: &[f64]| x[pair.host] - x[pair.resonator];
-            let mut shift = step.stage_q[i] * stretch(q) + step.stage_p[i] * stretch(p);
-            for (j, g_j) in g.iter().enumerate().take(i) {
-                shift += step.stage_g[i][j] * stretch(g_j);
-            }
-            q_stage[pair.host] += shift * pair.mode[0];
-            q_stage[pair.resonator] += shift * pair.mode[1];
         }
     }
 
     /// Adds each pair's fast-mode shift to the new velocity `new_p` (already the plain
     /// tableau's). The new position needs none of its own: it is the last stage's.
     #[inline(always)]
-    pub fn shift_velocity(
-        &self,
-        (q, p): (&[f64], &[f64]),
-        g: &[Vec<f64>; S],
-        new_p: &mut [f64],
-        (lo, hi): (usize, usize),
-    ) {
-        for (pair, step) in self.pairs.iter().zip(&self.steps) {
-            if pair.host < lo || pair.host > hi {
-                continue;
+    pub fn shift_velocity(&self, new_p: &mut [f64]) {
+        for o in &self.pairs {
+            if o.now.active {
+                let (step, now) = (&o.step, &o.now);
+                let mut shift = step.velocity_q * now.stretch + step.velocity_p * now.rate;
+                for (weight, g) in step.velocity_g.iter().zip(&now.forcing) {
+                    shift += weight * g;
+                }
+                new_p[o.pair.host] += shift * o.pair.mode[0];
+                new_p[o.pair.resonator] += shift * o.pair.mode[1];
             }
-            let stretch = |x: &[f64]| x[pair.host] - x[pair.resonator];
-            let mut shift = step.velocity_q * stretch(q) + step.velocity_p * stretch(p);
-            for (weight, g_i) in step.velocity_g.iter().zip(g) {
-                shift += weight * stretch(g_i);
-            }
-            new_p[pair.host] += shift * pair.mode[0];
-            new_p[pair.resonator] += shift * pair.mode[1];
         }
     }
 
@@ -213,7 +217,7 @@ impl<const S: usize> ExactResonators<S> {
     /// force on the host, `P e_host / m` (host and resonator entries).
     pub fn host(&self, site: usize) -> Option<HostOf<S>> {
         let k = self.pair_of_site[site]?;
-        let (pair, step) = (&self.pairs[k], &self.steps[k]);
+        let (pair, step) = (&self.pairs[k].pair, &self.pairs[k].step);
         Some(HostOf {
             host: pair.host,
             resonator: pair.resonator,
@@ -242,220 +246,53 @@ pub(crate) struct HostOf<const S: usize> {
     pub b_position: [f64; S],
 }
 
-/// The coefficient changes of one pair at θ = ω h for step size `h`.
-fn pair_step<const S: usize>(tableau: &NystromWeights<S>, theta: f64, h: f64) -> PairStep<S> {
-    let c = tableau.c;
-    let mut stage_q = [0.0; S];
-    let mut stage_p = [0.0; S];
-    let mut stage_g = [[0.0; S]; S];
-    for i in 1..S {
-        let phi = phis(c[i] * c[i] * theta * theta);
-        stage_q[i] = phi[0] - 1.0;
-        stage_p[i] = c[i] * h * (phi[1] - 1.0);
-        let change: [f64; S] = position_weight_change(&c[..i], c[i], theta);
-        for j in 0..i {
-            stage_g[i][j] = h * h * change[j];
+/// A conservative bond's impulse and moment along its path under the fast-mode weights of a
+/// host whose resonator is integrated exactly ([`oscillating_path_integrals`]).
+fn oscillating_bond_integrals(
+    model: &Model,
+    bond: usize,
+    path: &BondPath,
+    h: f64,
+    theta: f64,
+) -> (f64, f64) {
+    match model.contacts() {
+        None => oscillating_path_integrals(path, h, theta, |d| d * d.sqrt()),
+        Some(law) => {
+            let a = law.coefficient(bond);
+            let (impulse, moment) = oscillating_path_integrals(path, h, theta, |d| law.power(d));
+            (a * impulse, a * moment)
         }
-    }
-    let phi = phis(theta * theta);
-    let velocity_change = velocity_weight_change(&c, theta);
-    let position_change: [f64; S] = position_weight_change(&c[..S - 1], 1.0, theta);
-    PairStep {
-        theta,
-        stage_q,
-        stage_p,
-        stage_g,
-        velocity_q: -theta * theta * phi[1] / h,
-        velocity_p: phi[0] - 1.0,
-        velocity_g: std::array::from_fn(|i| h * velocity_change[i]),
-        b_velocity: std::array::from_fn(|i| tableau.b_prime[i] + velocity_change[i]),
-        b_position: std::array::from_fn(|i| tableau.b[i] + position_change[i]),
     }
 }
 
-/// φ_0 ..= φ_7 at x = θ² ≥ 0: φ_j(x) = Σ_m (−x)^m / (2m + j)!, so φ_0 = cos θ and
-/// φ_1 = sin θ / θ. The series for x ≤ 16 (its terms then fall from the first for j ≥ 2, or
-/// cancel by at most a factor 10), the recurrence φ_{j+2} = (1/j! − φ_j) / x beyond.
-pub(crate) fn phis(x: f64) -> [f64; 8] {
-    let theta = x.sqrt();
-    let mut phi = [0.0; 8];
-    phi[0] = theta.cos();
-    phi[1] = if theta == 0.0 {
-        1.0
-    } else {
-        theta.sin() / theta
-    };
-    let mut factorial = [1.0f64; 48];
-    for k in 1..48 {
-        factorial[k] = factorial[k - 1] * k as f64;
-    }
-    for j in 2..8 {
-        phi[j] = if x <= 16.0 {
-            let mut sum = 0.0;
-            let mut power = 1.0;
-            for m in 0..20 {
-                sum += power / factorial[2 * m + j];
-                power *= -x;
-            }
-            sum
-        } else {
-            (1.0 / factorial[j - 2] - phi[j - 2]) / x
-        };
-    }
-    phi
-}
-
-/// The change from θ = 0 to θ of the interpolatory weights on `nodes` (fractions of the step)
-/// of the position integral to `end`: ∫_0^end (end − z) φ1((end − z)² θ²) g(z) dz, whose
-/// moments are ∫ z^k … = k! end^{k+2} φ_{k+2}(end² θ²).
-fn position_weight_change<const S: usize>(nodes: &[f64], end: f64, theta: f64) -> [f64; S] {
-    let moments = |x: f64| {
-        let phi = phis(end * end * x);
-        let mut out = [0.0; S];
-        let mut scale = end * end;
-        for k in 0..nodes.len() {
-            out[k] = scale * phi[k + 2];
-            scale *= (k + 1) as f64 * end;
-        }
-        out
-    };
-    weight_change(nodes, moments(theta * theta), moments(0.0))
-}
-
-/// The change from θ = 0 to θ of the interpolatory weights on `nodes` of the velocity
-/// integral ∫_0^1 φ0((1 − z)² θ²) g(z) dz, whose moments are k! φ_{k+1}(θ²).
-fn velocity_weight_change<const S: usize>(nodes: &[f64; S], theta: f64) -> [f64; S] {
-    let moments = |x: f64| {
-        let phi = phis(x);
-        let mut out = [0.0; S];
-        let mut factorial = 1.0;
-        for k in 0..S {
-            out[k] = factorial * phi[k + 1];
-            factorial *= (k + 1) as f64;
-        }
-        out
-    };
-    weight_change(nodes, moments(theta * theta), moments(0.0))
-}
-
-/// w(θ) − w(0) for the interpolatory weights w on `nodes` with moments `at_theta` and
-/// `at_zero` (Σ_i w_i c_i^k = moment_k): one solve of the Vandermonde system with their
-/// difference.
-fn weight_change<const S: usize>(nodes: &[f64], at_theta: [f64; S], at_zero: [f64; S]) -> [f64; S] {
-    let n = nodes.len();
-    let mut rhs = [0.0; S];
-    for k in 0..n {
-        rhs[k] = at_theta[k] - at_zero[k];
-    }
-    let mut matrix = [[0.0; S]; S];
-    for (k, row) in matrix.iter_mut().enumerate().take(n) {
-        for (i, node) in nodes.iter().enumerate() {
-            row[i] = node.powi(k as i32);
-        }
-    }
-    solve(&mut matrix, &mut rhs, n);
-    rhs
-}
-
-/// Solves the leading n × n system in place by Gaussian elimination with partial pivoting.
-fn solve<const S: usize>(matrix: &mut [[f64; S]; S], rhs: &mut [f64; S], n: usize) {
-    for col in 0..n {
-        let pivot = (col..n)
-            .max_by(|&a, &b| matrix[a][col].abs().total_cmp(&matrix[b][col].abs()))
-            .unwrap_or(col);
-        matrix.swap(col, pivot);
-        rhs.swap(col, pivot);
-        let pivot_row = matrix[col];
-        for row in col + 1..n {
-            let factor = matrix[row][col] / pivot_row[col];
-            for (entry, pivot_entry) in matrix[row][col..n].iter_mut().zip(&pivot_row[col..n]) {
-                *entry -= factor * pivot_entry;
-            }
-            rhs[row] -= factor * rhs[col];
-        }
-    }
-    for col in (0..n).rev() {
-        let mut value = rhs[col];
-        for (entry, solved) in matrix[col][col + 1..n].iter().zip(&rhs[col + 1..n]) {
-            value -= entry * solved;
-        }
-        rhs[col] = value / matrix[col][col];
+/// The part of a bond's correction that reaches a host's fast mode in an extended Nyström step
+/// (`erkn6-contact`, [`ExactResonators`]). The plain correction (impulse − quadrature) acts on
+/// the host as on any site; the fast mode's share of the force is integrated with the
+/// variation-of-constants weights instead, so this adds the difference of the two
+/// corrections, (weighted integral − weighted quadrature) − (plain correction), along the fast
+/// mode. `sign` is −1 for the bond's left member, +1 for its right.
+pub(crate) fn fast_mode_correction<const S: usize>(
+    model: &Model,
+    (bond, path, stage): (usize, &BondPath, [f64; S]),
+    h: f64,
+    (plain_impulse, plain_moment): (f64, f64),
+    (pair, sign): (HostOf<S>, f64),
+) -> FastModeCorrection {
+    let (impulse, moment) = oscillating_bond_integrals(model, bond, path, h, pair.theta);
+    let weigh = |w: &[f64; S]| w.iter().zip(&stage).map(|(w, f)| w * f).sum::<f64>();
+    let extra_impulse = (impulse - h * weigh(&pair.b_velocity)) - plain_impulse;
+    let extra_moment = (moment - h * h * weigh(&pair.b_position)) - plain_moment;
+    FastModeCorrection {
+        sites: [pair.host, pair.resonator],
+        velocity: pair.share.map(|s| sign * extra_impulse * s),
+        position: pair.share.map(|s| sign * extra_moment * s),
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::integrate::DPRKN6;
-
-    const DPRKN6_WEIGHTS: NystromWeights<6> = NystromWeights {
-        c: DPRKN6.c,
-        b: DPRKN6.b,
-        b_prime: DPRKN6.b_prime,
-    };
-
-    /// The φ functions by series and by recurrence agree where both are accurate, and match
-    /// their closed forms.
-    #[test]
-    fn phi_functions_match_their_closed_forms() {
-        for x in [0.0, 0.3, 2.0, 9.0, 16.0, 25.0, 100.0] {
-            let phi = phis(x);
-            let theta: f64 = x.sqrt();
-            assert!((phi[0] - theta.cos()).abs() < 1e-15);
-            if x > 0.0 {
-                assert!((phi[2] - (1.0 - theta.cos()) / x).abs() < 1e-14, "φ2({x})");
-                assert!(
-                    (phi[3] - (1.0 - theta.sin() / theta) / x).abs() < 1e-14,
-                    "φ3({x})"
-                );
-            }
-            for j in 2..6 {
-                let by_recurrence =
-                    (1.0 / [1.0, 1.0, 2.0, 6.0, 24.0, 120.0][j - 2] - phi[j - 2]) / x;
-                if x >= 9.0 {
-                    assert!(
-                        (phi[j] - by_recurrence).abs() < 1e-12 * phi[j].abs().max(1e-3),
-                        "φ{j}({x})"
-                    );
-                }
-            }
-        }
-    }
-
-    /// With θ the velocity weights integrate φ0((1 − z)²θ²) z^k exactly for k < 6, and the
-    /// position weights (five nodes) (1 − z) φ1 z^k for k < 5; at θ = 0 they are DPRKN6's.
-    #[test]
-    fn weights_are_exact_for_polynomial_forcing() {
-        for theta in [0.0, 0.4, 1.3, 3.0] {
-            let step = pair_step(&DPRKN6_WEIGHTS, theta, 0.2);
-            let phi = phis(theta * theta);
-            let mut factorial = 1.0;
-            for k in 0..6 {
-                let sum: f64 = (0..6)
-                    .map(|i| step.b_velocity[i] * DPRKN6.c[i].powi(k))
-                    .sum();
-                assert!(
-                    (sum - factorial * phi[k as usize + 1]).abs() < 1e-13,
-                    "b θ={theta} k={k}"
-                );
-                if k < 5 {
-                    let sum: f64 = (0..6)
-                        .map(|i| step.b_position[i] * DPRKN6.c[i].powi(k))
-                        .sum();
-                    assert!(
-                        (sum - factorial * phi[k as usize + 2]).abs() < 1e-13,
-                        "b̄ θ={theta} k={k}"
-                    );
-                }
-                factorial *= f64::from(k + 1);
-            }
-            assert_eq!(
-                step.b_position[5], 0.0,
-                "the new position cannot use its own force"
-            );
-        }
-        let at_zero = pair_step(&DPRKN6_WEIGHTS, 0.0, 0.2);
-        assert_eq!(at_zero.b_velocity, DPRKN6.b_prime);
-        assert_eq!(at_zero.b_position, DPRKN6.b);
-    }
+/// A fast-mode correction: added to the host's and its resonator's velocity and position.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct FastModeCorrection {
+    pub sites: [usize; 2],
+    pub velocity: [f64; 2],
+    pub position: [f64; 2],
 }

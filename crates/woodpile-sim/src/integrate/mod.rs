@@ -19,6 +19,7 @@ mod contact_event;
 mod contact_scan;
 mod dop853;
 mod driver;
+mod erkn_weights;
 mod event_correction;
 mod exact_resonator;
 mod method;

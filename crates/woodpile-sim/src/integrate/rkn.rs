@@ -19,8 +19,9 @@
 //! *located*: the step is cut short at the first moment any contact of the window opens or
 //! closes, so that no step contains a kink, and the next step starts there.
 
+use super::erkn_weights::NystromWeights;
 use super::event_correction::{ContactEvents, Quadrature};
-use super::exact_resonator::{ExactResonators, NystromWeights};
+use super::exact_resonator::ExactResonators;
 use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
@@ -232,9 +233,8 @@ impl<const S: usize> Rkn<S> {
         let ranges = window.dof_ranges(model);
         let (q, v) = y.split_at(n);
         let tab = self.tableau;
-        let sites = (window.lo, window.hi);
         if let Some(exact) = self.exact.as_mut() {
-            exact.prepare(h);
+            exact.begin_step(h, (q, v), (window.lo, window.hi));
         }
         for i in 0..S {
             if i > 0 {
@@ -256,7 +256,7 @@ impl<const S: usize> Rkn<S> {
                     }
                 }
                 if let Some(exact) = &self.exact {
-                    exact.shift_stage(i, (q, v), &self.a, &mut self.q_stage, sites);
+                    exact.shift_stage(i, &mut self.q_stage);
                 }
             }
             if i == 0 && self.last_stage_current {
@@ -265,6 +265,9 @@ impl<const S: usize> Rkn<S> {
                 self.a.swap(0, S - 1);
                 if let Some(c) = self.contact.as_mut() {
                     c.reuse_stage(S - 1, 0);
+                }
+                if let Some(exact) = self.exact.as_mut() {
+                    exact.reuse_stage(S - 1, 0);
                 }
                 continue;
             }
@@ -277,8 +280,8 @@ impl<const S: usize> Rkn<S> {
                 (t + tab.c[i] * h, i),
                 window,
             );
-            if let Some(exact) = &self.exact {
-                exact.to_forcing(qs, &mut self.a[i], sites);
+            if let Some(exact) = self.exact.as_mut() {
+                exact.remove_springs(i, qs, &mut self.a[i]);
             }
         }
         let (new_q, new_v) = self.y_new.split_at_mut(n);
@@ -314,7 +317,7 @@ impl<const S: usize> Rkn<S> {
             }
         }
         if let Some(exact) = &self.exact {
-            exact.shift_velocity((q, v), &self.a, new_v, sites);
+            exact.shift_velocity(new_v);
         }
     }
 
