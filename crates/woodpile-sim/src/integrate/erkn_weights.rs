@@ -228,23 +228,16 @@ mod tests {
         for theta in [0.0, 0.4, 1.3, 3.0] {
             let step = pair_step(&DPRKN6_WEIGHTS, theta, 0.2);
             let phi = phis(theta * theta);
+            // Σ_i w_i c_i^k against its exact moment k! φ_j(θ²).
+            let moment =
+                |w: &[f64; 6], k: i32| -> f64 { (0..6).map(|i| w[i] * DPRKN6.c[i].powi(k)).sum() };
             let mut factorial = 1.0;
             for k in 0..6 {
-                let sum: f64 = (0..6)
-                    .map(|i| step.b_velocity[i] * DPRKN6.c[i].powi(k))
-                    .sum();
-                assert!(
-                    (sum - factorial * phi[k as usize + 1]).abs() < 1e-13,
-                    "b θ={theta} k={k}"
-                );
+                let velocity = moment(&step.b_velocity, k) - factorial * phi[k as usize + 1];
+                assert!(velocity.abs() < 1e-13, "b θ={theta} k={k}");
                 if k < 5 {
-                    let sum: f64 = (0..6)
-                        .map(|i| step.b_position[i] * DPRKN6.c[i].powi(k))
-                        .sum();
-                    assert!(
-                        (sum - factorial * phi[k as usize + 2]).abs() < 1e-13,
-                        "b̄ θ={theta} k={k}"
-                    );
+                    let position = moment(&step.b_position, k) - factorial * phi[k as usize + 2];
+                    assert!(position.abs() < 1e-13, "b̄ θ={theta} k={k}");
                 }
                 factorial *= f64::from(k + 1);
             }

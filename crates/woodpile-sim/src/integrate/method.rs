@@ -126,6 +126,18 @@ struct ErrorModel {
     order: f64,
 }
 
+/// The error model of DPRKN6 with exact contact events (`rkn6-contact`, `erkn6-contact`).
+/// Order 6 between contact events; across them the fractions' errors fall about 7-fold per
+/// halving from 0.2 to 0.1 (worst over 25 sweep scenes: 1.7e-6 to 2.3e-7, the `error_split`
+/// example), so the Richardson estimate assumes order 3. The coefficient puts the first step
+/// at 0.1 for tolerance 1e-6, where the worst measured error is 2.3e-7, and 0.215 for 1e-5: a
+/// smaller first step costs more evaluations over the surveys at 1e-5 and 1e-6, where the
+/// sweeps run, and a larger one more halvings.
+const RKN6_ERROR: ErrorModel = ErrorModel {
+    coef: 1e-3,
+    order: 3.0,
+};
+
 /// One row per method, in the order of [`Method::ALL`] (a test checks it).
 const FACTS: [Facts; 9] = [
     Facts {
@@ -173,16 +185,7 @@ const FACTS: [Facts; 9] = [
         // ωh = 0.5 and 4e-6 at 1 (computed), so its bound is the growth it may accumulate, not
         // an edge.
         stability_limit: 1.0,
-        // Order 6 between contact events; across them the fractions' errors fall about 7-fold
-        // per halving from 0.2 to 0.1 (worst over 25 sweep scenes: 1.7e-6 to 2.3e-7, the
-        // `error_split` example), so the Richardson estimate assumes order 3. The coefficient
-        // puts the first step at 0.1 for tolerance 1e-6, where the worst measured error is
-        // 2.3e-7, and 0.215 for 1e-5: a smaller first step costs more evaluations over the
-        // surveys at 1e-5 and 1e-6, where the sweeps run, and a larger one more halvings.
-        error: ErrorModel {
-            coef: 1e-3,
-            order: 3.0,
-        },
+        error: RKN6_ERROR,
     },
     Facts {
         name: "erkn6-contact",
@@ -193,10 +196,7 @@ const FACTS: [Facts; 9] = [
         // ramped), which it integrates as `rkn6-contact` does.
         stability_limit: 1.0,
         // As `rkn6-contact`'s, which it is wherever no harmonic resonator vibrates.
-        error: ErrorModel {
-            coef: 1e-3,
-            order: 3.0,
-        },
+        error: RKN6_ERROR,
     },
     Facts {
         name: "verlet",
