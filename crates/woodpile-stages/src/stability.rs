@@ -18,7 +18,8 @@
 //!
 //! With `step = "dt_omega"` the linear stability bound of each method (dt·ω = 2√2 for RK4, 2 for
 //! Verlet, ...) is a vertical line on the map, and `auto`'s largest step (dt·ω = 0.5, never above
-//! 0.9 of the bound) can be read off against it. Output: one row per run with the method, the
+//! 0.9 of the bound; dt·ω = 2 where it integrates the resonator exactly, `erkn6-contact`) can
+//! be read off against it. Output: one row per run with the method, the
 //! value (and its log10), the requested `step` (the map's grid), the step dt actually taken
 //! (t_end tiled by equal steps, within 1% of the request) and its dt·ω, the method's linear
 //! bound as a dt, `auto`'s first step, both again in the map's step unit as `log10_bound_step`

@@ -168,7 +168,7 @@ impl Plan {
     /// Whether `auto` should integrate `model`'s harmonic resonators exactly at tolerance `tol`:
     /// when the coarse run of its first pair, at twice the tolerance's step, would take the
     /// fastest of them past ω dt = [`MAX_OMEGA_DT`], beyond which DPRKN6 does not resolve it.
-    /// Below that the plain step is as accurate and cheaper: the exact one spends about 9% more
+    /// Below that the plain step is as accurate and cheaper: the exact one spends about 8% more
     /// instructions a step on a chain of 100 sites with two heavy resonators (callgrind), for
     /// nothing. So the paper's heavy resonators keep `rkn6-contact` and its numbers.
     fn exact_step_pays(model: &Model, tol: f64) -> bool {
