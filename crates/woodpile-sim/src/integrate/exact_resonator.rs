@@ -166,7 +166,8 @@ impl<const S: usize> ExactResonators<S> {
                 let (host, resonator) = (o.pair.host, o.pair.resonator);
                 acc[host] += o.pair.kappa * (q[host] - q[resonator]) * o.pair.inv_host_mass;
                 acc[resonator] = 0.0;
-                o.now.forcing[i] = acc[host] - acc[resonator];
+                // The pair's share of g, g_host − g_resonator, with the latter now zero.
+                o.now.forcing[i] = acc[host];
             }
         }
     }

@@ -280,11 +280,6 @@ impl Model {
             && alone
     }
 
-    /// Whether any resonator is harmonic ([`Model::is_harmonic`]).
-    pub fn has_harmonic_resonator(&self) -> bool {
-        (0..self.resonators.len()).any(|j| self.is_harmonic(j))
-    }
-
     /// The fastest a contact of a chain under a [`ContactLaw`] vibrates in a motion of total
     /// energy `energy`: sqrt(k (1/m_left + 1/m_right)) at the stiffness k the bond has at the
     /// largest overlap the energy allows ([`ContactLaw::overlap_within`]); a wall counts as
