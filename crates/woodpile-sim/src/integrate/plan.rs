@@ -151,17 +151,8 @@ impl Plan {
     pub fn dt_for(model: &Model, method: Method, tol: f64) -> f64 {
         let exact = method.integrates_harmonic_exactly();
         let omega = model.max_linear_omega(exact);
-        let resolved = if omega > 0.0 {
-            MAX_OMEGA_DT / omega
-        } else {
-            f64::INFINITY
-        }
-        .min(Self::harmonic_dt(model, method));
-        let stable = if omega > 0.0 {
-            0.9 * method.stability_limit() / omega
-        } else {
-            f64::INFINITY
-        };
+        let resolved = step_within(MAX_OMEGA_DT, omega).min(Self::harmonic_dt(model, method));
+        let stable = step_within(0.9 * method.stability_limit(), omega);
         Self::tolerance_dt(method, tol).min(resolved).min(stable)
     }
 
@@ -196,12 +187,7 @@ impl Plan {
             .max_resonator_omega(energy, method.integrates_harmonic_exactly())
             .max(model.max_contact_omega(energy))
             .max(model.max_dissipation_rate(energy));
-        let resolved = if omega > 0.0 {
-            MAX_OMEGA_DT / omega
-        } else {
-            f64::INFINITY
-        };
-        resolved.min(Self::harmonic_dt(model, method))
+        step_within(MAX_OMEGA_DT, omega).min(Self::harmonic_dt(model, method))
     }
 
     /// The step resonator `j` of `model` allows `method` in a motion of total energy `energy`:
@@ -214,33 +200,22 @@ impl Plan {
             true => MAX_HARMONIC_OMEGA_DT,
             false => MAX_OMEGA_DT,
         };
-        if omega > 0.0 {
-            cap / omega
-        } else {
-            f64::INFINITY
-        }
+        step_within(cap, omega)
     }
 
     /// The step the stiffest contact of `model` allows in a motion of total energy `energy`
     /// (infinite for the paper's chain, [`Model::max_contact_omega`]).
     pub fn contact_dt(model: &Model, energy: f64) -> f64 {
-        let omega = model.max_contact_omega(energy);
-        if omega > 0.0 {
-            MAX_OMEGA_DT / omega
-        } else {
-            f64::INFINITY
-        }
+        step_within(MAX_OMEGA_DT, model.max_contact_omega(energy))
     }
 
     /// The cap a method that integrates harmonic resonators exactly keeps on them
     /// ([`MAX_HARMONIC_OMEGA_DT`]); none for other methods, which resolve them by
     /// [`MAX_OMEGA_DT`].
     fn harmonic_dt(model: &Model, method: Method) -> f64 {
-        let omega = model.max_harmonic_omega();
-        if method.integrates_harmonic_exactly() && omega > 0.0 {
-            MAX_HARMONIC_OMEGA_DT / omega
-        } else {
-            f64::INFINITY
+        match method.integrates_harmonic_exactly() {
+            true => step_within(MAX_HARMONIC_OMEGA_DT, model.max_harmonic_omega()),
+            false => f64::INFINITY,
         }
     }
 
@@ -311,5 +286,14 @@ impl Plan {
             Method::Yoshida6 => Box::new(SymplecticStepper::new(model, YOSHIDA6)),
             Method::Dop853 => Box::new(Dop853::new(model, self.rtol, self.atol)),
         }
+    }
+}
+
+/// The largest step that keeps ω dt within `limit` for a frequency `omega` (none for 0).
+fn step_within(limit: f64, omega: f64) -> f64 {
+    if omega > 0.0 {
+        limit / omega
+    } else {
+        f64::INFINITY
     }
 }
