@@ -57,11 +57,16 @@ impl ActiveSites {
 
     /// Extends the moved sites after a step over `window`: only its margins can have changed.
     pub fn update(&mut self, model: &Model, y: &[f64], window: Window) {
+        let n_dof = model.n_dof();
+        self.update_by(window, |i| y[i] != 0.0 || y[n_dof + i] != 0.0);
+    }
+
+    /// [`ActiveSites::update`] for a state read through `moving(site)`: whether the site's
+    /// displacement or velocity is not zero (a lane of a batch, `super::lanes`).
+    pub(crate) fn update_by(&mut self, window: Window, moving: impl Fn(usize) -> bool) {
         if !self.enabled {
             return;
         }
-        let n_dof = model.n_dof();
-        let moving = |i: usize| y[i] != 0.0 || y[n_dof + i] != 0.0;
         self.moved = match self.moved {
             None => {
                 let lo = (window.lo..=window.hi).find(|&i| moving(i));

@@ -66,35 +66,14 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
     observer: &mut O,
 ) -> Result<Stats, SimError> {
     validate(cfg)?;
-    // The ledger E + D: the total energy itself for a conservative chain.
-    let e0 = ledger(model, 0.0, y);
     let h = match cfg.control {
         StepControl::Fixed { dt } => dt,
         StepControl::Adaptive { .. } => stepper.initial_step(model, 0.0, y, cfg.t_end),
     };
-    check_finite(y, 0.0)?;
-    observer.observe(model, 0.0, y);
-    let mut run = Stepping {
-        model,
-        cfg,
-        // Drift is measured (and bounded) only where energy is conserved and a relative
-        // drift exists.
-        tracks_drift: !model.is_time_dependent() && e0 > 0.0,
-        e0,
-        ends: WatchedEnds::new(model, y, e0),
-        active: ActiveSites::new(model, y, stepper.reach(), cfg.active_window),
-        stats: Stats::default(),
-        attempts: 0,
-        t: 0.0,
-        h,
-    };
+    let mut run = Stepping::start(model, cfg, y, (stepper.reach(), h), observer)?;
     let n_intervals = intervals(cfg.t_end, cfg.sample_every);
     for k in 1..=n_intervals {
-        let target = if k == n_intervals {
-            cfg.t_end
-        } else {
-            k as f64 * cfg.sample_every
-        };
+        let target = sample_time(cfg, k, n_intervals);
         run.cover(stepper, y, target)?;
         run.sample(y, observer)?;
     }
@@ -102,15 +81,24 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
     Ok(run.stats)
 }
 
+/// The time of sample `k` of `n_intervals` (the last is `t_end` itself).
+pub(super) fn sample_time(cfg: &DriveConfig, k: u64, n_intervals: u64) -> f64 {
+    if k == n_intervals {
+        cfg.t_end
+    } else {
+        k as f64 * cfg.sample_every
+    }
+}
+
 /// A run between samples: where it is, its next step, its active window and its statistics.
-struct Stepping<'a> {
+pub(super) struct Stepping<'a> {
     model: &'a Model,
     cfg: &'a DriveConfig,
     tracks_drift: bool,
     e0: f64,
     ends: WatchedEnds,
-    active: ActiveSites,
-    stats: Stats,
+    pub active: ActiveSites,
+    pub stats: Stats,
     /// Step attempts, rejected ones included (the adaptive budget).
     attempts: u64,
     t: f64,
@@ -118,7 +106,63 @@ struct Stepping<'a> {
     h: f64,
 }
 
-impl Stepping<'_> {
+impl<'a> Stepping<'a> {
+    /// A run of `model` from `y` at t = 0 by a stepper of `reach`, whose first step is `h`:
+    /// the start checked and shown to `observer`.
+    pub fn start<O: Observer + ?Sized>(
+        model: &'a Model,
+        cfg: &'a DriveConfig,
+        y: &[f64],
+        (reach, h): (usize, f64),
+        observer: &mut O,
+    ) -> Result<Self, SimError> {
+        // The ledger E + D: the total energy itself for a conservative chain.
+        let e0 = ledger(model, 0.0, y);
+        check_finite(y, 0.0)?;
+        observer.observe(model, 0.0, y);
+        Ok(Stepping {
+            model,
+            cfg,
+            // Drift is measured (and bounded) only where energy is conserved and a relative
+            // drift exists.
+            tracks_drift: !model.is_time_dependent() && e0 > 0.0,
+            e0,
+            ends: WatchedEnds::new(model, y, e0),
+            active: ActiveSites::new(model, y, reach, cfg.active_window),
+            stats: Stats::default(),
+            attempts: 0,
+            t: 0.0,
+            h,
+        })
+    }
+
+    /// The equal steps of at most `dt` that tile the way to `target`: their number and size.
+    pub fn tiling(&self, target: f64, dt: f64) -> (u64, f64) {
+        let span = target - self.t;
+        let n_steps = (span / dt - 1e-9).ceil().max(1.0) as u64;
+        (n_steps, span / n_steps as f64)
+    }
+
+    /// Counts a fixed step of size `h_eq` towards `target` (the `last` of its tiling lands on
+    /// it), and enforces the budget.
+    pub fn count_fixed_step(&mut self, last: bool, target: f64, h_eq: f64) -> Result<(), SimError> {
+        self.t = if last { target } else { self.t + h_eq };
+        self.stats.steps += 1;
+        self.stats.max_step = self.stats.max_step.max(h_eq);
+        if self.stats.steps > self.cfg.max_steps {
+            return Err(SimError::TooManySteps {
+                t: self.t,
+                max_steps: self.cfg.max_steps,
+            });
+        }
+        Ok(())
+    }
+
+    /// Where the run is.
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
     /// Advances from `t` to `target` by the step control's strategy.
     fn cover<S: Stepper + ?Sized>(
         &mut self,
@@ -140,9 +184,7 @@ impl Stepping<'_> {
         target: f64,
         dt: f64,
     ) -> Result<(), SimError> {
-        let span = target - self.t;
-        let n_steps = (span / dt - 1e-9).ceil().max(1.0) as u64;
-        let h_eq = span / n_steps as f64;
+        let (n_steps, h_eq) = self.tiling(target, dt);
         for i in 0..n_steps {
             let window = self.active.window();
             self.stats.site_steps += window.len() as u64;
@@ -156,19 +198,7 @@ impl Stepping<'_> {
                 },
             );
             self.active.update(self.model, y, window);
-            self.t = if i + 1 == n_steps {
-                target
-            } else {
-                self.t + h_eq
-            };
-            self.stats.steps += 1;
-            self.stats.max_step = self.stats.max_step.max(h_eq);
-            if self.stats.steps > self.cfg.max_steps {
-                return Err(SimError::TooManySteps {
-                    t: self.t,
-                    max_steps: self.cfg.max_steps,
-                });
-            }
+            self.count_fixed_step(i + 1 == n_steps, target, h_eq)?;
             check_finite_in(y, self.t, &window.state_ranges(self.model))?;
         }
         Ok(())
@@ -228,7 +258,7 @@ impl Stepping<'_> {
 
     /// At a sample: the energy drift checked, the ends watched, the observer told (and asked
     /// whether to stop).
-    fn sample<O: Observer + ?Sized>(
+    pub fn sample<O: Observer + ?Sized>(
         &mut self,
         y: &[f64],
         observer: &mut O,
@@ -259,7 +289,7 @@ pub fn intervals(t_end: f64, sample_every: f64) -> u64 {
     ((t_end / sample_every) - 1e-9).ceil().max(1.0) as u64
 }
 
-fn validate(cfg: &DriveConfig) -> Result<(), SimError> {
+pub(super) fn validate(cfg: &DriveConfig) -> Result<(), SimError> {
     let positive = |x: f64| x.is_finite() && x > 0.0;
     if !positive(cfg.t_end) {
         return Err(SimError::BadRun(format!(
@@ -291,7 +321,11 @@ fn check_finite(y: &[f64], t: f64) -> Result<(), SimError> {
 /// Fails if any entry of `y` in `ranges` is NaN or infinite. x - x is 0 for a finite x and NaN
 /// otherwise, and never overflows; eight independent partial sums let the loop vectorise.
 #[allow(unsafe_code)]
-fn check_finite_in(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {
+pub(super) fn check_finite_in(
+    y: &[f64],
+    t: f64,
+    ranges: &[std::ops::Range<usize>],
+) -> Result<(), SimError> {
     #[cfg(target_arch = "x86_64")]
     if crate::simd::avx2() {
         // SAFETY: `avx2()` is true only when the CPU has AVX2 and FMA.

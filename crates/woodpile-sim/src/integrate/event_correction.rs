@@ -29,7 +29,7 @@ const NEGLIGIBLE_FORCE: f64 = 1e-14;
 pub(crate) type BondSites = (usize, Option<usize>, Option<usize>);
 
 /// A bond's correction: (left site or None for a wall, right site or None, impulse, position).
-type Correction = (Option<usize>, Option<usize>, f64, f64);
+pub(super) type Correction = (Option<usize>, Option<usize>, f64, f64);
 
 /// Extra passes of a dissipative chain's corrections ([`ContactEvents::refine`]).
 const REFINE_PASSES: usize = 2;
@@ -50,14 +50,14 @@ fn apply(model: &Model, corrections: &[Correction], (new_q, new_v): (&mut [f64],
     }
 }
 
-fn negligible<const S: usize>(stage_forces: [f64; S], end_force: f64) -> bool {
+pub(super) fn negligible<const S: usize>(stage_forces: [f64; S], end_force: f64) -> bool {
     stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force < NEGLIGIBLE_FORCE
 }
 
 /// A bond's elastic force at the end of its path, and its impulse and moment along it: the
 /// paper's \[d\]_+^{3/2}, or the chain's [`ContactLaw`] (coefficient, exponent, and the static
 /// overlap added to the path by [`bond_path`]).
-fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
+pub(super) fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
     match model.contacts() {
         None => {
             let end = path.d1.max(0.0);
@@ -69,7 +69,12 @@ fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
 
 /// A bond's impulse and moment along its path, and the energy its dashpot dissipates there
 /// (0 for a conservative chain).
-fn bond_integrals(model: &Model, bond: usize, path: &BondPath, h: f64) -> (f64, f64, f64) {
+pub(super) fn bond_integrals(
+    model: &Model,
+    bond: usize,
+    path: &BondPath,
+    h: f64,
+) -> (f64, f64, f64) {
     if model.is_dissipative() {
         return damped_path_integrals(path, h, damped_force(model, bond));
     }

@@ -22,6 +22,7 @@ mod driver;
 mod erkn_weights;
 mod event_correction;
 mod exact_resonator;
+pub mod lanes;
 mod method;
 mod plan;
 mod rk;

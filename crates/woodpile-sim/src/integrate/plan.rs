@@ -258,16 +258,26 @@ impl Plan {
         observer: &mut O,
         active_window: bool,
     ) -> Result<Stats, SimError> {
-        let cfg = DriveConfig {
+        let cfg = self.drive_config((t_end, sample_every), active_window);
+        // One dynamic call a step picks the stepper; its loops inside are static.
+        drive(model, &mut *self.stepper(model), y, &cfg, observer)
+    }
+
+    /// What the driver is told of this plan for a run to `t_end`, sampled every
+    /// `sample_every`.
+    pub fn drive_config(
+        &self,
+        (t_end, sample_every): (f64, f64),
+        active_window: bool,
+    ) -> DriveConfig {
+        DriveConfig {
             t_end,
             sample_every,
             control: self.control,
             max_steps: super::MAX_STEPS,
             energy_drift_limit: Some(self.drift_limit),
             active_window,
-        };
-        // One dynamic call a step picks the stepper; its loops inside are static.
-        drive(model, &mut *self.stepper(model), y, &cfg, observer)
+        }
     }
 
     /// The stepper of the plan's method for `model`: the one place a method becomes code.

@@ -39,15 +39,23 @@ fn assumed_order(model: &Model, plan: &Plan) -> f64 {
     }
 }
 
+/// The runs of `auto`'s first pair, made already (in lanes, `super::lanes`): the coarse one at
+/// 2 dt, shown to the observer only to be cancelled, and the fine one at dt, shown to it.
+pub(super) struct FirstPair {
+    pub coarse: Result<Outcome, SimError>,
+    pub fine: Result<Outcome, SimError>,
+}
+
 /// `auto`: the ladder of steps dt, dt/2, ... each rung of which either accepts its pair of
 /// runs (dt and 2 dt, and a run at 1.5 dt where the scene needs it) or says why not and
-/// halves the step, until [`MAX_HALVINGS`].
+/// halves the step, until [`MAX_HALVINGS`]. With `first`, the first pair's runs are those.
 pub(super) fn verified<O: Observer + ?Sized>(
     scenario: &Scenario,
     plan: Plan,
     observer: &mut O,
+    first: Option<FirstPair>,
 ) -> Result<Outcome, SimError> {
-    let mut ladder = Ladder::start(scenario, plan, observer)?;
+    let mut ladder = Ladder::start(scenario, plan, observer, first)?;
     let mut why = Refusal::NoRunKeptEnergy;
     for halvings_left in (0..=MAX_HALVINGS).rev() {
         match ladder.rung(halvings_left)? {
@@ -110,6 +118,8 @@ struct Ladder<'a, O: Observer + ?Sized> {
     dt: f64,
     /// The run at 2 dt (None when it blew up).
     coarse: Option<Outcome>,
+    /// The first rung's fine run, when it was made before the ladder started.
+    first_fine: Option<Result<Outcome, SimError>>,
     /// The change between the two runs before `coarse` (4 dt and 2 dt), once made: the
     /// asymptotic-regime check.
     previous_change: Option<f64>,
@@ -118,8 +128,14 @@ struct Ladder<'a, O: Observer + ?Sized> {
 }
 
 impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
-    /// The ladder at `auto`'s first step, with the run at twice it made.
-    fn start(scenario: &'a Scenario, plan: Plan, observer: &'a mut O) -> Result<Self, SimError> {
+    /// The ladder at `auto`'s first step, with the run at twice it made (or taken from
+    /// `first`, with the first rung's fine run).
+    fn start(
+        scenario: &'a Scenario,
+        plan: Plan,
+        observer: &'a mut O,
+        first: Option<FirstPair>,
+    ) -> Result<Self, SimError> {
         let tol = scenario.accuracy.tolerance;
         let guarded = Plan {
             drift_limit: BLOW_UP_DRIFT,
@@ -127,7 +143,13 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
         };
         let dt = auto_first_step(scenario, &plan);
         let mut spent = 0;
-        let coarse = check_run(scenario, &guarded.with_dt(2.0 * dt), observer, &mut spent)?;
+        let (coarse, first_fine) = match first {
+            Some(FirstPair { coarse, fine }) => (kept(coarse, &mut spent)?, Some(fine)),
+            None => {
+                let plan = guarded.with_dt(2.0 * dt);
+                (check_run(scenario, &plan, observer, &mut spent)?, None)
+            }
+        };
         let order = assumed_order(&scenario.model, &plan);
         Ok(Ladder {
             scenario,
@@ -140,6 +162,7 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
             strictness: Strictness::of(&scenario.model, tol),
             dt,
             coarse,
+            first_fine,
             previous_change: None,
             spent,
             estimate: f64::INFINITY,
@@ -151,8 +174,14 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
     /// a scene error (not a blow-up) ends the ladder.
     fn rung(&mut self, halvings_left: u32) -> Result<Rung, SimError> {
         let (scenario, tol) = (self.scenario, self.tol);
-        self.observer.reset();
-        let fine = match run_plan(scenario, &self.guarded.with_dt(self.dt), self.observer) {
+        let run = match self.first_fine.take() {
+            Some(run) => run,
+            None => {
+                self.observer.reset();
+                run_plan(scenario, &self.guarded.with_dt(self.dt), self.observer)
+            }
+        };
+        let fine = match run {
             Ok(out) => out,
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
             Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
@@ -293,7 +322,12 @@ fn check_run<O: Observer + ?Sized>(
     observer: &O,
     spent: &mut u64,
 ) -> Result<Option<Outcome>, SimError> {
-    match run_plan(scenario, plan, &mut CancelOnly(observer)) {
+    kept(run_plan(scenario, plan, &mut CancelOnly(observer)), spent)
+}
+
+/// A verification run's result as [`check_run`] keeps it.
+fn kept(run: Result<Outcome, SimError>, spent: &mut u64) -> Result<Option<Outcome>, SimError> {
+    match run {
         Ok(out) => {
             *spent += out.stats.rhs_evals;
             Ok(Some(out))

@@ -10,9 +10,11 @@
 
 pub mod budget;
 mod ladder;
+mod lanes;
 
 pub use ladder::accepted_estimate;
 use ladder::verified;
+pub use lanes::simulate_batch;
 
 use crate::energy::{Fractions, Region};
 use crate::error::SimError;
@@ -87,7 +89,7 @@ pub fn simulate<O: Observer + ?Sized>(
             step_checked(scenario, &plan, observer)
         }
         MethodChoice::Named(_) => run_plan(scenario, &plan, observer),
-        MethodChoice::Auto => verified(scenario, plan, observer),
+        MethodChoice::Auto => verified(scenario, plan, observer, None),
     }
 }
 
@@ -164,6 +166,18 @@ pub fn run_with_plan<O: Observer + ?Sized>(
         observer,
         active_window,
     )?;
+    Ok(outcome_of(scenario, plan, (y, e_initial), stats))
+}
+
+/// The outcome of a run of `scenario` by `plan` that ended in state `y` with `stats`, having
+/// started with the energy `e_initial`.
+fn outcome_of(
+    scenario: &Scenario,
+    plan: &Plan,
+    (y, e_initial): (Vec<f64>, f64),
+    stats: Stats,
+) -> Outcome {
+    let model = &scenario.model;
     let mut density = vec![0.0; model.n_sites()];
     let end = (scenario.t_end, y.as_slice());
     let fractions = Fractions::of_state(model, end, scenario.region, e_initial, &mut density);
@@ -171,7 +185,7 @@ pub fn run_with_plan<O: Observer + ?Sized>(
         true => density.iter().sum(),
         false => fractions.total,
     };
-    Ok(Outcome {
+    Outcome {
         fractions,
         e_initial,
         e_final,
@@ -180,5 +194,5 @@ pub fn run_with_plan<O: Observer + ?Sized>(
         total_rhs_evals: stats.rhs_evals,
         error_estimate: None,
         final_state: y,
-    })
+    }
 }

@@ -1,0 +1,148 @@
+//! Each lane's contact events: the scan for bonds whose contact opened or closed, run on all
+//! lanes at once (a lane mask per bond), and the corrections, lane by lane in the scalar
+//! [`crate::integrate::event_correction`]'s order and with its functions, so that a lane's end
+//! state is corrected exactly as its scalar run's is.
+
+use super::step::S;
+use super::{lanewise, Lanes, LANES};
+use crate::integrate::contact_event::BondPath;
+use crate::integrate::contact_scan::changes_contact;
+use crate::integrate::event_correction::{
+    bond_integrals, end_force, negligible, BondSites, Correction,
+};
+use crate::integrate::rkn::DPRKN6;
+use crate::model::{Model, Window};
+
+/// The scan's and corrections' scratch, and the bonds corrected per lane.
+#[derive(Debug, Clone, Default)]
+pub(super) struct LaneEvents {
+    /// The bonds some live lane saw change in this step, with the mask of those lanes, in the
+    /// scalar scan's order (inner bonds rising, then the left wall, then the right).
+    changed: Vec<(BondSites, u32)>,
+    pending: Vec<Correction>,
+    /// Bonds corrected so far, per lane.
+    pub count: [u64; LANES],
+}
+
+impl LaneEvents {
+    /// Corrects the end state `(new_q, new_v)` of the step of size `h` from `(q, v)`, in every
+    /// live lane whose bonds of `window` changed contact, from the stages' bond forces
+    /// `stage_force`. Returns which lanes were corrected.
+    pub fn correct(
+        &mut self,
+        models: &[&Model; LANES],
+        (q, v): (&[Lanes], &[Lanes]),
+        (new_q, new_v): (&mut [Lanes], &mut [Lanes]),
+        (stage_force, h): (&[Vec<Lanes>; S], f64),
+        (window, live): (Window, [bool; LANES]),
+    ) -> [bool; LANES] {
+        let live_mask = (0..LANES).fold(0, |m, l| m | (u32::from(live[l]) << l));
+        self.scan(models[0], new_q, stage_force, window, live_mask);
+        let mut corrected = [false; LANES];
+        if self.changed.is_empty() {
+            return corrected;
+        }
+        for (l, model) in models.iter().enumerate() {
+            let mut pending = std::mem::take(&mut self.pending);
+            pending.clear();
+            for &((bond, left, right), mask) in &self.changed {
+                if mask >> l & 1 == 0 {
+                    continue;
+                }
+                let stage: [f64; S] = std::array::from_fn(|s| stage_force[s][bond][l]);
+                let member = |x: &[Lanes], site: Option<usize>| site.map_or(0.0, |i| x[i][l]);
+                let path = BondPath {
+                    d0: member(q, left) - member(q, right),
+                    rate0: member(v, left) - member(v, right),
+                    d1: member(new_q, left) - member(new_q, right),
+                    rate1: member(new_v, left) - member(new_v, right),
+                };
+                if negligible(stage, end_force(model, bond, &path)) {
+                    continue;
+                }
+                let (impulse, moment, _) = bond_integrals(model, bond, &path, h);
+                let (q0, q1) = (DPRKN6.quadrature)(stage, h);
+                pending.push((left, right, impulse - q0, moment - q1));
+            }
+            apply(model.inv_mass(), &pending, (new_q, new_v), l);
+            self.count[l] += pending.len() as u64;
+            corrected[l] = !pending.is_empty();
+            self.pending = pending;
+        }
+        corrected
+    }
+
+    /// Lists in `self.changed` every bond of `window` whose contact opened or closed during
+    /// the step in some lane of `live_mask`, as the scalar scan does per lane (a bond outside a
+    /// lane's own window is at rest there, and never changes).
+    fn scan(
+        &mut self,
+        model: &Model,
+        new_q: &[Lanes],
+        stage_force: &[Vec<Lanes>; S],
+        window: Window,
+        live_mask: u32,
+    ) {
+        self.changed.clear();
+        let (lo, hi) = (window.lo, window.hi);
+        for bond in lo + 1..=hi {
+            // Some but not all of the S + 1 values say "touching": the largest is positive and
+            // the smallest is not (compare-and-select, as the scalar block test).
+            let mut low = lanewise(new_q[bond - 1], new_q[bond], |l, r| l - r);
+            let mut high = low;
+            for forces in stage_force {
+                let f = forces[bond];
+                low = lanewise(low, f, |low, f| if f < low { f } else { low });
+                high = lanewise(high, f, |high, f| if f > high { f } else { high });
+            }
+            let mask = (0..LANES).fold(0, |m, l| {
+                m | (u32::from((high[l] > 0.0) & (low[l] <= 0.0)) << l)
+            }) & live_mask;
+            if mask != 0 {
+                self.changed
+                    .push(((bond, Some(bond - 1), Some(bond)), mask));
+            }
+        }
+        let n_sites = model.n_sites();
+        let last = n_sites - 1;
+        let [left_wall, right_wall] = model.walls();
+        let wall = |bond: usize, d_end: Lanes| {
+            (0..LANES).fold(0, |m, l| {
+                let forces = std::array::from_fn(|s| stage_force[s][bond][l]);
+                m | (u32::from(changes_contact::<S>(forces, d_end[l])) << l)
+            }) & live_mask
+        };
+        if lo == 0 && left_wall {
+            let mask = wall(0, new_q[0].map(|x| 0.0 - x));
+            if mask != 0 {
+                self.changed.push(((0, None, Some(0)), mask));
+            }
+        }
+        if hi == last && right_wall {
+            let mask = wall(n_sites, new_q[last].map(|x| 0.0 + x));
+            if mask != 0 {
+                self.changed.push(((n_sites, Some(last), None), mask));
+            }
+        }
+    }
+}
+
+/// Adds lane `l`'s corrections to the end state, as the scalar `apply` does: the bond pushes
+/// its left member back and its right member on.
+fn apply(
+    inv_mass: &[f64],
+    corrections: &[Correction],
+    (new_q, new_v): (&mut [Lanes], &mut [Lanes]),
+    l: usize,
+) {
+    for &(left, right, impulse, moment) in corrections {
+        if let Some(i) = left {
+            new_v[i][l] -= impulse * inv_mass[i];
+            new_q[i][l] -= moment * inv_mass[i];
+        }
+        if let Some(i) = right {
+            new_v[i][l] += impulse * inv_mass[i];
+            new_q[i][l] += moment * inv_mass[i];
+        }
+    }
+}

@@ -1,0 +1,127 @@
+//! Four scenes in the lanes of one register: `rkn6-contact` advancing four chains together,
+//! each lane doing exactly the operations of the scalar [`super::Rkn`] in its order, so that
+//! every lane's run equals its scene's scalar run bit for bit (tested, and `make check` at
+//! `--abs 0`).
+//!
+//! Why: a sweep's neighbouring points are the same chain with other resonator masses or
+//! couplings. The scalar step is already four sites wide, but its window edges, its
+//! loop-carried force and its bookkeeping are paid once per scene; here they are paid once
+//! per four (docs/performance.md, "Scenes in SIMD lanes").
+//!
+//! What lanes share, and what each keeps ([`LaneChain`]): the chain (sites, walls, resonator
+//! sites and exponents) is one; each lane has its own masses of the resonators and couplings,
+//! its own initial impulse, its own active window, contact corrections, first-same-as-last
+//! reuse, failures and observer. The lanes step on the union of their windows: outside its
+//! own window a lane is exactly at rest, and working on resting sites changes none of its bits.
+//!
+//! Only the paper's conservative chain takes lanes (Hertz's law without precompression, unit
+//! site masses, fixed or free ends, constant couplings); any other scene steps alone.
+//! - [`step`]: the batched DPRKN6 step and force loop.
+//! - [`events`]: each lane's contact-event scan and corrections.
+//! - [`drive`]: the fixed-step time loop of four runs, [`drive_lanes`].
+
+mod drive;
+mod events;
+mod step;
+
+pub use drive::drive_lanes;
+
+use crate::model::{Coupling, Model};
+
+/// Scenes per batch: the f64 lanes of an AVX2 register.
+pub const LANES: usize = 4;
+
+/// One value per lane.
+pub(crate) type Lanes = [f64; LANES];
+
+/// Every lane at zero.
+pub(crate) const ZERO: Lanes = [0.0; LANES];
+
+/// `op` on each lane of `x` and `y`. Whole-lane operations on slices borrowed apart are what
+/// the compiler turns into packed instructions; element by element it reloads every pointer
+/// (docs/performance.md).
+#[inline(always)]
+pub(crate) fn lanewise(x: Lanes, y: Lanes, op: impl Fn(f64, f64) -> f64) -> Lanes {
+    std::array::from_fn(|l| op(x[l], y[l]))
+}
+
+/// A resonator of the shared chain: its host site and exponent, and each lane's coupling and
+/// mass ratio.
+#[derive(Debug, Clone)]
+pub(crate) struct LaneResonator {
+    pub site: usize,
+    pub p: u32,
+    pub kappa: Lanes,
+    pub eps: Lanes,
+}
+
+/// The chain the lanes share, with each lane's resonator parameters.
+#[derive(Debug, Clone)]
+pub(crate) struct LaneChain {
+    pub n_sites: usize,
+    pub walls: [bool; 2],
+    pub resonators: Vec<LaneResonator>,
+}
+
+impl LaneChain {
+    /// The shared chain of `models` (one per lane), or `None` when they differ in anything
+    /// but their resonators' masses and couplings, or when one is not the paper's
+    /// conservative chain ([`takes_lanes`]).
+    pub fn of(models: &[&Model; LANES]) -> Option<LaneChain> {
+        let first = models[0];
+        let same_shape = |m: &Model| {
+            takes_lanes(m)
+                && m.n_sites() == first.n_sites()
+                && m.boundary() == first.boundary()
+                && m.resonators().len() == first.resonators().len()
+                && m.resonators()
+                    .iter()
+                    .zip(first.resonators())
+                    .all(|(r, r0)| r.site == r0.site && r.p == r0.p)
+        };
+        if !models.iter().all(|m| same_shape(m)) {
+            return None;
+        }
+        let constant = |m: &Model, j: usize| match m.resonators()[j].coupling {
+            Coupling::Constant(kappa) => kappa,
+            Coupling::Ramp { .. } => unreachable!("a ramped coupling does not take lanes"),
+        };
+        let resonators = (0..first.resonators().len())
+            .map(|j| LaneResonator {
+                site: first.resonators()[j].site,
+                p: first.resonators()[j].p,
+                kappa: std::array::from_fn(|l| constant(models[l], j)),
+                eps: std::array::from_fn(|l| models[l].resonators()[j].eps),
+            })
+            .collect();
+        Some(LaneChain {
+            n_sites: first.n_sites(),
+            walls: first.walls(),
+            resonators,
+        })
+    }
+
+    /// Positions (or velocities) per lane: sites, then resonators.
+    pub fn n_dof(&self) -> usize {
+        self.n_sites + self.resonators.len()
+    }
+}
+
+/// Whether `models` (one per lane) can step together: they share a chain that takes lanes.
+pub fn shares_a_chain(models: &[&Model; LANES]) -> bool {
+    LaneChain::of(models).is_some()
+}
+
+/// Whether `model` can run in a lane: the paper's conservative chain, whose force loop the
+/// lanes copy (Hertz's law without precompression, unit site masses, walls or free ends, and
+/// constant couplings).
+pub fn takes_lanes(model: &Model) -> bool {
+    model.contacts().is_none()
+        && !model.is_dissipative()
+        && !model.has_soft_end()
+        && model.site_masses().is_none()
+        && model
+            .resonators()
+            .iter()
+            .all(|r| matches!(r.coupling, Coupling::Constant(_)))
+}

@@ -1,0 +1,175 @@
+//! [`simulate`] of many scenes, four at a time in lanes where they allow it: `auto`'s first
+//! pair of runs (2 dt, then dt) made for four scenes together
+//! ([`crate::integrate::lanes`]), after which each scene's ladder goes on alone from those
+//! runs. Every result is its scene's [`simulate`] result bit for bit; only the time differs.
+//!
+//! Four scenes take lanes together when each asks for `auto`, plans `rkn6-contact` at the
+//! same first step, runs for as long with the same samples, and all share a chain that takes
+//! lanes ([`crate::integrate::lanes::takes_lanes`]). A sweep's neighbouring points mostly do;
+//! any other group runs scene by scene.
+
+use super::ladder::{verified, FirstPair};
+use super::{auto_first_step, budget, outcome_of, simulate, Outcome, Scenario};
+use crate::energy::total_energy;
+use crate::error::SimError;
+use crate::integrate::lanes::{drive_lanes, shares_a_chain, LANES};
+use crate::integrate::{CancelOnly, MethodChoice, Observer, Plan, AUTO_METHOD, BLOW_UP_DRIFT};
+
+/// Simulates each of `scenarios` as [`simulate`] does, showing the samples of each one's
+/// reported run to its own of `observers` (as many), with groups of four consecutive scenes
+/// that allow it stepped together in lanes.
+pub fn simulate_batch<O: Observer>(
+    scenarios: &[&Scenario],
+    observers: &mut [O],
+) -> Vec<Result<Outcome, SimError>> {
+    assert_eq!(
+        scenarios.len(),
+        observers.len(),
+        "one observer per scenario"
+    );
+    let mut results = Vec::with_capacity(scenarios.len());
+    for (group, observers) in scenarios.chunks(LANES).zip(observers.chunks_mut(LANES)) {
+        let batched = match (
+            <&[&Scenario; LANES]>::try_from(group),
+            <&mut [O; LANES]>::try_from(&mut *observers),
+        ) {
+            (Ok(group), Ok(observers)) => in_lanes(group, observers),
+            _ => None,
+        };
+        match batched {
+            Some(outcomes) => results.extend(outcomes),
+            None => results.extend(
+                group
+                    .iter()
+                    .zip(observers.iter_mut())
+                    .map(|(s, o)| simulate(s, o)),
+            ),
+        }
+    }
+    results
+}
+
+/// Four scenes that can take lanes, their shared plan and first step, and their initial
+/// states; `None` when they cannot.
+struct LaneGroup<'s> {
+    scenarios: &'s [&'s Scenario; LANES],
+    plan: Plan,
+    dt: f64,
+    starts: [(Vec<f64>, f64); LANES],
+}
+
+impl<'s> LaneGroup<'s> {
+    fn of(scenarios: &'s [&'s Scenario; LANES]) -> Option<Self> {
+        let plan_of = |s: &Scenario| {
+            let auto = s.method == MethodChoice::Auto;
+            let plan = Plan::choose(&s.model, s.method, s.accuracy).ok()?;
+            (auto && plan.method == AUTO_METHOD && budget::check(s).is_ok()).then_some(plan)
+        };
+        let first = scenarios[0];
+        let plan = plan_of(first)?;
+        let dt = auto_first_step(first, &plan);
+        let alike = |s: &&Scenario| {
+            plan_of(s) == Some(plan)
+                && auto_first_step(s, &plan) == dt
+                && s.t_end == first.t_end
+                && s.sample_every == first.sample_every
+        };
+        if !scenarios.iter().all(alike) || !shares_a_chain(&scenarios.map(|s| &s.model)) {
+            return None;
+        }
+        let start = |s: &Scenario| {
+            let mut y = s.model.rest_state();
+            s.model
+                .apply_impulse(&mut y, s.impulse_site, s.impulse_velocity)
+                .ok()?;
+            let e_initial = total_energy(&s.model, 0.0, &y);
+            Some((y, e_initial))
+        };
+        let starts: Vec<(Vec<f64>, f64)> =
+            scenarios.iter().map(|s| start(s)).collect::<Option<_>>()?;
+        Some(LaneGroup {
+            scenarios,
+            plan,
+            dt,
+            starts: starts.try_into().ok()?,
+        })
+    }
+
+    /// The four scenes' runs by `plan`, each sample shown to its lane's observer.
+    fn run(
+        &self,
+        plan: &Plan,
+        observers: [&mut dyn Observer; LANES],
+    ) -> [Result<Outcome, SimError>; LANES] {
+        let first = self.scenarios[0];
+        let cfg = plan.drive_config((first.t_end, first.sample_every), true);
+        let mut ys = self.starts.clone().map(|(y, _)| y);
+        let models = self.scenarios.map(|s| &s.model);
+        let stats = drive_lanes(models, &mut ys, &cfg, observers)
+            .expect("a lane group shares a chain and a fixed step");
+        let mut ys = ys.map(Some);
+        std::array::from_fn(|l| {
+            let y = ys[l].take().expect("each lane's state is taken once");
+            let start = (y, self.starts[l].1);
+            stats[l]
+                .clone()
+                .map(|stats| outcome_of(self.scenarios[l], plan, start, stats))
+        })
+    }
+}
+
+/// `auto` on four scenes whose first pair runs in lanes, or `None` when they cannot.
+fn in_lanes<O: Observer>(
+    scenarios: &[&Scenario; LANES],
+    observers: &mut [O; LANES],
+) -> Option<[Result<Outcome, SimError>; LANES]> {
+    let group = LaneGroup::of(scenarios)?;
+    // The ladder's first pair, as `Ladder::start` and its first rung make it: verification
+    // runs are guarded against blow-up only.
+    let guarded = Plan {
+        drift_limit: BLOW_UP_DRIFT,
+        ..group.plan
+    };
+    let mut cancel_only = observers.each_ref().map(CancelOnly);
+    let coarse = group.run(
+        &guarded.with_dt(2.0 * group.dt),
+        cancel_only.each_mut().map(|o| o as &mut dyn Observer),
+    );
+    for observer in observers.iter_mut() {
+        observer.reset();
+    }
+    let fine = group.run(
+        &guarded.with_dt(group.dt),
+        observers.each_mut().map(|o| o as &mut dyn Observer),
+    );
+    let mut pairs = coarse.into_iter().zip(fine).map(Some).collect::<Vec<_>>();
+    Some(std::array::from_fn(|l| {
+        let (coarse, fine) = pairs[l].take().expect("each pair is taken once");
+        let first = FirstPair { coarse, fine };
+        verified(scenarios[l], group.plan, &mut observers[l], Some(first))
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{paper_scene, tolerance, PaperDefect};
+
+    /// Neighbouring F7 points take lanes; a point of another chain keeps its group out.
+    #[test]
+    fn neighbouring_sweep_points_form_a_lane_group() {
+        let scene = |eps1: f64, site: i64| {
+            let defects = [
+                PaperDefect::linear(0, eps1, 1.0),
+                PaperDefect::linear(site, 7.0, 1.0),
+            ];
+            paper_scene(&defects, MethodChoice::Auto, tolerance(1e-5))
+        };
+        let scenes: Vec<Scenario> = (0..LANES).map(|k| scene(3.0 + k as f64, 20)).collect();
+        let group: [&Scenario; LANES] = std::array::from_fn(|l| &scenes[l]);
+        assert!(LaneGroup::of(&group).is_some());
+        let other = scene(4.0, 21);
+        let mixed: [&Scenario; LANES] = [&scenes[0], &scenes[1], &other, &scenes[3]];
+        assert!(LaneGroup::of(&mixed).is_none());
+    }
+}

@@ -1,0 +1,183 @@
+//! Scenes in lanes: four runs stepped together must each equal their scene's scalar run bit
+//! for bit (fractions, final state, statistics, samples, and failures), whatever the lanes
+//! differ in: resonator masses and couplings, impulses, windows, wall bounces, a lane that
+//! blows up.
+#![allow(clippy::unwrap_used)]
+
+use woodpile_sim::energy::Region;
+use woodpile_sim::integrate::lanes::{drive_lanes, shares_a_chain, LANES};
+use woodpile_sim::integrate::{
+    drive, DriveConfig, Method, MethodChoice, Observer, Plan, StepControl, BLOW_UP_DRIFT,
+};
+use woodpile_sim::model::{Boundary, Model, Resonator};
+use woodpile_sim::observe::FractionSeries;
+use woodpile_sim::simulation::{auto_first_step, simulate, simulate_batch, Scenario};
+use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
+use woodpile_sim::SimError;
+
+/// F7's chain (defects at 0 and 20) with the resonator masses `eps`, at tolerance 1e-5.
+fn f7_scene((eps1, eps2): (f64, f64)) -> Scenario {
+    let defects = [
+        PaperDefect::linear(0, eps1, 1.0),
+        PaperDefect::linear(20, eps2, 1.0),
+    ];
+    paper_scene(&defects, MethodChoice::Auto, tolerance(1e-5))
+}
+
+/// Each scene's outcome and recorded samples, by `simulate_batch` and by `simulate` alone.
+fn batched_and_alone(scenes: &[Scenario]) {
+    let refs: Vec<&Scenario> = scenes.iter().collect();
+    let mut series: Vec<FractionSeries> = scenes
+        .iter()
+        .map(|s| FractionSeries::new(&s.model, s.region))
+        .collect();
+    let batched = simulate_batch(&refs, &mut series);
+    for (k, s) in scenes.iter().enumerate() {
+        let mut alone = FractionSeries::new(&s.model, s.region);
+        let expected = simulate(s, &mut alone);
+        assert_eq!(batched[k], expected, "scene {k}: outcome");
+        assert_eq!(series[k], alone, "scene {k}: samples");
+    }
+}
+
+/// Nine F7 points (two groups of four in lanes, the ninth alone), some passing their first
+/// pair and some needing a third run, each equal to its scalar `auto` run.
+#[test]
+fn sweep_points_in_lanes_equal_their_scalar_runs() {
+    let eps = [
+        (3.0, 5.0),
+        (3.0, 6.0),
+        (40.0, 7.0),
+        (100.0, 100.0),
+        (12.0, 3.5),
+        (20.0, 20.0),
+        (8.0, 60.0),
+        (4.5, 4.0),
+        (9.0, 9.0),
+    ];
+    let scenes: Vec<Scenario> = eps.iter().map(|&e| f7_scene(e)).collect();
+    let models: Vec<&Model> = scenes.iter().map(|s| &s.model).collect();
+    assert!(shares_a_chain(&models[..LANES].try_into().unwrap()));
+    // The first group takes lanes: one method and one first step.
+    let plan = |s: &Scenario| Plan::choose(&s.model, s.method, s.accuracy).unwrap();
+    let first: Vec<(Method, f64)> = scenes[..LANES]
+        .iter()
+        .map(|s| (plan(s).method, auto_first_step(s, &plan(s))))
+        .collect();
+    assert!(
+        first
+            .iter()
+            .all(|&f| f == (Method::Rkn6Contact, first[0].1)),
+        "{first:?}"
+    );
+    batched_and_alone(&scenes);
+}
+
+/// A short walled chain whose lanes start their waves at different sites and bounce them off
+/// both walls many times, so that their windows differ and the walls' contacts open and close.
+#[test]
+fn lanes_with_other_impulses_and_wall_bounces_equal_their_scalar_runs() {
+    let scene = |site: usize, velocity: f64, eps: f64| {
+        let resonators = vec![Resonator::constant(7, eps, 2.0, 1)];
+        let model = Model::new(15, Boundary::Fixed, resonators).unwrap();
+        Scenario {
+            region: Region::new(6, 8, 15).unwrap(),
+            model,
+            impulse_site: site,
+            impulse_velocity: velocity,
+            t_end: 120.0,
+            method: MethodChoice::Auto,
+            accuracy: tolerance(1e-6),
+            sample_every: 7.0,
+        }
+    };
+    let scenes = [
+        scene(0, 1.0, 5.0),
+        scene(3, -1.0, 8.0),
+        scene(14, -1.0, 30.0),
+        scene(10, 1.0, 12.0),
+    ];
+    batched_and_alone(&scenes);
+}
+
+/// Scenes that cannot share lanes (other resonator sites, a named method) run alone, with the
+/// same results.
+#[test]
+fn scenes_that_cannot_share_lanes_run_alone() {
+    let mut scenes: Vec<Scenario> = (0..4).map(|k| f7_scene((3.0 + k as f64, 5.0))).collect();
+    scenes[2] = paper_scene(
+        &[PaperDefect::linear(5, 4.0, 1.0)],
+        MethodChoice::Auto,
+        tolerance(1e-5),
+    );
+    let models: Vec<&Model> = scenes.iter().map(|s| &s.model).collect();
+    assert!(!shares_a_chain(&models[..].try_into().unwrap()));
+    batched_and_alone(&scenes);
+    let mut named = scenes.clone();
+    named[2] = f7_scene((9.0, 9.0));
+    named[1].method = MethodChoice::Named(Method::Rkn6Contact);
+    named[1].accuracy = fixed_dt(0.1);
+    batched_and_alone(&named);
+}
+
+/// One lane too stiff for the step blows up and stops; the others run on, and every lane's
+/// result, failure included, is its scalar run's.
+#[test]
+fn a_lane_that_blows_up_stops_alone() {
+    let stiff = [
+        PaperDefect::linear(0, 0.01, 50.0),
+        PaperDefect::linear(20, 5.0, 1.0),
+    ];
+    let mut scenes: Vec<Scenario> = (0..4).map(|k| f7_scene((3.0 + k as f64, 5.0))).collect();
+    scenes[1] = paper_scene(&stiff, MethodChoice::Auto, tolerance(1e-5));
+    let plan = Plan::choose(&scenes[0].model, MethodChoice::Auto, tolerance(1e-5))
+        .unwrap()
+        .with_dt(0.3);
+    let cfg = DriveConfig {
+        t_end: 150.0,
+        sample_every: 10.0,
+        control: StepControl::Fixed { dt: 0.3 },
+        max_steps: 1_000_000,
+        energy_drift_limit: Some(BLOW_UP_DRIFT),
+        active_window: true,
+    };
+    let start = |s: &Scenario| {
+        let mut y = s.model.rest_state();
+        s.model
+            .apply_impulse(&mut y, s.impulse_site, s.impulse_velocity)
+            .unwrap();
+        y
+    };
+    let mut ys: [Vec<f64>; LANES] = std::array::from_fn(|l| start(&scenes[l]));
+    let mut recorders: [FractionSeries; LANES] =
+        std::array::from_fn(|l| FractionSeries::new(&scenes[l].model, scenes[l].region));
+    let models: [&Model; LANES] = std::array::from_fn(|l| &scenes[l].model);
+    let observers = recorders.each_mut().map(|o| o as &mut dyn Observer);
+    let results = drive_lanes(models, &mut ys, &cfg, observers).unwrap();
+    for l in 0..LANES {
+        let mut y = start(&scenes[l]);
+        let mut alone = FractionSeries::new(&scenes[l].model, scenes[l].region);
+        let model = &scenes[l].model;
+        let expected = drive(
+            model,
+            plan.stepper(model).as_mut(),
+            &mut y,
+            &cfg,
+            &mut alone,
+        );
+        assert_eq!(results[l], expected, "lane {l}");
+        if expected.is_ok() {
+            assert_eq!(ys[l], y, "lane {l}: final state");
+            assert_eq!(recorders[l], alone, "lane {l}: samples");
+        }
+    }
+    assert!(
+        matches!(
+            results[1],
+            Err(SimError::NonFinite { .. } | SimError::EnergyDrift { .. })
+        ),
+        "the stiff lane must fail: {:?}",
+        results[1]
+    );
+    assert!(results.iter().filter(|r| r.is_ok()).count() == 3);
+}
