@@ -23,5 +23,7 @@ pub mod store;
 
 pub use canonical::Key;
 pub use error::{FileError, Result};
-pub use point::{point_key, simulate_point, PointData, PointResult, PointStats, Shares};
+pub use point::{
+    point_key, simulate_point, simulate_points_until, PointData, PointResult, PointStats, Shares,
+};
 pub use store::{Fetched, PointStore};

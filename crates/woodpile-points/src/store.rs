@@ -18,7 +18,7 @@ use woodpile_scene::Scene;
 use crate::atomic;
 use crate::canonical::Key;
 use crate::error::{FileError, Result};
-use crate::point::{simulate_point_until, PointData, PointResult, Shares};
+use crate::point::{simulate_point_until, simulate_points_until, PointData, PointResult, Shares};
 
 const MAGIC: &[u8; 4] = b"WPPT";
 /// The largest point file read: far beyond a series of the sample budget's length.
@@ -101,6 +101,38 @@ impl PointStore {
             result,
             simulated: true,
         }))
+    }
+
+    /// [`PointStore::get_or_simulate_until`] of several points (`keys[k]` is the key of
+    /// `scenes[k]`), those not cached simulated together ([`simulate_points_until`]: four
+    /// neighbours at a time in lanes), each saved the moment its group is done.
+    pub fn get_or_simulate_many(
+        &self,
+        (keys, scenes): (&[&Key], &[&Scene]),
+        series: Shares,
+        stop: &dyn Fn() -> bool,
+    ) -> Result<Vec<Option<Fetched>>> {
+        let mut fetched: Vec<Option<Fetched>> = keys
+            .iter()
+            .map(|key| {
+                self.load(key).map(|cached| Fetched {
+                    result: cached,
+                    simulated: false,
+                })
+            })
+            .collect();
+        let todo: Vec<usize> = (0..keys.len()).filter(|&k| fetched[k].is_none()).collect();
+        let to_simulate: Vec<&Scene> = todo.iter().map(|&k| scenes[k]).collect();
+        let results = simulate_points_until(&to_simulate, series, stop);
+        for (k, result) in todo.into_iter().zip(results) {
+            let Some(result) = result else { continue };
+            self.save(keys[k], &result)?;
+            fetched[k] = Some(Fetched {
+                result,
+                simulated: true,
+            });
+        }
+        Ok(fetched)
     }
 
     /// Stores `result` under `key`, atomically. A fan-out folder that is a symbolic link is

@@ -34,6 +34,7 @@ use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use woodpile_scene::Scene;
+use woodpile_sim::integrate::lanes::LANES;
 use woodpile_sim::integrate::MethodChoice;
 
 use woodpile_pipeline::error::{PipelineError, Result};
@@ -276,15 +277,37 @@ impl PointGrid for Sweep {
             .filter(|&i| results[i].is_none() && *first_of.entry(&keys[i]).or_insert(i) == i)
             .collect();
         events.simulating(stage, todo.len(), keys.len() - todo.len());
+        // Neighbouring points in groups of four, which run in lanes where they can.
         let computed: Vec<(usize, Fetched)> = todo
-            .par_iter()
-            .map(|&i| {
-                let scene = self.scene_at(indices[i])?;
-                let fetched = store.get_or_simulate(&keys[i], &scene, self.series)?;
-                events.point_done();
-                Ok((i, fetched))
+            .par_chunks(LANES)
+            .map(|group| {
+                let scenes: Vec<Scene> = group
+                    .iter()
+                    .map(|&i| self.scene_at(indices[i]))
+                    .collect::<Result<_>>()?;
+                let scenes: Vec<&Scene> = scenes.iter().collect();
+                let group_keys: Vec<&Key> = group.iter().map(|&i| &keys[i]).collect();
+                let fetched =
+                    store.get_or_simulate_many((&group_keys, &scenes), self.series, &|| false)?;
+                Ok(group
+                    .iter()
+                    .zip(fetched)
+                    .map(|(&i, f)| {
+                        events.point_done();
+                        (
+                            i,
+                            f.unwrap_or(Fetched {
+                                result: Err("cancelled".into()),
+                                simulated: false,
+                            }),
+                        )
+                    })
+                    .collect::<Vec<_>>())
             })
-            .collect::<Result<_>>()?;
+            .collect::<Result<Vec<_>>>()?
+            .into_iter()
+            .flatten()
+            .collect();
         let simulated = computed.iter().filter(|(_, f)| f.simulated).count();
         for (i, fetched) in computed {
             results[i] = Some(fetched.result);

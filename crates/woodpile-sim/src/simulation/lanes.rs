@@ -12,7 +12,7 @@ use super::ladder::{verified, FirstPair};
 use super::{auto_first_step, budget, outcome_of, simulate, Outcome, Scenario};
 use crate::energy::total_energy;
 use crate::error::SimError;
-use crate::integrate::lanes::{drive_lanes, shares_a_chain, LANES};
+use crate::integrate::lanes::{drive_lanes, enabled, shares_a_chain, LANES};
 use crate::integrate::{CancelOnly, MethodChoice, Observer, Plan, AUTO_METHOD, BLOW_UP_DRIFT};
 
 /// Simulates each of `scenarios` as [`simulate`] does, showing the samples of each one's
@@ -123,7 +123,7 @@ fn in_lanes<O: Observer>(
     scenarios: &[&Scenario; LANES],
     observers: &mut [O; LANES],
 ) -> Option<[Result<Outcome, SimError>; LANES]> {
-    let group = LaneGroup::of(scenarios)?;
+    let group = LaneGroup::of(scenarios).filter(|_| enabled())?;
     // The ladder's first pair, as `Ladder::start` and its first rung make it: verification
     // runs are guarded against blow-up only.
     let guarded = Plan {

@@ -20,6 +20,8 @@ pub(super) struct LaneEvents {
     /// scalar scan's order (inner bonds rising, then the left wall, then the right).
     changed: Vec<(BondSites, u32)>,
     pending: Vec<Correction>,
+    /// Per lane, the sites the last step's corrections moved.
+    pub touched: [Vec<usize>; LANES],
     /// Bonds corrected so far, per lane.
     pub count: [u64; LANES],
 }
@@ -39,6 +41,9 @@ impl LaneEvents {
         let live_mask = (0..LANES).fold(0, |m, l| m | (u32::from(live[l]) << l));
         self.scan(models[0], new_q, stage_force, window, live_mask);
         let mut corrected = [false; LANES];
+        for touched in &mut self.touched {
+            touched.clear();
+        }
         if self.changed.is_empty() {
             return corrected;
         }
@@ -65,6 +70,10 @@ impl LaneEvents {
                 pending.push((left, right, impulse - q0, moment - q1));
             }
             apply(model.inv_mass(), &pending, (new_q, new_v), l);
+            let touched = &mut self.touched[l];
+            for &(left, right, ..) in &pending {
+                touched.extend(left.into_iter().chain(right));
+            }
             self.count[l] += pending.len() as u64;
             corrected[l] = !pending.is_empty();
             self.pending = pending;

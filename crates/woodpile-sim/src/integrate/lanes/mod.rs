@@ -107,6 +107,14 @@ impl LaneChain {
     }
 }
 
+/// Whether scenes may take lanes at all: unless `WOODPILE_LANES` is `off`, which runs every
+/// scene alone (same results), so that both paths can be timed on one machine. Decided once
+/// per process.
+pub fn enabled() -> bool {
+    static CHOICE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *CHOICE.get_or_init(|| !std::env::var("WOODPILE_LANES").is_ok_and(|v| v == "off"))
+}
+
 /// Whether `models` (one per lane) can step together: they share a chain that takes lanes.
 pub fn shares_a_chain(models: &[&Model; LANES]) -> bool {
     LaneChain::of(models).is_some()

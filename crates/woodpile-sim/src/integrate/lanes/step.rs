@@ -104,9 +104,11 @@ impl LaneRkn6 {
     ) {
         let tab = DPRKN6;
         let ranges = self.dof_ranges(window);
-        // The last stage is reused when it is current in every live lane; otherwise the first
-        // is evaluated for all, which gives the current lanes the same bits again.
-        let reuse = (0..LANES).all(|l| !live[l] || self.last_stage_current[l]);
+        // The last stage is reused when it is current in every live lane, or was moved by a
+        // correction at a few sites whose forces are then evaluated again; otherwise (the
+        // first step) the first stage is evaluated whole.
+        let reuse = (0..LANES)
+            .all(|l| !live[l] || self.last_stage_current[l] || !self.events.touched[l].is_empty());
         for i in 0..S {
             if i > 0 {
                 for r in ranges.clone() {
@@ -126,6 +128,13 @@ impl LaneRkn6 {
             if i == 0 && reuse {
                 self.a.swap(0, S - 1);
                 self.stage_force.swap(S - 1, 0);
+                for l in (0..LANES).filter(|&l| live[l] && !self.last_stage_current[l]) {
+                    self.evals[l] += 1;
+                    for &site in &self.events.touched[l] {
+                        let forces = (&mut self.a[0][..], &mut self.stage_force[0][..]);
+                        patch(&self.chain, q, forces, (window, l), site);
+                    }
+                }
                 continue;
             }
             for l in (0..LANES).filter(|&l| live[l]) {
@@ -152,6 +161,58 @@ impl LaneRkn6 {
                 }
             }
         }
+    }
+}
+
+/// Lane `l`'s forces of the state `q` near `site`, whose position a contact correction moved
+/// after the forces `acc` and `record` (a whole evaluation's) were taken: the bonds beside it
+/// and the accelerations of it and its neighbours, each by the operations [`accelerations`]
+/// makes of it on `window`, so that the patched forces are a whole evaluation's bit for bit.
+fn patch(
+    chain: &LaneChain,
+    q: &[Lanes],
+    (acc, record): (&mut [Lanes], &mut [Lanes]),
+    (window, l): (Window, usize),
+    site: usize,
+) {
+    let n = chain.n_sites;
+    let (lo, hi) = (window.lo, window.hi);
+    let (u, rv) = q.split_at(n);
+    let (acc_u, acc_v) = acc.split_at_mut(n);
+    let [left_wall, right_wall] = chain.walls;
+    // The force of bond b, between sites b - 1 and b, as the loop computes it.
+    let bond = |b: usize| {
+        let d = (u[b - 1][l] - u[b][l]).max(0.0);
+        d * d.sqrt()
+    };
+    for b in [site, site + 1] {
+        if b > lo && b <= hi {
+            record[b][l] = bond(b);
+        }
+    }
+    if site == 0 && lo == 0 && left_wall {
+        record[0][l] = hertz_force(-u[0][l]);
+    }
+    if site == n - 1 && hi == n - 1 && right_wall {
+        record[n][l] = hertz_force(u[n - 1][l]);
+    }
+    for k in site.saturating_sub(1).max(lo)..=(site + 1).min(hi) {
+        let left = if k > lo { bond(k) } else { 0.0 };
+        let mut a = if k < hi { left - bond(k + 1) } else { left };
+        if k == 0 && left_wall {
+            a += hertz_force(-u[0][l]);
+        }
+        if k == n - 1 && right_wall {
+            a -= hertz_force(u[n - 1][l]);
+        }
+        for (j, r) in chain.resonators.iter().enumerate() {
+            if r.site == k {
+                let f = r.kappa[l] * odd_power(u[k][l] - rv[j][l], r.p);
+                a -= f;
+                acc_v[j][l] = f / r.eps[l];
+            }
+        }
+        acc_u[k][l] = a;
     }
 }
 
