@@ -81,10 +81,22 @@ impl LaneEvents {
         corrected
     }
 
-    /// Lists in `self.changed` every bond of `window` whose contact opened or closed during
-    /// the step in some lane of `live_mask`, as the scalar scan does per lane (a bond outside a
-    /// lane's own window is at rest there, and never changes).
-    fn scan(
+    crate::simd::dispatched! {
+        /// Lists in `self.changed` every bond of `window` whose contact opened or closed during
+        /// the step in some lane of `live_mask`, as the scalar scan does per lane (a bond outside a
+        /// lane's own window is at rest there, and never changes). In its AVX2 copy where the CPU has
+        /// one (`crate::simd`).
+        fn scan[&mut self](
+            model: &Model,
+            new_q: &[Lanes],
+            stage_force: &[Vec<Lanes>; S],
+            window: Window,
+            live_mask: u32,
+        ) => scan_body, scan_avx2
+    }
+
+    #[inline(always)]
+    fn scan_body(
         &mut self,
         model: &Model,
         new_q: &[Lanes],
