@@ -13,10 +13,11 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
 use woodpile_points::rows::{SweepPoint, SweepShape};
-use woodpile_points::{point_key, Key, PointResult, PointStore, Shares};
+use woodpile_points::{point_key, simulate_points_until, Key, PointResult, PointStore, Shares};
 use woodpile_scene::grid::{at_point, parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
+use woodpile_sim::integrate::lanes::LANES;
 
 use crate::interrupt::{internal_message, interruptible_keeping};
 use crate::listed::{outcome_rows, table_dict};
@@ -168,9 +169,12 @@ impl Run<'_> {
         let poll = |py: Python<'_>| points_done(py, progress, &self.done, count);
         let (points, signal) = interruptible_keeping(py, &poll, |cancel| {
             crate::pool::run_parallel(|| {
-                (0..count)
-                    .into_par_iter()
-                    .map(|i| self.point(i, cancel))
+                // Neighbouring points in groups of four, which run in lanes where they can
+                // (`woodpile_sim::simulation::simulate_batch`), as the pipeline's sweeps do.
+                let indices: Vec<usize> = (0..count).collect();
+                indices
+                    .par_chunks(LANES)
+                    .flat_map_iter(|group| self.group(group, cancel))
                     .collect::<Vec<_>>()
             })
         })?;
@@ -218,6 +222,65 @@ impl Run<'_> {
         table_dict(py, &shape.rows(&points))
     }
 
+    /// Points `indices`, together: as [`Run::point`] makes each. A panic in the core makes
+    /// each point again alone, so that it is the failure of its own point only.
+    fn group(
+        &self,
+        indices: &[usize],
+        cancel: &AtomicBool,
+    ) -> Vec<Result<Option<Finished>, Unmade>> {
+        let stop = || cancel.load(Ordering::Relaxed);
+        let made: Vec<Result<(Key, Scene), String>> = indices
+            .iter()
+            .map(|&i| {
+                let scene = self.grid.scene_at(i)?;
+                Ok((point_key(&scene, self.series), scene))
+            })
+            .collect();
+        if stop() || made.iter().any(Result::is_err) {
+            return indices.iter().map(|&i| self.point(i, cancel)).collect();
+        }
+        let made: Vec<&(Key, Scene)> = made.iter().flatten().collect();
+        let keys: Vec<&Key> = made.iter().map(|(key, _)| key).collect();
+        let scenes: Vec<&Scene> = made.iter().map(|(_, scene)| scene).collect();
+        let simulated = std::panic::catch_unwind(AssertUnwindSafe(|| match self.store {
+            Some(store) => store
+                .get_or_simulate_many((&keys, &scenes), self.series, &stop)
+                .map(|all| all.into_iter().map(|f| f.map(|f| f.result)).collect())
+                .map_err(|e| e.to_string()),
+            None => Ok(simulate_points_until(&scenes, self.series, &stop)),
+        }));
+        let results: Vec<Option<PointResult>> = match simulated {
+            Ok(Ok(results)) => results,
+            Ok(Err(reason)) => {
+                return indices
+                    .iter()
+                    .map(|_| Err(Unmade::Cache(reason.clone())))
+                    .collect()
+            }
+            Err(_) => return indices.iter().map(|&i| self.point(i, cancel)).collect(),
+        };
+        keys.into_iter()
+            .zip(results)
+            .map(|(key, result)| Ok(self.finish(result).map(|r| (key.clone(), r))))
+            .collect()
+    }
+
+    /// A point's result as the table keeps it (its last sample only, without series),
+    /// counted as done.
+    fn finish(&self, result: Option<PointResult>) -> Option<PointResult> {
+        // Without series, a point keeps its last sample only: thousands of points' series of a
+        // long run would fill the memory.
+        let result = result.map(|r| match self.every_sample {
+            true => r,
+            false => r.map(|p| p.last_sample()),
+        });
+        if result.is_some() {
+            self.done.fetch_add(1, Ordering::Relaxed);
+        }
+        result
+    }
+
     /// Point `index`: from the cache or simulated (and cached), `None` if the sweep was
     /// stopped first. A panic in the core is the point's failure, not the sweep's.
     fn point(&self, index: usize, cancel: &AtomicBool) -> Result<Option<Finished>, Unmade> {
@@ -242,16 +305,7 @@ impl Run<'_> {
             Ok(result) => result?,
             Err(panic) => Some(Err(internal_message(&panic))),
         };
-        // Without series, a point keeps its last sample only: thousands of points' series of a
-        // long run would fill the memory.
-        let result = result.map(|r| match self.every_sample {
-            true => r,
-            false => r.map(|p| p.last_sample()),
-        });
-        if result.is_some() {
-            self.done.fetch_add(1, Ordering::Relaxed);
-        }
-        Ok(result.map(|r| (key, r)))
+        Ok(self.finish(result).map(|r| (key, r)))
     }
 }
 
