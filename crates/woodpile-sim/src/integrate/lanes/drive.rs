@@ -168,6 +168,7 @@ impl<'m> LaneBatch<'m> {
 
     /// Per lane, the sum of x − x over the state on `union`: 0 exactly when every entry is
     /// finite (one pass for all lanes, as [`check_finite_in`] makes for one).
+    #[allow(clippy::eq_op)] // x - x is the point: it is NaN exactly when x is not finite
     fn finite_sums(&self, union: Window) -> Lanes {
         let n_sites = self.stepper.chain.n_sites;
         let mut sum = ZERO;

@@ -65,9 +65,7 @@ impl LaneRkn6 {
             (&self.stage_force, h),
             (window, live),
         );
-        for l in 0..LANES {
-            self.last_stage_current[l] = !corrected[l];
-        }
+        self.last_stage_current = corrected.map(|c| !c);
         for r in self.dof_ranges(window) {
             q[r.clone()].copy_from_slice(&self.new_q[r.clone()]);
             v[r.clone()].copy_from_slice(&self.new_v[r]);
