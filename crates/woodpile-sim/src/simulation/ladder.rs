@@ -173,15 +173,8 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
     /// A refusal halves the step for the next rung, or gives up when no rung left can accept;
     /// a scene error (not a blow-up) ends the ladder.
     fn rung(&mut self, halvings_left: u32) -> Result<Rung, SimError> {
-        let (scenario, tol) = (self.scenario, self.tol);
-        let run = match self.first_fine.take() {
-            Some(run) => run,
-            None => {
-                self.observer.reset();
-                run_plan(scenario, &self.guarded.with_dt(self.dt), self.observer)
-            }
-        };
-        let fine = match run {
+        let tol = self.tol;
+        let fine = match self.fine_run() {
             Ok(out) => out,
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
             Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
@@ -253,6 +246,18 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
         self.step_down(change, Some(fine));
         let hopeless = self.out_of_reach(&why, halvings_left);
         Ok(hopeless.map_or(Rung::Refine(why), Rung::GiveUp))
+    }
+
+    /// The rung's run at dt, shown to the observer: made now, or before the ladder started.
+    fn fine_run(&mut self) -> Result<Outcome, SimError> {
+        match self.first_fine.take() {
+            Some(run) => run,
+            None => {
+                self.observer.reset();
+                let plan = self.guarded.with_dt(self.dt);
+                run_plan(self.scenario, &plan, self.observer)
+            }
+        }
     }
 
     /// Halves the step: the run just made (`fine`, with its `change` from the coarse one)

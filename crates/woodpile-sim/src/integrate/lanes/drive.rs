@@ -33,13 +33,7 @@ pub fn drive_lanes(
     let mut runs: [Option<Stepping<'_>>; LANES] = std::array::from_fn(|_| None);
     let mut results: [Option<Result<Stats, SimError>>; LANES] = std::array::from_fn(|_| None);
     for l in 0..LANES {
-        let start = Stepping::start(
-            models[l],
-            cfg,
-            &ys[l],
-            (super::step::S, dt),
-            &mut *observers[l],
-        );
+        let start = Stepping::start(models[l], cfg, &ys[l], (super::S, dt), &mut *observers[l]);
         match start {
             Ok(run) => runs[l] = Some(run),
             Err(e) => batch.stop(l, &mut results, e),

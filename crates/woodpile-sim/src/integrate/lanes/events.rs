@@ -3,8 +3,7 @@
 //! [`crate::integrate::event_correction`]'s order and with its functions, so that a lane's end
 //! state is corrected exactly as its scalar run's is.
 
-use super::step::S;
-use super::{lanewise, Lanes, LANES};
+use super::{lanewise, Lanes, LANES, S};
 use crate::integrate::contact_event::BondPath;
 use crate::integrate::contact_scan::changes_contact;
 use crate::integrate::event_correction::{

@@ -34,6 +34,9 @@ pub const LANES: usize = 4;
 /// One value per lane.
 pub(crate) type Lanes = [f64; LANES];
 
+/// Stages of DPRKN6, the tableau the lanes step by.
+pub(crate) const S: usize = 6;
+
 /// Every lane at zero.
 pub(crate) const ZERO: Lanes = [0.0; LANES];
 

@@ -4,13 +4,10 @@
 //! (`raw_step_body`, `Model::accelerations_impl`), which is what keeps it bit-identical.
 
 use super::events::LaneEvents;
-use super::{lanewise, LaneChain, Lanes, LANES, ZERO};
+use super::{lanewise, LaneChain, Lanes, LANES, S, ZERO};
 use crate::force::{hertz_force, odd_power};
 use crate::integrate::rkn::DPRKN6;
 use crate::model::{Model, Window};
-
-/// Stages of DPRKN6.
-pub(super) const S: usize = 6;
 
 /// `rkn6-contact` for four lanes, with its scratch (allocated once).
 #[derive(Debug, Clone)]
