@@ -51,7 +51,8 @@ fn in_lanes(batch: &[Scenario], dt: f64) -> [Vec<f64>; LANES] {
     let models: [&Model; LANES] = std::array::from_fn(|l| &batch[l].model);
     let mut nobody = [(); LANES];
     let observers = nobody.each_mut().map(|o| o as &mut dyn Observer);
-    let results = drive_lanes(models, &mut ys, &cfg, observers).expect("one chain");
+    let results =
+        drive_lanes(Method::Rkn6Contact, models, &mut ys, &cfg, observers).expect("one chain");
     for r in results {
         r.unwrap();
     }

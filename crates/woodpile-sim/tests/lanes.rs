@@ -40,6 +40,41 @@ fn batched_and_alone(scenes: &[Scenario]) {
     }
 }
 
+/// The method and first step `auto` plans for each of `scenes`.
+fn first_steps(scenes: &[Scenario]) -> Vec<(Method, f64)> {
+    let plan = |s: &Scenario| Plan::choose(&s.model, s.method, s.accuracy).unwrap();
+    scenes
+        .iter()
+        .map(|s| (plan(s).method, auto_first_step(s, &plan(s))))
+        .collect()
+}
+
+/// Eight F7 fine points (light resonators, run by `erkn6-contact`) in two lane groups, each
+/// equal to its scalar `auto` run: the exact pair steps and their fast-mode corrections per
+/// lane.
+#[test]
+fn light_resonators_in_lanes_equal_their_scalar_runs() {
+    let eps = [
+        (0.1, 0.3),
+        (0.3, 0.3),
+        (0.72, 0.62),
+        (1.0, 0.2),
+        (0.5, 0.9),
+        (0.15, 0.15),
+        (0.8, 0.4),
+        (0.25, 1.0),
+    ];
+    let scenes: Vec<Scenario> = eps.iter().map(|&e| f7_scene(e)).collect();
+    let first = first_steps(&scenes[..LANES]);
+    assert!(
+        first
+            .iter()
+            .all(|&f| f == (Method::Erkn6Contact, first[0].1)),
+        "{first:?}"
+    );
+    batched_and_alone(&scenes);
+}
+
 /// Nine F7 points (two groups of four in lanes, the ninth alone), some passing their first
 /// pair and some needing a third run, each equal to its scalar `auto` run.
 #[test]
@@ -59,11 +94,7 @@ fn sweep_points_in_lanes_equal_their_scalar_runs() {
     let models: Vec<&Model> = scenes.iter().map(|s| &s.model).collect();
     assert!(shares_a_chain(&models[..LANES].try_into().unwrap()));
     // The first group takes lanes: one method and one first step.
-    let plan = |s: &Scenario| Plan::choose(&s.model, s.method, s.accuracy).unwrap();
-    let first: Vec<(Method, f64)> = scenes[..LANES]
-        .iter()
-        .map(|s| (plan(s).method, auto_first_step(s, &plan(s))))
-        .collect();
+    let first = first_steps(&scenes[..LANES]);
     assert!(
         first
             .iter()
@@ -153,7 +184,7 @@ fn a_lane_that_blows_up_stops_alone() {
         std::array::from_fn(|l| FractionSeries::new(&scenes[l].model, scenes[l].region));
     let models: [&Model; LANES] = std::array::from_fn(|l| &scenes[l].model);
     let observers = recorders.each_mut().map(|o| o as &mut dyn Observer);
-    let results = drive_lanes(models, &mut ys, &cfg, observers).unwrap();
+    let results = drive_lanes(Method::Rkn6Contact, models, &mut ys, &cfg, observers).unwrap();
     for l in 0..LANES {
         let mut y = start(&scenes[l]);
         let mut alone = FractionSeries::new(&scenes[l].model, scenes[l].region);

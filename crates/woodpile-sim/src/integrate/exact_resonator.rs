@@ -33,6 +33,39 @@ use super::contact_event::{oscillating_path_integrals, BondPath};
 use super::erkn_weights::{pair_step, NystromWeights, PairStep};
 use crate::model::Model;
 
+/// A vector of degrees of freedom as the pair steps read it: a state's own slice, or one lane
+/// of four (`super::lanes`). Reads and writes are plain loads, stores and additions, so both
+/// give the same bits.
+pub(crate) trait Dofs {
+    /// Entry `k`.
+    fn at(&self, k: usize) -> f64;
+}
+
+/// [`Dofs`] that the pair steps also write.
+pub(crate) trait DofsMut: Dofs {
+    /// Entry `k` becomes `x`.
+    fn set(&mut self, k: usize, x: f64);
+    /// Entry `k` += `x`.
+    #[inline(always)]
+    fn add(&mut self, k: usize, x: f64) {
+        self.set(k, self.at(k) + x);
+    }
+}
+
+impl Dofs for [f64] {
+    #[inline(always)]
+    fn at(&self, k: usize) -> f64 {
+        self[k]
+    }
+}
+
+impl DofsMut for [f64] {
+    #[inline(always)]
+    fn set(&mut self, k: usize, x: f64) {
+        self[k] = x;
+    }
+}
+
 /// One host site and its harmonic resonator.
 #[derive(Debug, Clone, Copy)]
 struct Pair {
@@ -144,14 +177,19 @@ impl<const S: usize> ExactResonators<S> {
     /// coefficients and notes each pair's stretch and its rate (a pair whose host is outside
     /// the window is at rest and takes no part).
     #[inline(always)]
-    pub fn begin_step(&mut self, h: f64, (q, p): (&[f64], &[f64]), (lo, hi): (usize, usize)) {
+    pub fn begin_step<D: Dofs + ?Sized>(
+        &mut self,
+        h: f64,
+        (q, p): (&D, &D),
+        (lo, hi): (usize, usize),
+    ) {
         self.prepare(h);
         for o in &mut self.pairs {
             let (host, resonator) = (o.pair.host, o.pair.resonator);
             o.now.active = host >= lo && host <= hi;
             if o.now.active {
-                o.now.stretch = q[host] - q[resonator];
-                o.now.rate = p[host] - p[resonator];
+                o.now.stretch = q.at(host) - q.at(resonator);
+                o.now.rate = p.at(host) - p.at(resonator);
             }
         }
     }
@@ -160,15 +198,27 @@ impl<const S: usize> ExactResonators<S> {
     /// pair's spring force taken out of its host's acceleration, and its resonator's set to
     /// zero (a resonator feels its spring only). Keeps the pair's share of g for the shifts.
     #[inline(always)]
-    pub fn remove_springs(&mut self, i: usize, q: &[f64], acc: &mut [f64]) {
+    pub fn remove_springs<D: Dofs + ?Sized, A: DofsMut + ?Sized>(
+        &mut self,
+        i: usize,
+        q: &D,
+        acc: &mut A,
+    ) {
         for o in &mut self.pairs {
-            if o.now.active {
-                let (host, resonator) = (o.pair.host, o.pair.resonator);
-                acc[host] += o.pair.kappa * (q[host] - q[resonator]) * o.pair.inv_host_mass;
-                acc[resonator] = 0.0;
-                // The pair's share of g, g_host − g_resonator, with the latter now zero.
-                o.now.forcing[i] = acc[host];
-            }
+            o.remove_spring(i, q, acc);
+        }
+    }
+
+    /// [`ExactResonators::remove_springs`] for the pair hosted at `site` only, if any: for a
+    /// stage whose forces were evaluated again at a few sites (`super::lanes`).
+    pub fn remove_spring_at<D: Dofs + ?Sized, A: DofsMut + ?Sized>(
+        &mut self,
+        (i, site): (usize, usize),
+        q: &D,
+        acc: &mut A,
+    ) {
+        if let Some(k) = self.pair_of_site[site] {
+            self.pairs[k].remove_spring(i, q, acc);
         }
     }
 
@@ -183,7 +233,7 @@ impl<const S: usize> ExactResonators<S> {
     /// (already the plain tableau's), from the step's start and the forcings of the stages
     /// before it.
     #[inline(always)]
-    pub fn shift_stage(&self, i: usize, q_stage: &mut [f64]) {
+    pub fn shift_stage<A: DofsMut + ?Sized>(&self, i: usize, q_stage: &mut A) {
         for o in &self.pairs {
             if o.now.active {
                 let (step, now) = (&o.step, &o.now);
@@ -191,8 +241,8 @@ impl<const S: usize> ExactResonators<S> {
                 for (weight, g) in step.stage_g[i][..i].iter().zip(&now.forcing) {
                     shift += weight * g;
                 }
-                q_stage[o.pair.host] += shift * o.pair.mode[0];
-                q_stage[o.pair.resonator] += shift * o.pair.mode[1];
+                q_stage.add(o.pair.host, shift * o.pair.mode[0]);
+                q_stage.add(o.pair.resonator, shift * o.pair.mode[1]);
             }
         }
     }
@@ -200,7 +250,7 @@ impl<const S: usize> ExactResonators<S> {
     /// Adds each pair's fast-mode shift to the new velocity `new_p` (already the plain
     /// tableau's). The new position needs none of its own: it is the last stage's.
     #[inline(always)]
-    pub fn shift_velocity(&self, new_p: &mut [f64]) {
+    pub fn shift_velocity<A: DofsMut + ?Sized>(&self, new_p: &mut A) {
         for o in &self.pairs {
             if o.now.active {
                 let (step, now) = (&o.step, &o.now);
@@ -208,8 +258,8 @@ impl<const S: usize> ExactResonators<S> {
                 for (weight, g) in step.velocity_g.iter().zip(&now.forcing) {
                     shift += weight * g;
                 }
-                new_p[o.pair.host] += shift * o.pair.mode[0];
-                new_p[o.pair.resonator] += shift * o.pair.mode[1];
+                new_p.add(o.pair.host, shift * o.pair.mode[0]);
+                new_p.add(o.pair.resonator, shift * o.pair.mode[1]);
             }
         }
     }
@@ -230,6 +280,27 @@ impl<const S: usize> ExactResonators<S> {
             b_velocity: step.b_velocity,
             b_position: step.b_position,
         })
+    }
+}
+
+impl<const S: usize> Oscillator<S> {
+    /// Takes the pair's spring out of stage `i`'s accelerations `acc` (of positions `q`) and
+    /// keeps its share of g ([`ExactResonators::remove_springs`]).
+    #[inline(always)]
+    fn remove_spring<D: Dofs + ?Sized, A: DofsMut + ?Sized>(
+        &mut self,
+        i: usize,
+        q: &D,
+        acc: &mut A,
+    ) {
+        if self.now.active {
+            let (host, resonator) = (self.pair.host, self.pair.resonator);
+            let spring = self.pair.kappa * (q.at(host) - q.at(resonator)) * self.pair.inv_host_mass;
+            acc.add(host, spring);
+            acc.set(resonator, 0.0);
+            // The pair's share of g, g_host − g_resonator, with the latter now zero.
+            self.now.forcing[i] = acc.at(host);
+        }
     }
 }
 

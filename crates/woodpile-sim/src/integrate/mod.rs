@@ -38,6 +38,7 @@ pub use driver::{drive, intervals, END_ARRIVAL_SPEED};
 pub use method::{Method, MethodChoice};
 pub use plan::{
     Accuracy, Plan, AUTO_METHOD, BLOW_UP_DRIFT, DISSIPATIVE_AUTO_METHOD, DRIFT_PER_TOL,
+    HARMONIC_AUTO_METHOD,
 };
 pub use rk::{ExplicitRk, Rk4, Tableau};
 pub use rk4_fused::Rk4Fused;

@@ -256,7 +256,7 @@ impl<const S: usize> Rkn<S> {
                     }
                 }
                 if let Some(exact) = &self.exact {
-                    exact.shift_stage(i, &mut self.q_stage);
+                    exact.shift_stage(i, self.q_stage.as_mut_slice());
                 }
             }
             if i == 0 && self.last_stage_current {
@@ -281,7 +281,7 @@ impl<const S: usize> Rkn<S> {
                 window,
             );
             if let Some(exact) = self.exact.as_mut() {
-                exact.remove_springs(i, qs, &mut self.a[i]);
+                exact.remove_springs(i, qs, self.a[i].as_mut_slice());
             }
         }
         let (new_q, new_v) = self.y_new.split_at_mut(n);

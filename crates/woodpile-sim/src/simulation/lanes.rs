@@ -3,8 +3,8 @@
 //! ([`crate::integrate::lanes`]), after which each scene's ladder goes on alone from those
 //! runs. Every result is its scene's [`simulate`] result bit for bit; only the time differs.
 //!
-//! Four scenes take lanes together when each asks for `auto`, plans `rkn6-contact` at the
-//! same first step, runs for as long with the same samples, and all share a chain that takes
+//! Four scenes take lanes together when each asks for `auto`, plans the same method
+//! (`rkn6-contact`, or `erkn6-contact` for light harmonic resonators) at the same first step, runs for as long with the same samples, and all share a chain that takes
 //! lanes ([`crate::integrate::lanes::takes_lanes`]). A sweep's neighbouring points mostly do;
 //! any other group runs scene by scene.
 
@@ -13,7 +13,9 @@ use super::{auto_first_step, budget, outcome_of, simulate, Outcome, Scenario};
 use crate::energy::total_energy;
 use crate::error::SimError;
 use crate::integrate::lanes::{drive_lanes, enabled, shares_a_chain, LANES};
-use crate::integrate::{CancelOnly, MethodChoice, Observer, Plan, AUTO_METHOD, BLOW_UP_DRIFT};
+use crate::integrate::{
+    CancelOnly, MethodChoice, Observer, Plan, AUTO_METHOD, BLOW_UP_DRIFT, HARMONIC_AUTO_METHOD,
+};
 
 /// Simulates each of `scenarios` as [`simulate`] does, showing the samples of each one's
 /// reported run to its own of `observers` (as many), with groups of four consecutive scenes
@@ -63,7 +65,8 @@ impl<'s> LaneGroup<'s> {
         let plan_of = |s: &Scenario| {
             let auto = s.method == MethodChoice::Auto;
             let plan = Plan::choose(&s.model, s.method, s.accuracy).ok()?;
-            (auto && plan.method == AUTO_METHOD && budget::check(s).is_ok()).then_some(plan)
+            let method = plan.method == AUTO_METHOD || plan.method == HARMONIC_AUTO_METHOD;
+            (auto && method && budget::check(s).is_ok()).then_some(plan)
         };
         let first = scenarios[0];
         let plan = plan_of(first)?;
@@ -105,7 +108,7 @@ impl<'s> LaneGroup<'s> {
         let cfg = plan.drive_config((first.t_end, first.sample_every), true);
         let mut ys = self.starts.clone().map(|(y, _)| y);
         let models = self.scenarios.map(|s| &s.model);
-        let stats = drive_lanes(models, &mut ys, &cfg, observers)
+        let stats = drive_lanes(plan.method, models, &mut ys, &cfg, observers)
             .expect("a lane group shares a chain and a fixed step");
         let mut ys = ys.map(Some);
         std::array::from_fn(|l| {

@@ -6,17 +6,19 @@ use super::step::LaneRkn6;
 use super::{lanewise, LaneChain, Lanes, LANES, ZERO};
 use crate::error::SimError;
 use crate::integrate::driver::{check_finite_in, intervals, sample_time, validate, Stepping};
-use crate::integrate::{DriveConfig, Observer, Stats, StepControl};
+use crate::integrate::{DriveConfig, Method, Observer, Stats, StepControl};
 use crate::model::{Model, Window};
 
 /// Integrates four states `ys` (`[q, q']` each, of `models`, one per lane) from t = 0 to
-/// `cfg.t_end` by `rkn6-contact` at `cfg`'s fixed step, calling each lane's observer at the
+/// `cfg.t_end` by `method` (`rkn6-contact` or `erkn6-contact`) at `cfg`'s fixed step, calling each lane's observer at the
 /// samples, and leaves each lane's final state in `ys`. Each lane's result is its scalar run's
 /// ([`crate::integrate::drive`] with [`crate::integrate::Plan::stepper`]) bit for bit: its
 /// statistics, or the error that stopped it (which stops that lane only).
 ///
-/// `None` when the models do not share a chain ([`LaneChain::of`]) or the step is not fixed.
+/// `None` when the models do not share a chain ([`LaneChain::of`]), the step is not fixed, or
+/// the method is another.
 pub fn drive_lanes(
+    method: Method,
     models: [&Model; LANES],
     ys: &mut [Vec<f64>; LANES],
     cfg: &DriveConfig,
@@ -26,10 +28,15 @@ pub fn drive_lanes(
     let StepControl::Fixed { dt } = cfg.control else {
         return None;
     };
+    let exact = match method {
+        Method::Rkn6Contact => false,
+        Method::Erkn6Contact => true,
+        _ => return None,
+    };
     if let Err(e) = validate(cfg) {
         return Some(std::array::from_fn(|_| Err(e.clone())));
     }
-    let mut batch = LaneBatch::new(chain, &models, ys);
+    let mut batch = LaneBatch::new(LaneRkn6::new(chain, &models, exact), &models, ys);
     let mut runs: [Option<Stepping<'_>>; LANES] = std::array::from_fn(|_| None);
     let mut results: [Option<Result<Stats, SimError>>; LANES] = std::array::from_fn(|_| None);
     for l in 0..LANES {
@@ -74,16 +81,16 @@ struct LaneBatch<'m> {
 }
 
 impl<'m> LaneBatch<'m> {
-    /// The lanes of `chain` at the states `ys` (one per lane, `[q, q']`).
-    fn new(chain: LaneChain, models: &[&'m Model; LANES], ys: &[Vec<f64>; LANES]) -> Self {
-        let n = chain.n_dof();
+    /// The lanes of `stepper` at the states `ys` (one per lane, `[q, q']`).
+    fn new(stepper: LaneRkn6, models: &[&'m Model; LANES], ys: &[Vec<f64>; LANES]) -> Self {
+        let n = stepper.chain.n_dof();
         let q = (0..n).map(|k| std::array::from_fn(|l| ys[l][k])).collect();
         let v = (0..n)
             .map(|k| std::array::from_fn(|l| ys[l][n + k]))
             .collect();
         LaneBatch {
             models: *models,
-            stepper: LaneRkn6::new(chain),
+            stepper,
             q,
             v,
             live: [true; LANES],

@@ -9,6 +9,9 @@ use crate::integrate::contact_scan::changes_contact;
 use crate::integrate::event_correction::{
     bond_integrals, end_force, negligible, BondSites, Correction,
 };
+use crate::integrate::exact_resonator::{
+    fast_mode_correction, ExactResonators, FastModeCorrection,
+};
 use crate::integrate::rkn::DPRKN6;
 use crate::model::{Model, Window};
 
@@ -19,6 +22,7 @@ pub(super) struct LaneEvents {
     /// scalar scan's order (inner bonds rising, then the left wall, then the right).
     changed: Vec<(BondSites, u32)>,
     pending: Vec<Correction>,
+    pending_fast: Vec<FastModeCorrection>,
     /// Per lane, the sites the last step's corrections moved.
     pub touched: [Vec<usize>; LANES],
     /// Bonds corrected so far, per lane.
@@ -36,6 +40,7 @@ impl LaneEvents {
         (new_q, new_v): (&mut [Lanes], &mut [Lanes]),
         (stage_force, h): (&[Vec<Lanes>; S], f64),
         (window, live): (Window, [bool; LANES]),
+        exact: &[Option<ExactResonators<S>>; LANES],
     ) -> [bool; LANES] {
         let live_mask = (0..LANES).fold(0, |m, l| m | (u32::from(live[l]) << l));
         self.scan(models[0], new_q, stage_force, window, live_mask);
@@ -67,8 +72,25 @@ impl LaneEvents {
                 let (impulse, moment, _) = bond_integrals(model, bond, &path, h);
                 let (q0, q1) = (DPRKN6.quadrature)(stage, h);
                 pending.push((left, right, impulse - q0, moment - q1));
+                if let Some(exact) = &exact[l] {
+                    for (member, sign) in [(left, -1.0), (right, 1.0)] {
+                        if let Some(pair) = member.and_then(|site| exact.host(site)) {
+                            let plain = (impulse - q0, moment - q1);
+                            let fast = (bond, &path, stage);
+                            let correction =
+                                fast_mode_correction(model, fast, h, plain, (pair, sign));
+                            self.pending_fast.push(correction);
+                        }
+                    }
+                }
             }
             apply(model.inv_mass(), &pending, (new_q, new_v), l);
+            for fast in self.pending_fast.drain(..) {
+                for k in 0..2 {
+                    new_v[fast.sites[k]][l] += fast.velocity[k];
+                    new_q[fast.sites[k]][l] += fast.position[k];
+                }
+            }
             let touched = &mut self.touched[l];
             for &(left, right, ..) in &pending {
                 touched.extend(left.into_iter().chain(right));

@@ -14,6 +14,10 @@
 //! reuse, failures and observer. The lanes step on the union of their windows: outside its
 //! own window a lane is exactly at rest, and working on resting sites changes none of its bits.
 //!
+//! The lanes step by `rkn6-contact` or by `erkn6-contact`, whose harmonic resonators each lane
+//! integrates exactly with its own scalar [`super::exact_resonator::ExactResonators`] (the
+//! pair steps read and write one lane through [`Lane`] and [`LaneMut`]).
+//!
 //! Only the paper's conservative chain takes lanes (Hertz's law without precompression, unit
 //! site masses, fixed or free ends, constant couplings); any other scene steps alone.
 //! - [`step`]: the batched DPRKN6 step and force loop.
@@ -26,6 +30,7 @@ mod step;
 
 pub use drive::drive_lanes;
 
+use super::exact_resonator::{Dofs, DofsMut};
 use crate::model::{Coupling, Model};
 
 /// Scenes per batch: the f64 lanes of an AVX2 register.
@@ -46,6 +51,33 @@ pub(crate) const ZERO: Lanes = [0.0; LANES];
 #[inline(always)]
 pub(crate) fn lanewise(x: Lanes, y: Lanes, op: impl Fn(f64, f64) -> f64) -> Lanes {
     std::array::from_fn(|l| op(x[l], y[l]))
+}
+
+/// Lane `l` of a batch's vector, read as one state's vector is ([`Dofs`]).
+pub(crate) struct Lane<'a>(pub &'a [Lanes], pub usize);
+
+/// Lane `l` of a batch's vector, read and written as one state's vector is ([`DofsMut`]).
+pub(crate) struct LaneMut<'a>(pub &'a mut [Lanes], pub usize);
+
+impl Dofs for Lane<'_> {
+    #[inline(always)]
+    fn at(&self, k: usize) -> f64 {
+        self.0[k][self.1]
+    }
+}
+
+impl Dofs for LaneMut<'_> {
+    #[inline(always)]
+    fn at(&self, k: usize) -> f64 {
+        self.0[k][self.1]
+    }
+}
+
+impl DofsMut for LaneMut<'_> {
+    #[inline(always)]
+    fn set(&mut self, k: usize, x: f64) {
+        self.0[k][self.1] = x;
+    }
 }
 
 /// A resonator of the shared chain: its host site and exponent, and each lane's coupling and

@@ -4,8 +4,10 @@
 //! (`raw_step_body`, `Model::accelerations_impl`), which is what keeps it bit-identical.
 
 use super::events::LaneEvents;
-use super::{lanewise, LaneChain, Lanes, LANES, S, ZERO};
+use super::{lanewise, Lane, LaneChain, LaneMut, Lanes, LANES, S, ZERO};
 use crate::force::{hertz_force, odd_power};
+use crate::integrate::erkn_weights::NystromWeights;
+use crate::integrate::exact_resonator::ExactResonators;
 use crate::integrate::rkn::DPRKN6;
 use crate::model::{Model, Window};
 
@@ -25,10 +27,20 @@ pub(super) struct LaneRkn6 {
     /// stepper's first-same-as-last flag).
     last_stage_current: [bool; LANES],
     events: LaneEvents,
+    /// Per lane, its harmonic resonators integrated exactly (`erkn6-contact`), if any.
+    exact: [Option<ExactResonators<S>>; LANES],
 }
 
 impl LaneRkn6 {
-    pub fn new(chain: LaneChain) -> Self {
+    /// The lanes of `chain`, their models `models`, with their harmonic resonators integrated
+    /// exactly when `exact` (`erkn6-contact`; `rkn6-contact` otherwise).
+    pub fn new(chain: LaneChain, models: &[&Model; LANES], exact: bool) -> Self {
+        let weights = NystromWeights {
+            c: DPRKN6.c,
+            b: DPRKN6.b,
+            b_prime: DPRKN6.b_prime,
+        };
+        let exact = models.map(|m| exact.then(|| ExactResonators::of(m, weights)).flatten());
         let n = chain.n_dof();
         let bonds = chain.n_sites + 1;
         Self {
@@ -40,6 +52,7 @@ impl LaneRkn6 {
             evals: [0; LANES],
             last_stage_current: [false; LANES],
             events: LaneEvents::default(),
+            exact,
             chain,
         }
     }
@@ -61,6 +74,7 @@ impl LaneRkn6 {
             (&mut self.new_q, &mut self.new_v),
             (&self.stage_force, h),
             (window, live),
+            &self.exact,
         );
         self.last_stage_current = corrected.map(|c| !c);
         for r in self.dof_ranges(window) {
@@ -102,6 +116,11 @@ impl LaneRkn6 {
         // The last stage is reused when it is current in every live lane, or was moved by a
         // correction at a few sites whose forces are then evaluated again; otherwise (the
         // first step) the first stage is evaluated whole.
+        for (l, exact) in self.exact.iter_mut().enumerate() {
+            if let Some(exact) = exact {
+                exact.begin_step(h, (&Lane(q, l), &Lane(v, l)), (window.lo, window.hi));
+            }
+        }
         let reuse = (0..LANES)
             .all(|l| !live[l] || self.last_stage_current[l] || !self.events.touched[l].is_empty());
         for i in 0..S {
@@ -119,15 +138,29 @@ impl LaneRkn6 {
                         }
                     }
                 }
+                for (l, exact) in self.exact.iter().enumerate() {
+                    if let Some(exact) = exact {
+                        exact.shift_stage(i, &mut LaneMut(&mut self.q_stage, l));
+                    }
+                }
             }
             if i == 0 && reuse {
                 self.a.swap(0, S - 1);
                 self.stage_force.swap(S - 1, 0);
+                for exact in self.exact.iter_mut().flatten() {
+                    exact.reuse_stage(S - 1, 0);
+                }
                 for l in (0..LANES).filter(|&l| live[l] && !self.last_stage_current[l]) {
                     self.evals[l] += 1;
                     for &site in &self.events.touched[l] {
                         let forces = (&mut self.a[0][..], &mut self.stage_force[0][..]);
-                        patch(&self.chain, q, forces, (window, l), site);
+                        let patched = patch(&self.chain, q, forces, (window, l), site);
+                        if let Some(exact) = self.exact[l].as_mut() {
+                            for k in patched {
+                                let acc = &mut LaneMut(&mut self.a[0], l);
+                                exact.remove_spring_at((0, k), &Lane(q, l), acc);
+                            }
+                        }
                     }
                 }
                 continue;
@@ -144,6 +177,11 @@ impl LaneRkn6 {
                 (&mut self.a[i], &mut self.stage_force[i]),
                 window,
             );
+            for (l, exact) in self.exact.iter_mut().enumerate() {
+                if let Some(exact) = exact {
+                    exact.remove_springs(i, &Lane(qs, l), &mut LaneMut(&mut self.a[i], l));
+                }
+            }
         }
         for r in ranges {
             // DPRKN6's last stage position is the new position, computed the same way.
@@ -156,6 +194,11 @@ impl LaneRkn6 {
                 }
             }
         }
+        for (l, exact) in self.exact.iter().enumerate() {
+            if let Some(exact) = exact {
+                exact.shift_velocity(&mut LaneMut(&mut self.new_v, l));
+            }
+        }
     }
 }
 
@@ -163,13 +206,14 @@ impl LaneRkn6 {
 /// after the forces `acc` and `record` (a whole evaluation's) were taken: the bonds beside it
 /// and the accelerations of it and its neighbours, each by the operations [`accelerations`]
 /// makes of it on `window`, so that the patched forces are a whole evaluation's bit for bit.
+/// Returns the sites whose accelerations it wrote.
 fn patch(
     chain: &LaneChain,
     q: &[Lanes],
     (acc, record): (&mut [Lanes], &mut [Lanes]),
     (window, l): (Window, usize),
     site: usize,
-) {
+) -> std::ops::RangeInclusive<usize> {
     let n = chain.n_sites;
     let (lo, hi) = (window.lo, window.hi);
     let (u, rv) = q.split_at(n);
@@ -191,7 +235,8 @@ fn patch(
     if site == n - 1 && hi == n - 1 && right_wall {
         record[n][l] = hertz_force(u[n - 1][l]);
     }
-    for k in site.saturating_sub(1).max(lo)..=(site + 1).min(hi) {
+    let patched = site.saturating_sub(1).max(lo)..=(site + 1).min(hi);
+    for k in patched.clone() {
         let left = if k > lo { bond(k) } else { 0.0 };
         let mut a = if k < hi { left - bond(k + 1) } else { left };
         if k == 0 && left_wall {
@@ -209,6 +254,7 @@ fn patch(
         }
         acc_u[k][l] = a;
     }
+    patched
 }
 
 /// `dst += w x`, lane by lane.
