@@ -129,6 +129,30 @@ fn lanes_with_other_impulses_and_wall_bounces_equal_their_scalar_runs() {
         scene(10, 1.0, 12.0),
     ];
     batched_and_alone(&scenes);
+    // Light resonators (`erkn6-contact`) on a longer chain, whose host some lanes' windows
+    // reach late and others hold from the start.
+    let long = |site: usize, velocity: f64, eps: f64| {
+        let resonators = vec![Resonator::constant(30, eps, 1.0, 1)];
+        Scenario {
+            model: Model::new(41, Boundary::Fixed, resonators).unwrap(),
+            region: Region::new(29, 31, 41).unwrap(),
+            ..scene(site, velocity, eps)
+        }
+    };
+    let light = [
+        long(0, 1.0, 0.05),
+        long(5, -1.0, 0.08),
+        long(40, -1.0, 0.06),
+        long(33, 1.0, 0.1),
+    ];
+    let first = first_steps(&light);
+    assert!(
+        first
+            .iter()
+            .all(|&f| f == (Method::Erkn6Contact, first[0].1)),
+        "{first:?}"
+    );
+    batched_and_alone(&light);
 }
 
 /// Scenes that cannot share lanes (other resonator sites, a named method) run alone, with the
