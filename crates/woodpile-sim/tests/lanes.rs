@@ -9,7 +9,7 @@ use woodpile_sim::integrate::lanes::{drive_lanes, shares_a_chain, LANES};
 use woodpile_sim::integrate::{
     drive, DriveConfig, Method, MethodChoice, Observer, Plan, StepControl, BLOW_UP_DRIFT,
 };
-use woodpile_sim::model::{Boundary, Model, Resonator};
+use woodpile_sim::model::{Boundary, End, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::simulation::{auto_first_step, simulate, simulate_batch, Scenario};
 use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
@@ -235,4 +235,105 @@ fn a_lane_that_blows_up_stops_alone() {
         results[1]
     );
     assert!(results.iter().filter(|r| r.is_ok()).count() == 3);
+}
+
+/// `base` with its resonators' masses scaled by `factor`: a neighbouring point of a sweep
+/// over them, on the same chain.
+fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
+    let m = &base.model;
+    let resonators = m
+        .resonators()
+        .iter()
+        .map(|r| Resonator {
+            eps: r.eps * factor,
+            ..*r
+        })
+        .collect();
+    let masses = (0..m.n_sites()).map(|i| m.site_mass(i)).collect();
+    let mut model =
+        Model::with_masses(m.n_sites(), m.boundary(), resonators, Some(masses)).unwrap();
+    if let Some(law) = m.contacts() {
+        model = model.with_contacts(law.clone()).unwrap();
+    }
+    Scenario {
+        model,
+        ..base.clone()
+    }
+}
+
+/// Whether four scenes take lanes together: one method and first step, one chain.
+fn take_lanes(scenes: &[Scenario]) -> bool {
+    let first = first_steps(scenes);
+    let models: Vec<&Model> = scenes.iter().map(|s| &s.model).collect();
+    let auto = scenes.iter().all(|s| s.method == MethodChoice::Auto);
+    auto && first.iter().all(|&f| f == first[0]) && shares_a_chain(&models[..].try_into().unwrap())
+}
+
+/// The experiment's chain in lanes (the chain audit's scenes at tolerance 1e-5 to t = 60: an
+/// exponent from 1 to 3,
+/// alternating masses and contact coefficients, precompression or a striker), each lane a
+/// neighbouring point, each equal to its scalar run.
+#[test]
+fn the_experiments_chain_in_lanes_equals_its_scalar_runs() {
+    let mut rng = woodpile_sim::testing::Lcg(2026);
+    let mut batched = 0;
+    for k in 0..24 {
+        // At the sweeps' tolerance and over a shorter run, to keep the test quick.
+        let base = Scenario {
+            accuracy: tolerance(1e-5),
+            t_end: 60.0,
+            sample_every: 5.0,
+            ..woodpile_sim::testing::chain_audit_scene(&mut rng)
+        };
+        // Points of a sweep over the impulse's site, two apart so that the struck sites have
+        // the same mass (and the impact the same energy); on every fourth group one lane also
+        // has lighter resonators, which may change its first step and keep the group out.
+        let last = base.model.n_sites() - 1;
+        let mut scenes: Vec<Scenario> = (0..LANES)
+            .map(|k| Scenario {
+                impulse_site: (base.impulse_site + 2 * k).min(last),
+                ..base.clone()
+            })
+            .collect();
+        if k % 4 == 3 {
+            scenes[3] = with_resonator_masses_scaled(&scenes[3], 0.999);
+        }
+        batched += usize::from(take_lanes(&scenes));
+        batched_and_alone(&scenes);
+    }
+    assert!(batched >= 6, "only {batched} of 24 groups took lanes");
+}
+
+/// Soft ends (springs without dashpots) and a heavy striker's mass per lane, in lanes.
+#[test]
+fn soft_ends_and_site_masses_in_lanes_equal_their_scalar_runs() {
+    let scene = |striker: f64, eps: f64| {
+        let soft = End::Soft {
+            spring: 0.05,
+            damping: 0.0,
+        };
+        let mut masses = vec![1.0; 30];
+        masses[0] = striker;
+        let resonators = vec![Resonator::constant(15, eps, 1.0, 1)];
+        let model =
+            Model::with_masses(30, Boundary::ends(soft, soft), resonators, Some(masses)).unwrap();
+        Scenario {
+            region: Region::new(14, 16, 30).unwrap(),
+            model,
+            impulse_site: 0,
+            impulse_velocity: 1.0,
+            t_end: 80.0,
+            method: MethodChoice::Auto,
+            accuracy: tolerance(1e-6),
+            sample_every: 4.0,
+        }
+    };
+    let scenes = [
+        scene(1.0, 5.0),
+        scene(1.0, 6.0),
+        scene(1.0, 7.0),
+        scene(1.0, 8.0),
+    ];
+    assert!(take_lanes(&scenes));
+    batched_and_alone(&scenes);
 }

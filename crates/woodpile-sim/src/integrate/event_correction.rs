@@ -11,7 +11,7 @@ use super::contact_event::{
     BondPath,
 };
 use super::contact_scan::{block_changes, block_of, changes_contact};
-use super::exact_resonator::{fast_mode_correction, ExactResonators, FastModeCorrection};
+use super::exact_resonator::{fast_mode_correction, Dofs, ExactResonators, FastModeCorrection};
 use crate::contact::ContactLaw;
 use crate::model::{Model, Window};
 
@@ -438,14 +438,15 @@ impl<const S: usize> ContactEvents<S> {
 /// A bond's overlap and rate at both ends of a step, from the states (positions, velocities) at
 /// its start and end: left member minus right member, a wall counting as at rest, plus the
 /// bond's static overlap under a precompressed [`ContactLaw`].
-fn bond_path(
+/// The state may be a lane of four (`super::lanes`): it is read through [`Dofs`].
+pub(super) fn bond_path<D: Dofs + ?Sized>(
     model: &Model,
     bond: usize,
-    (q, v): (&[f64], &[f64]),
-    (new_q, new_v): (&[f64], &[f64]),
+    (q, v): (&D, &D),
+    (new_q, new_v): (&D, &D),
     (left, right): (Option<usize>, Option<usize>),
 ) -> BondPath {
-    let member = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
+    let member = |x: &D, site: Option<usize>| site.map_or(0.0, |i| x.at(i));
     let path = BondPath {
         d0: member(q, left) - member(q, right),
         rate0: member(v, left) - member(v, right),

@@ -3,11 +3,11 @@
 //! [`crate::integrate::event_correction`]'s order and with its functions, so that a lane's end
 //! state is corrected exactly as its scalar run's is.
 
-use super::{lanewise, Lanes, LANES, S};
-use crate::integrate::contact_event::BondPath;
+use super::{lanewise, Lane, Lanes, LANES, S};
+use crate::contact::ContactLaw;
 use crate::integrate::contact_scan::changes_contact;
 use crate::integrate::event_correction::{
-    bond_integrals, end_force, negligible, BondSites, Correction,
+    bond_integrals, bond_path, end_force, negligible, BondSites, Correction,
 };
 use crate::integrate::exact_resonator::{
     fast_mode_correction, ExactResonators, FastModeCorrection,
@@ -59,13 +59,11 @@ impl LaneEvents {
                     continue;
                 }
                 let stage: [f64; S] = std::array::from_fn(|s| stage_force[s][bond][l]);
-                let member = |x: &[Lanes], site: Option<usize>| site.map_or(0.0, |i| x[i][l]);
-                let path = BondPath {
-                    d0: member(q, left) - member(q, right),
-                    rate0: member(v, left) - member(v, right),
-                    d1: member(new_q, left) - member(new_q, right),
-                    rate1: member(new_v, left) - member(new_v, right),
-                };
+                let (start, end) = (
+                    (&Lane(q, l), &Lane(v, l)),
+                    (&Lane(new_q, l), &Lane(new_v, l)),
+                );
+                let path = bond_path(model, bond, start, end, (left, right));
                 if negligible(stage, end_force(model, bond, &path)) {
                     continue;
                 }
@@ -127,10 +125,19 @@ impl LaneEvents {
     ) {
         self.changed.clear();
         let (lo, hi) = (window.lo, window.hi);
+        // Under precompression a bond's overlap is its static overlap plus left − right.
+        let offsets = model
+            .contacts()
+            .map(ContactLaw::static_overlaps)
+            .filter(|delta| delta.iter().any(|&d| d > 0.0));
+        let offset = |bond: usize| offsets.map_or(0.0, |delta| delta[bond]);
         for bond in lo + 1..=hi {
             // Some but not all of the S + 1 values say "touching": the largest is positive and
             // the smallest is not (compare-and-select, as the scalar block test).
-            let mut low = lanewise(new_q[bond - 1], new_q[bond], |l, r| l - r);
+            let mut low = match offsets {
+                None => lanewise(new_q[bond - 1], new_q[bond], |l, r| l - r),
+                Some(delta) => lanewise(new_q[bond - 1], new_q[bond], |l, r| delta[bond] + (l - r)),
+            };
             let mut high = low;
             for forces in stage_force {
                 let f = forces[bond];
@@ -155,13 +162,13 @@ impl LaneEvents {
             }) & live_mask
         };
         if lo == 0 && left_wall {
-            let mask = wall(0, new_q[0].map(|x| 0.0 - x));
+            let mask = wall(0, new_q[0].map(|x| offset(0) - x));
             if mask != 0 {
                 self.changed.push(((0, None, Some(0)), mask));
             }
         }
         if hi == last && right_wall {
-            let mask = wall(n_sites, new_q[last].map(|x| 0.0 + x));
+            let mask = wall(n_sites, new_q[last].map(|x| offset(n_sites) + x));
             if mask != 0 {
                 self.changed.push(((n_sites, Some(last), None), mask));
             }

@@ -18,19 +18,22 @@
 //! integrates exactly with its own scalar [`super::exact_resonator::ExactResonators`] (the
 //! pair steps read and write one lane through [`Lane`] and [`LaneMut`]).
 //!
-//! Only the paper's conservative chain takes lanes (Hertz's law without precompression, unit
-//! site masses, fixed or free ends, constant couplings); any other scene steps alone.
+//! Only conservative chains with constant couplings take lanes (the paper's, or the
+//! experiment's: a striker, precompression, per-contact coefficients, any exponent, site
+//! masses, soft ends without dashpots); a dissipative or ramped scene steps alone.
 //! - [`step`]: the batched DPRKN6 step and force loop.
 //! - [`events`]: each lane's contact-event scan and corrections.
 //! - [`drive`]: the fixed-step time loop of four runs, [`drive_lanes`].
 
 mod drive;
 mod events;
+mod force;
 mod step;
 
 pub use drive::drive_lanes;
 
 use super::exact_resonator::{Dofs, DofsMut};
+use crate::contact::ContactLaw;
 use crate::model::{Coupling, Model};
 
 /// Scenes per batch: the f64 lanes of an AVX2 register.
@@ -90,24 +93,33 @@ pub(crate) struct LaneResonator {
     pub eps: Lanes,
 }
 
-/// The chain the lanes share, with each lane's resonator parameters.
+/// The chain the lanes share, with each lane's resonator parameters and site masses.
 #[derive(Debug, Clone)]
 pub(crate) struct LaneChain {
     pub n_sites: usize,
     pub walls: [bool; 2],
     pub resonators: Vec<LaneResonator>,
+    /// The contacts beyond the paper's (coefficients, exponent, precompression), the same in
+    /// every lane; `None` for the paper's Hertz law.
+    pub contacts: Option<ContactLaw>,
+    /// The springs of soft ends (left, right), the same in every lane.
+    pub springs: [Option<f64>; 2],
+    /// Each lane's site masses (1 in a lane whose model has none: dividing by 1 changes no
+    /// bit); `None` when no lane has any.
+    pub masses: Option<Vec<Lanes>>,
 }
 
 impl LaneChain {
     /// The shared chain of `models` (one per lane), or `None` when they differ in anything
-    /// but their resonators' masses and couplings, or when one is not the paper's
-    /// conservative chain ([`takes_lanes`]).
+    /// but their resonators' masses and couplings and their site masses, or when one is not a
+    /// conservative chain with constant couplings ([`takes_lanes`]).
     pub fn of(models: &[&Model; LANES]) -> Option<LaneChain> {
         let first = models[0];
         let same_shape = |m: &Model| {
             takes_lanes(m)
                 && m.n_sites() == first.n_sites()
                 && m.boundary() == first.boundary()
+                && m.contacts() == first.contacts()
                 && m.resonators().len() == first.resonators().len()
                 && m.resonators()
                     .iter()
@@ -129,10 +141,20 @@ impl LaneChain {
                 eps: std::array::from_fn(|l| models[l].resonators()[j].eps),
             })
             .collect();
+        let soft = |end: crate::model::End| end.soft().map(|(spring, _)| spring);
+        let boundary = first.boundary();
+        let masses = models.iter().any(|m| m.site_masses().is_some()).then(|| {
+            (0..first.n_sites())
+                .map(|i| std::array::from_fn(|l| models[l].site_mass(i)))
+                .collect()
+        });
         Some(LaneChain {
             n_sites: first.n_sites(),
             walls: first.walls(),
             resonators,
+            contacts: first.contacts().cloned(),
+            springs: [soft(boundary.left()), soft(boundary.right())],
+            masses,
         })
     }
 
@@ -155,14 +177,11 @@ pub fn shares_a_chain(models: &[&Model; LANES]) -> bool {
     LaneChain::of(models).is_some()
 }
 
-/// Whether `model` can run in a lane: the paper's conservative chain, whose force loop the
-/// lanes copy (Hertz's law without precompression, unit site masses, walls or free ends, and
-/// constant couplings).
+/// Whether `model` can run in a lane: a conservative chain (the paper's, or the experiment's
+/// with a striker, precompression, per-contact coefficients, any exponent, site masses and
+/// soft ends without dashpots) with constant couplings, whose force loop the lanes copy.
 pub fn takes_lanes(model: &Model) -> bool {
-    model.contacts().is_none()
-        && !model.is_dissipative()
-        && !model.has_soft_end()
-        && model.site_masses().is_none()
+    !model.is_dissipative()
         && model
             .resonators()
             .iter()

@@ -4,8 +4,8 @@
 //! (`raw_step_body`, `Model::accelerations_impl`), which is what keeps it bit-identical.
 
 use super::events::LaneEvents;
+use super::force::{accelerations, patch};
 use super::{lanewise, Lane, LaneChain, LaneMut, Lanes, LANES, S, ZERO};
-use crate::force::{hertz_force, odd_power};
 use crate::integrate::erkn_weights::NystromWeights;
 use crate::integrate::exact_resonator::ExactResonators;
 use crate::integrate::rkn::DPRKN6;
@@ -41,14 +41,21 @@ impl LaneRkn6 {
             b_prime: DPRKN6.b_prime,
         };
         let exact = models.map(|m| exact.then(|| ExactResonators::of(m, weights)).flatten());
-        let n = chain.n_dof();
         let bonds = chain.n_sites + 1;
+        // A bond outside the window is at rest and carries its static force (0 but under
+        // precompression): what its record must read when the window grows over it and a
+        // reused stage was recorded before it did (as the scalar `ContactEvents::new`).
+        let at_rest: Vec<Lanes> = match &chain.contacts {
+            None => vec![ZERO; bonds],
+            Some(law) => (0..bonds).map(|b| [law.static_force(b); LANES]).collect(),
+        };
+        let n = chain.n_dof();
         Self {
             q_stage: vec![ZERO; n],
             a: std::array::from_fn(|_| vec![ZERO; n]),
             new_q: vec![ZERO; n],
             new_v: vec![ZERO; n],
-            stage_force: std::array::from_fn(|_| vec![ZERO; bonds]),
+            stage_force: std::array::from_fn(|_| at_rest.clone()),
             evals: [0; LANES],
             last_stage_current: [false; LANES],
             events: LaneEvents::default(),
@@ -202,119 +209,10 @@ impl LaneRkn6 {
     }
 }
 
-/// Lane `l`'s forces of the state `q` near `site`, whose position a contact correction moved
-/// after the forces `acc` and `record` (a whole evaluation's) were taken: the bonds beside it
-/// and the accelerations of it and its neighbours, each by the operations [`accelerations`]
-/// makes of it on `window`, so that the patched forces are a whole evaluation's bit for bit.
-/// Returns the sites whose accelerations it wrote.
-fn patch(
-    chain: &LaneChain,
-    q: &[Lanes],
-    (acc, record): (&mut [Lanes], &mut [Lanes]),
-    (window, l): (Window, usize),
-    site: usize,
-) -> std::ops::RangeInclusive<usize> {
-    let n = chain.n_sites;
-    let (lo, hi) = (window.lo, window.hi);
-    let (u, rv) = q.split_at(n);
-    let (acc_u, acc_v) = acc.split_at_mut(n);
-    let [left_wall, right_wall] = chain.walls;
-    // The force of bond b, between sites b - 1 and b, as the loop computes it.
-    let bond = |b: usize| {
-        let d = (u[b - 1][l] - u[b][l]).max(0.0);
-        d * d.sqrt()
-    };
-    for b in [site, site + 1] {
-        if b > lo && b <= hi {
-            record[b][l] = bond(b);
-        }
-    }
-    if site == 0 && lo == 0 && left_wall {
-        record[0][l] = hertz_force(-u[0][l]);
-    }
-    if site == n - 1 && hi == n - 1 && right_wall {
-        record[n][l] = hertz_force(u[n - 1][l]);
-    }
-    let patched = site.saturating_sub(1).max(lo)..=(site + 1).min(hi);
-    for k in patched.clone() {
-        let left = if k > lo { bond(k) } else { 0.0 };
-        let mut a = if k < hi { left - bond(k + 1) } else { left };
-        if k == 0 && left_wall {
-            a += hertz_force(-u[0][l]);
-        }
-        if k == n - 1 && right_wall {
-            a -= hertz_force(u[n - 1][l]);
-        }
-        for (j, r) in chain.resonators.iter().enumerate() {
-            if r.site == k {
-                let f = r.kappa[l] * odd_power(u[k][l] - rv[j][l], r.p);
-                a -= f;
-                acc_v[j][l] = f / r.eps[l];
-            }
-        }
-        acc_u[k][l] = a;
-    }
-    patched
-}
-
 /// `dst += w x`, lane by lane.
 #[inline(always)]
 fn add_scaled(dst: &mut [Lanes], x: &[Lanes], w: f64) {
     for (d, x) in dst.iter_mut().zip(x) {
         *d = lanewise(*d, *x, |d, x| d + w * x);
-    }
-}
-
-/// The paper's force loop (`Model::accelerations_impl` with `hertz_chain`, recording), lane by
-/// lane: accelerations `acc` at positions `q` on `window`, and every bond force into `record`.
-#[inline(always)]
-fn accelerations(
-    chain: &LaneChain,
-    q: &[Lanes],
-    (acc, record): (&mut [Lanes], &mut [Lanes]),
-    window: Window,
-) {
-    let n = chain.n_sites;
-    let (lo, hi) = (window.lo, window.hi);
-    let (u, rv) = q.split_at(n);
-    let (acc_u, acc_v) = acc.split_at_mut(n);
-    let u_w = &u[lo..=hi];
-    let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
-    let record_w = &mut record[lo + 1..=hi][..u_w.len() - 1];
-    let mut previous = ZERO;
-    for bond in 1..u_w.len() {
-        let f = lanewise(u_w[bond - 1], u_w[bond], |a, b| {
-            let d = (a - b).max(0.0);
-            d * d.sqrt()
-        });
-        acc_w[bond - 1] = lanewise(previous, f, |p, f| p - f);
-        record_w[bond - 1] = f;
-        previous = f;
-    }
-    acc_w[u_w.len() - 1] = previous;
-    let [left_wall, right_wall] = chain.walls;
-    if lo == 0 && left_wall {
-        for l in 0..LANES {
-            let f = hertz_force(-u[0][l]);
-            record[0][l] = f;
-            acc_u[0][l] += f;
-        }
-    }
-    if hi == n - 1 && right_wall {
-        for l in 0..LANES {
-            let f = hertz_force(u[n - 1][l]);
-            record[n][l] = f;
-            acc_u[n - 1][l] -= f;
-        }
-    }
-    for (j, r) in chain.resonators.iter().enumerate() {
-        if r.site < lo || r.site > hi {
-            continue;
-        }
-        for l in 0..LANES {
-            let f = r.kappa[l] * odd_power(u[r.site][l] - rv[j][l], r.p);
-            acc_u[r.site][l] -= f;
-            acc_v[j][l] = f / r.eps[l];
-        }
     }
 }
