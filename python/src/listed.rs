@@ -9,7 +9,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use woodpile_points::rows::{columns, Cell, Column, Row};
 use woodpile_scene::Scene;
-use woodpile_sim::simulation::{simulate, Outcome};
+use woodpile_sim::simulation::{simulate, simulate_batch, Outcome};
 
 use crate::interrupt::{internal_message, Watch};
 
@@ -64,6 +64,41 @@ pub(crate) fn simulate_one(scene: &Scene, cancel: &AtomicBool) -> Result<Outcome
     };
     std::panic::catch_unwind(AssertUnwindSafe(run))
         .unwrap_or_else(|panic| Err(internal_message(&panic)))
+}
+
+/// [`simulate_one`] of each of `scenes`, neighbours together: four consecutive scenes that
+/// share a chain and a first step run `auto`'s first pair in lanes
+/// (`woodpile_sim::simulation::simulate_batch`), with the same results. A panic makes each
+/// scene again alone, so that it is the failure of its own scene only.
+pub(crate) fn simulate_group(
+    scenes: &[&Scene],
+    cancel: &AtomicBool,
+) -> Vec<Result<Outcome, String>> {
+    let stop = || cancel.load(Ordering::Relaxed);
+    let run = || {
+        let scenarios: Vec<_> = scenes.iter().map(|s| &s.scenario).collect();
+        let mut watches: Vec<_> = scenes
+            .iter()
+            .map(|_| Watch {
+                inner: (),
+                stop: &stop,
+                clock: None,
+            })
+            .collect();
+        simulate_batch(&scenarios, &mut watches)
+            .into_iter()
+            .map(|outcome| {
+                let mut outcome = outcome.map_err(|e| e.to_string())?;
+                outcome.final_state = Vec::new();
+                Ok(outcome)
+            })
+            .collect()
+    };
+    if stop() {
+        return scenes.iter().map(|_| Err("cancelled".into())).collect();
+    }
+    std::panic::catch_unwind(AssertUnwindSafe(run))
+        .unwrap_or_else(|_| scenes.iter().map(|s| simulate_one(s, cancel)).collect())
 }
 
 /// The rows of `simulate_many`: one per scene, in input order; `D` on every row when any scene

@@ -214,3 +214,27 @@ def test_simulate_many_runs_any_list_in_order_as_simulate_does():
     assert frame.failure[4] is not None and np.isnan(frame.E_tr[4])
     with pytest.raises(woodpile.SceneError, match=r"scenes\[1\]"):
         woodpile.simulate_many([scenes[0], dict(base, defect=[{"site": 0, "eps": -1.0}])])
+
+
+def test_neighbouring_points_in_lanes_match_simulate():
+    """Groups of four neighbouring points run their first pair together in SIMD lanes, by
+    `rkn6-contact` (heavy resonators) or `erkn6-contact` (light ones); every point must equal
+    its own `simulate` to the bit, in `sweep` and in `simulate_many` alike."""
+    template = {
+        "chain": {"n": 60, "boundary": "fixed"},
+        "impulse": {"site": -15, "velocity": 1.0},
+        "defect": [{"site": 0, "eps": "$eps"}, {"site": 10, "eps": 7.0}],
+        "run": {"t_end": 60.0, "tolerance": 1e-5},
+    }
+    values = [3.0, 4.0, 5.0, 6.0, 0.3, 0.35, 0.4, 0.45, 9.0]
+    table = woodpile.sweep(template, {"eps": values})
+    scenes = [
+        dict(template, defect=[{"site": 0, "eps": eps}, {"site": 10, "eps": 7.0}])
+        for eps in values
+    ]
+    many = woodpile.simulate_many(scenes)
+    for k, scene in enumerate(scenes):
+        alone = woodpile.simulate(scene)
+        row = table.iloc[k]
+        assert (row["R"], row["T"], row["E_tr"]) == (alone.R, alone.T, alone.E_tr)
+        assert (many["R"][k], many["T"][k], many["E_tr"][k]) == (alone.R, alone.T, alone.E_tr)
