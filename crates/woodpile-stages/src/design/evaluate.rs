@@ -5,7 +5,8 @@ use woodpile_scene::Scene;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
-use woodpile_points::{point_key, PointResult, PointStore, Shares};
+use woodpile_points::{point_key, Fetched, Key, PointResult, PointStore, Shares};
+use woodpile_sim::integrate::lanes::LANES;
 
 use super::{Design, Evaluated, Layout, Search};
 use crate::schema::Fraction;
@@ -64,7 +65,8 @@ impl Design {
         }
     }
 
-    /// Evaluates `layouts` in parallel through the point cache, in order.
+    /// Evaluates `layouts` in parallel through the point cache, in order, four neighbours at
+    /// a time (the robustness samples of one design share a chain, and take SIMD lanes).
     pub(super) fn evaluate(
         &self,
         search: Search,
@@ -73,38 +75,65 @@ impl Design {
         store: &PointStore,
         events: &dyn Events,
     ) -> Result<Vec<Evaluated>> {
-        layouts
-            .into_par_iter()
-            .map(|layout| {
-                if let Some(bound) = self.space.max_total_eps {
-                    if layout.total_eps() > bound {
-                        let reason =
-                            format!("total eps {} above the bound {bound}", layout.total_eps());
-                        return Ok(Evaluated {
-                            search,
-                            layout,
-                            result: Err(reason),
-                            score: f64::NEG_INFINITY,
-                            key: String::new(),
-                            simulated: false,
-                        });
-                    }
-                }
-                let scene = self.scene(&layout, tolerance)?;
-                let key = point_key(&scene, Shares::Energy);
-                let fetched = store.get_or_simulate(&key, &scene, Shares::Energy)?;
-                let (result, simulated) = (fetched.result, fetched.simulated);
-                events.point_done();
-                let score = self.score(&result);
-                Ok(Evaluated {
+        let groups: Vec<Vec<Evaluated>> = layouts
+            .par_chunks(LANES)
+            .map(|group| self.evaluate_group(search, group, tolerance, (store, events)))
+            .collect::<Result<_>>()?;
+        Ok(groups.into_iter().flatten().collect())
+    }
+
+    /// [`Design::evaluate`] of a few layouts, simulated together.
+    fn evaluate_group(
+        &self,
+        search: Search,
+        layouts: &[Layout],
+        tolerance: Option<f64>,
+        (store, events): (&PointStore, &dyn Events),
+    ) -> Result<Vec<Evaluated>> {
+        let over_bound = |layout: &Layout| {
+            let bound = self.space.max_total_eps?;
+            (layout.total_eps() > bound)
+                .then(|| format!("total eps {} above the bound {bound}", layout.total_eps()))
+        };
+        let feasible: Vec<&Layout> = layouts.iter().filter(|l| over_bound(l).is_none()).collect();
+        let scenes: Vec<Scene> = feasible
+            .iter()
+            .map(|layout| self.scene(layout, tolerance))
+            .collect::<Result<_>>()?;
+        let keys: Vec<Key> = scenes.iter().map(|s| point_key(s, Shares::Energy)).collect();
+        let fetched = store.get_or_simulate_many(
+            (&keys.iter().collect::<Vec<_>>(), &scenes.iter().collect::<Vec<_>>()),
+            Shares::Energy,
+            &|| false,
+        )?;
+        let mut simulated = keys.into_iter().zip(fetched);
+        let evaluated = layouts.iter().map(|layout| {
+            if let Some(reason) = over_bound(layout) {
+                return Evaluated {
                     search,
-                    layout,
-                    result,
-                    score,
-                    key: key.to_string(),
-                    simulated,
-                })
-            })
-            .collect()
+                    layout: layout.clone(),
+                    result: Err(reason),
+                    score: f64::NEG_INFINITY,
+                    key: String::new(),
+                    simulated: false,
+                };
+            }
+            let (key, fetched) = simulated.next().expect("a result per feasible layout");
+            let fetched = fetched.unwrap_or(Fetched {
+                result: Err("cancelled".into()),
+                simulated: false,
+            });
+            events.point_done();
+            let score = self.score(&fetched.result);
+            Evaluated {
+                search,
+                layout: layout.clone(),
+                result: fetched.result,
+                score,
+                key: key.to_string(),
+                simulated: fetched.simulated,
+            }
+        });
+        Ok(evaluated.collect())
     }
 }
