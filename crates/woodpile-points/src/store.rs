@@ -105,7 +105,8 @@ impl PointStore {
 
     /// [`PointStore::get_or_simulate_until`] of several points (`keys[k]` is the key of
     /// `scenes[k]`), those not cached simulated together ([`simulate_points_until`]: four
-    /// neighbours at a time in lanes), each saved the moment its group is done.
+    /// neighbours at a time in lanes), and saved once all are simulated (callers pass a group
+    /// of four; the first failed save ends the call).
     pub fn get_or_simulate_many(
         &self,
         (keys, scenes): (&[&Key], &[&Scene]),

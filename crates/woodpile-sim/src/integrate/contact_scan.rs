@@ -3,11 +3,18 @@
 
 /// Whether a bond's contact changed state during a step: its stage forces and end overlap do
 /// not all agree on "touching". Bonds that stay open (the whole quiet chain) or stay closed
-/// (smooth force) need no correction.
+/// (smooth force) need no correction. Written as [`block_changes`] is, the largest of the
+/// S + 1 values positive and the smallest not (compare-and-select from the end overlap), so
+/// that the two agree on every input, a NaN end overlap included (neither flags it), and the
+/// SIMD lanes' scan can match either.
 #[inline(always)]
 pub(crate) fn changes_contact<const S: usize>(stage_forces: [f64; S], d_end: f64) -> bool {
-    let touching = stage_forces.iter().filter(|&&f| f > 0.0).count() + usize::from(d_end > 0.0);
-    touching > 0 && touching <= S
+    let (mut low, mut high) = (d_end, d_end);
+    for f in stage_forces {
+        low = if f < low { f } else { low };
+        high = if f > high { f } else { high };
+    }
+    (high > 0.0) & (low <= 0.0)
 }
 
 /// `slice` (of length `N`) as an array reference, so that loops over it need no bounds checks.
@@ -57,6 +64,17 @@ mod tests {
         assert!(changes_contact([0.1, 0.1, 0.1, 0.2], -0.3));
         assert!(changes_contact([0.0, 0.0, 0.1], 0.0));
         assert!(!changes_contact([0.1, 0.2, 0.1], 0.1));
+    }
+
+    #[test]
+    fn a_nan_end_overlap_is_no_change_for_either_test() {
+        assert!(!changes_contact([0.5, 0.0, 0.2], f64::NAN));
+        let nan = [f64::NAN, 0.0, 0.0, 0.0];
+        let forces = [0.5, 0.0, 0.0, 0.0];
+        assert_eq!(
+            block_changes(&nan, &[0.0; 4], [&forces, &forces, &forces]),
+            0
+        );
     }
 
     #[test]

@@ -66,7 +66,10 @@ impl<'s> LaneGroup<'s> {
             let auto = s.method == MethodChoice::Auto;
             let plan = Plan::choose(&s.model, s.method, s.accuracy).ok()?;
             let method = plan.method == AUTO_METHOD || plan.method == HARMONIC_AUTO_METHOD;
-            (auto && method && budget::check(s).is_ok()).then_some(plan)
+            // A zero impulse (even -0.0) leaves its lane at rest, where the scalar run never
+            // writes its struck site's velocity and the lanes would write +0.0 over it.
+            let struck = s.impulse_velocity != 0.0;
+            (auto && method && struck && budget::check(s).is_ok()).then_some(plan)
         };
         let first = scenarios[0];
         let plan = plan_of(first)?;
@@ -138,12 +141,23 @@ fn in_lanes<O: Observer>(
         &guarded.with_dt(2.0 * group.dt),
         cancel_only.each_mut().map(|o| o as &mut dyn Observer),
     );
-    for observer in observers.iter_mut() {
-        observer.reset();
-    }
+    // A lane whose coarse run failed for good (not by blowing up) ends there, as its ladder
+    // would before making the fine run: its observer sees no more.
+    let shown: Vec<FineObserver<'_, O>> = observers
+        .iter_mut()
+        .zip(&coarse)
+        .map(|(observer, coarse)| match coarse {
+            Err(e) if !blew_up(e) => FineObserver::Hidden(observer),
+            _ => {
+                observer.reset();
+                FineObserver::Shown(observer)
+            }
+        })
+        .collect();
+    let mut shown: [FineObserver<'_, O>; LANES] = shown.try_into().ok()?;
     let fine = group.run(
         &guarded.with_dt(group.dt),
-        observers.each_mut().map(|o| o as &mut dyn Observer),
+        shown.each_mut().map(|o| o as &mut dyn Observer),
     );
     let mut pairs = coarse.into_iter().zip(fine).map(Some).collect::<Vec<_>>();
     Some(std::array::from_fn(|l| {
@@ -151,6 +165,38 @@ fn in_lanes<O: Observer>(
         let first = FirstPair { coarse, fine };
         verified(scenarios[l], group.plan, &mut observers[l], Some(first))
     }))
+}
+
+/// Whether a run failed by blowing up or losing its energy: a step too coarse, which the
+/// ladder halves, rather than a failure of the scene.
+fn blew_up(e: &SimError) -> bool {
+    matches!(e, SimError::NonFinite { .. } | SimError::EnergyDrift { .. })
+}
+
+/// A lane's observer of the fine run: its own, or, for a lane whose ladder ended at its
+/// coarse run, one that records nothing (and still passes on a wish to stop).
+enum FineObserver<'a, O> {
+    Shown(&'a mut O),
+    Hidden(&'a O),
+}
+
+impl<O: Observer> Observer for FineObserver<'_, O> {
+    fn observe(&mut self, model: &crate::model::Model, t: f64, y: &[f64]) {
+        if let FineObserver::Shown(o) = self {
+            o.observe(model, t, y);
+        }
+    }
+    fn reset(&mut self) {
+        if let FineObserver::Shown(o) = self {
+            o.reset();
+        }
+    }
+    fn cancelled(&self) -> bool {
+        match self {
+            FineObserver::Shown(o) => o.cancelled(),
+            FineObserver::Hidden(o) => o.cancelled(),
+        }
+    }
 }
 
 #[cfg(test)]

@@ -100,9 +100,15 @@ impl Design {
             .iter()
             .map(|layout| self.scene(layout, tolerance))
             .collect::<Result<_>>()?;
-        let keys: Vec<Key> = scenes.iter().map(|s| point_key(s, Shares::Energy)).collect();
+        let keys: Vec<Key> = scenes
+            .iter()
+            .map(|s| point_key(s, Shares::Energy))
+            .collect();
         let fetched = store.get_or_simulate_many(
-            (&keys.iter().collect::<Vec<_>>(), &scenes.iter().collect::<Vec<_>>()),
+            (
+                &keys.iter().collect::<Vec<_>>(),
+                &scenes.iter().collect::<Vec<_>>(),
+            ),
             Shares::Energy,
             &|| false,
         )?;

@@ -97,7 +97,8 @@ impl<'m> LaneBatch<'m> {
         }
     }
 
-    /// Stops lane `l` with `error`: its state is set to rest, so that it costs nothing more.
+    /// Stops lane `l` with `error`: its state and its stepper's forces are set to rest, so
+    /// that it costs nothing more (no drift into huge or subnormal values).
     fn stop(
         &mut self,
         l: usize,
@@ -109,6 +110,7 @@ impl<'m> LaneBatch<'m> {
         for x in self.q.iter_mut().chain(self.v.iter_mut()) {
             x[l] = 0.0;
         }
+        self.stepper.retire(l);
     }
 
     /// Lane `l`'s state, `[q, q']`, into `y`.

@@ -25,8 +25,6 @@ pub(super) struct LaneEvents {
     pending_fast: Vec<FastModeCorrection>,
     /// Per lane, the sites the last step's corrections moved.
     pub touched: [Vec<usize>; LANES],
-    /// Bonds corrected so far, per lane.
-    pub count: [u64; LANES],
 }
 
 impl LaneEvents {
@@ -93,7 +91,6 @@ impl LaneEvents {
             for &(left, right, ..) in &pending {
                 touched.extend(left.into_iter().chain(right));
             }
-            self.count[l] += pending.len() as u64;
             corrected[l] = !pending.is_empty();
             self.pending = pending;
         }

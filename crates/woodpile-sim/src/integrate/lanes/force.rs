@@ -138,7 +138,9 @@ fn law_chain(
 /// after the forces `acc` and `record` (a whole evaluation's) were taken: the bonds beside it
 /// and the accelerations of it and its neighbours, each by the operations [`accelerations`]
 /// makes of it on `window`, so that the patched forces are a whole evaluation's bit for bit.
-/// Returns the sites whose accelerations it wrote.
+/// Returns the sites whose accelerations it wrote. This relies on every force of the chain
+/// acting between neighbours or within a site and its resonators: a longer-range force would
+/// need a wider patch.
 pub(super) fn patch(
     chain: &LaneChain,
     q: &[Lanes],

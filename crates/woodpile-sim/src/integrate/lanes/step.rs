@@ -90,6 +90,26 @@ impl LaneRkn6 {
         }
     }
 
+    /// Puts lane `l`, whose run has stopped, at rest: its stage forces zero, its bond records
+    /// at their rest values, its last stage current.
+    pub fn retire(&mut self, l: usize) {
+        for x in self.a.iter_mut().flatten() {
+            x[l] = 0.0;
+        }
+        let rest = |b: usize| {
+            self.chain
+                .contacts
+                .as_ref()
+                .map_or(0.0, |law| law.static_force(b))
+        };
+        for record in &mut self.stage_force {
+            for (b, x) in record.iter_mut().enumerate() {
+                x[l] = rest(b);
+            }
+        }
+        self.last_stage_current[l] = true;
+    }
+
     fn dof_ranges(&self, window: Window) -> [std::ops::Range<usize>; 2] {
         [
             window.lo..window.hi + 1,
@@ -128,8 +148,14 @@ impl LaneRkn6 {
                 exact.begin_step(h, (&Lane(q, l), &Lane(v, l)), (window.lo, window.hi));
             }
         }
+        // A lane that is not current was corrected in the last step, at the sites in
+        // `touched`; only the first step evaluates its first stage whole.
         let reuse = (0..LANES)
             .all(|l| !live[l] || self.last_stage_current[l] || !self.events.touched[l].is_empty());
+        debug_assert!(
+            self.evals.iter().all(|&e| e == 0) || reuse,
+            "after the first step, every live lane is current or was corrected"
+        );
         for i in 0..S {
             if i > 0 {
                 for r in ranges.clone() {
