@@ -429,3 +429,54 @@ pub fn damped_audit_scene(rng: &mut Lcg) -> Scenario {
         ..base
     }
 }
+
+/// Four neighbouring points of a sweep around `base`, as a sweep hands them to the SIMD lanes
+/// (`crate::simulation::simulate_batch`): the impulse's site two apart from point to point
+/// (so that on a chain of alternating masses the struck sites have the same mass, and the
+/// impact the same energy); for `k % 4 == 3` the last point's resonators also a thousandth
+/// lighter, which may change its first step and keep the group out of lanes.
+pub fn lane_neighbours(base: &Scenario, k: usize) -> Vec<Scenario> {
+    let last = base.model.n_sites() - 1;
+    let mut scenes: Vec<Scenario> = (0..crate::integrate::lanes::LANES)
+        .map(|j| Scenario {
+            impulse_site: (base.impulse_site + 2 * j).min(last),
+            ..base.clone()
+        })
+        .collect();
+    if k % 4 == 3 {
+        let lighter = with_resonator_masses_scaled(&scenes[3], 0.999);
+        scenes[3] = lighter;
+    }
+    scenes
+}
+
+/// `base` with its resonators' masses scaled by `factor`: a neighbouring point of a sweep
+/// over them, on the same chain.
+pub fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
+    let m = &base.model;
+    let resonators = m
+        .resonators()
+        .iter()
+        .map(|r| Resonator {
+            eps: r.eps * factor,
+            ..*r
+        })
+        .collect();
+    let masses = (0..m.n_sites()).map(|i| m.site_mass(i)).collect();
+    let mut model = Model::with_masses(m.n_sites(), m.boundary(), resonators, Some(masses))
+        .expect("the base's chain, valid");
+    if let Some(law) = m.contacts() {
+        model = model
+            .with_contacts(law.clone())
+            .expect("the base's contacts, valid");
+    }
+    if let Some(damping) = m.damping() {
+        model = model
+            .with_damping(damping.clone())
+            .expect("the base's damping, valid");
+    }
+    Scenario {
+        model,
+        ..base.clone()
+    }
+}

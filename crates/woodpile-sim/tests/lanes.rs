@@ -12,7 +12,7 @@ use woodpile_sim::integrate::{
 use woodpile_sim::model::{Boundary, End, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::simulation::{auto_first_step, simulate, simulate_batch, Scenario};
-use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
+use woodpile_sim::testing::{fixed_dt, lane_neighbours, paper_scene, tolerance, PaperDefect};
 use woodpile_sim::SimError;
 
 /// F7's chain (defects at 0 and 20) with the resonator masses `eps`, at tolerance 1e-5.
@@ -237,30 +237,6 @@ fn a_lane_that_blows_up_stops_alone() {
     assert!(results.iter().filter(|r| r.is_ok()).count() == 3);
 }
 
-/// `base` with its resonators' masses scaled by `factor`: a neighbouring point of a sweep
-/// over them, on the same chain.
-fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
-    let m = &base.model;
-    let resonators = m
-        .resonators()
-        .iter()
-        .map(|r| Resonator {
-            eps: r.eps * factor,
-            ..*r
-        })
-        .collect();
-    let masses = (0..m.n_sites()).map(|i| m.site_mass(i)).collect();
-    let mut model =
-        Model::with_masses(m.n_sites(), m.boundary(), resonators, Some(masses)).unwrap();
-    if let Some(law) = m.contacts() {
-        model = model.with_contacts(law.clone()).unwrap();
-    }
-    Scenario {
-        model,
-        ..base.clone()
-    }
-}
-
 /// Whether four scenes take lanes together: one method and first step, one chain.
 fn take_lanes(scenes: &[Scenario]) -> bool {
     let first = first_steps(scenes);
@@ -285,19 +261,7 @@ fn the_experiments_chain_in_lanes_equals_its_scalar_runs() {
             sample_every: 5.0,
             ..woodpile_sim::testing::chain_audit_scene(&mut rng)
         };
-        // Points of a sweep over the impulse's site, two apart so that the struck sites have
-        // the same mass (and the impact the same energy); on every fourth group one lane also
-        // has lighter resonators, which may change its first step and keep the group out.
-        let last = base.model.n_sites() - 1;
-        let mut scenes: Vec<Scenario> = (0..LANES)
-            .map(|k| Scenario {
-                impulse_site: (base.impulse_site + 2 * k).min(last),
-                ..base.clone()
-            })
-            .collect();
-        if k % 4 == 3 {
-            scenes[3] = with_resonator_masses_scaled(&scenes[3], 0.999);
-        }
+        let scenes = lane_neighbours(&base, k);
         batched += usize::from(take_lanes(&scenes));
         batched_and_alone(&scenes);
     }
