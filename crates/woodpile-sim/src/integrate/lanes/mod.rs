@@ -1,4 +1,5 @@
-//! Four scenes in the lanes of one register: `rkn6-contact` advancing four chains together,
+//! Four scenes in the lanes of one register: `rkn6-contact` (or `erkn6-contact`) advancing four
+//! chains together,
 //! each lane doing exactly the operations of the scalar [`super::Rkn`] in its order, so that
 //! every lane's run equals its scene's scalar run bit for bit (tested, and `make check` at
 //! `--abs 0`).
@@ -9,8 +10,8 @@
 //! per four (docs/performance.md, "Scenes in SIMD lanes").
 //!
 //! What lanes share, and what each keeps ([`LaneChain`]): the chain (sites, walls, resonator
-//! sites and exponents) is one; each lane has its own masses of the resonators and couplings,
-//! its own initial impulse, its own active window, contact corrections, first-same-as-last
+//! sites and exponents, contacts, boundary) is one; each lane has its own masses of the
+//! resonators and couplings, its own site masses, its own initial impulse, its own active window, contact corrections, first-same-as-last
 //! reuse, failures and observer. The lanes step on the union of their windows: outside its
 //! own window a lane is exactly at rest, and working on resting sites changes none of its bits.
 //!
@@ -21,7 +22,8 @@
 //! Only conservative chains with constant couplings take lanes (the paper's, or the
 //! experiment's: a striker, precompression, per-contact coefficients, any exponent, site
 //! masses, soft ends without dashpots); a dissipative or ramped scene steps alone.
-//! - [`step`]: the batched DPRKN6 step and force loop.
+//! - [`step`]: the batched DPRKN6 step, its first-same-as-last reuse and exact resonators.
+//! - [`force`]: the force loop of four lanes, and its patch at a few sites of one.
 //! - [`events`]: each lane's contact-event scan and corrections.
 //! - [`drive`]: the fixed-step time loop of four runs, [`drive_lanes`].
 

@@ -1,6 +1,6 @@
-//! The batched `rkn6-contact` step: DPRKN6 on four chains in structure-of-arrays form (entry k
-//! of a vector is degree of freedom k, its lanes the four scenes), then each lane's contact
-//! corrections. Every lane does the scalar [`crate::integrate::Rkn`]'s operations in its order
+//! The batched `rkn6-contact` step (and `erkn6-contact`'s, with each lane's harmonic resonators
+//! integrated exactly): DPRKN6 on four chains in structure-of-arrays form (entry k of a vector
+//! is degree of freedom k, its lanes the four scenes), then each lane's contact corrections. Every lane does the scalar [`crate::integrate::Rkn`]'s operations in its order
 //! (`raw_step_body`, `Model::accelerations_impl`), which is what keeps it bit-identical.
 
 use super::events::LaneEvents;
@@ -11,7 +11,7 @@ use crate::integrate::exact_resonator::ExactResonators;
 use crate::integrate::rkn::DPRKN6;
 use crate::model::{Model, Window};
 
-/// `rkn6-contact` for four lanes, with its scratch (allocated once).
+/// `rkn6-contact` or `erkn6-contact` for four lanes, with its scratch (allocated once).
 #[derive(Debug, Clone)]
 pub(super) struct LaneRkn6 {
     pub chain: LaneChain,
