@@ -16,9 +16,10 @@
 use woodpile_bench::on_two_cores;
 use woodpile_sim::integrate::lanes::shares_a_chain;
 use woodpile_sim::integrate::{MethodChoice, Plan};
-use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::simulation::{auto_first_step, simulate, simulate_batch, Scenario};
-use woodpile_sim::testing::{audit_scene, chain_audit_scene, lane_neighbours, tolerance, Lcg};
+use woodpile_sim::simulation::{auto_first_step, Scenario};
+use woodpile_sim::testing::{
+    audit_scene, by_lanes_and_alone, chain_audit_scene, lane_neighbours, tolerance, Lcg,
+};
 use woodpile_sim::Model;
 
 /// What one group gave: whether it took lanes, and whether every scene matched.
@@ -46,23 +47,10 @@ fn takes_lanes(scenes: &[Scenario]) -> bool {
 
 /// Group `k`: its scenes by lanes and alone, compared.
 fn audit(k: usize, scenes: &[Scenario]) -> Group {
-    let refs: Vec<&Scenario> = scenes.iter().collect();
-    let mut series: Vec<FractionSeries> = scenes
-        .iter()
-        .map(|s| FractionSeries::new(&s.model, s.region))
-        .collect();
-    let batched = simulate_batch(&refs, &mut series);
-    let identical = scenes
-        .iter()
-        .zip(&batched)
-        .zip(&series)
-        .all(|((s, b), recorded)| {
-            let mut alone = FractionSeries::new(&s.model, s.region);
-            let expected = simulate(s, &mut alone);
-            *b == expected && *recorded == alone
-        });
+    let runs = by_lanes_and_alone(scenes);
+    let identical = runs.iter().all(|(lanes, alone)| lanes == alone);
     let in_lanes = takes_lanes(scenes);
-    let outcome = match &batched[0] {
+    let outcome = match &runs[0].0 .0 {
         Ok(out) => format!("{} dt {:.4}", out.plan.method.name(), out.stats.max_step),
         Err(e) => format!("error: {e}"),
     };

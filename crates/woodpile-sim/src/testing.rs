@@ -12,6 +12,7 @@ use crate::energy::{Fractions, Region};
 use crate::error::SimError;
 use crate::integrate::{Accuracy, Method, MethodChoice};
 use crate::model::{Boundary, Coupling, Model, Resonator};
+use crate::observe::FractionSeries;
 use crate::simulation::{simulate, Scenario};
 
 /// Half-width N of the paper's chains (sites -N..N).
@@ -479,4 +480,28 @@ pub fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
         model,
         ..base.clone()
     }
+}
+
+/// One scene's run, as an outcome (or the error that stopped it) and its recorded samples.
+pub type RecordedRun = (Result<crate::simulation::Outcome, SimError>, FractionSeries);
+
+/// Each of `scenes` run by `simulate_batch` (four neighbours at a time in SIMD lanes where
+/// they can) and by `simulate` alone, with every sample recorded: pairs that must be equal.
+pub fn by_lanes_and_alone(scenes: &[Scenario]) -> Vec<(RecordedRun, RecordedRun)> {
+    let refs: Vec<&Scenario> = scenes.iter().collect();
+    let mut series: Vec<FractionSeries> = scenes
+        .iter()
+        .map(|s| FractionSeries::new(&s.model, s.region))
+        .collect();
+    let batched = crate::simulation::simulate_batch(&refs, &mut series);
+    batched
+        .into_iter()
+        .zip(series)
+        .zip(scenes)
+        .map(|(lanes, s)| {
+            let mut alone = FractionSeries::new(&s.model, s.region);
+            let outcome = simulate(s, &mut alone);
+            (lanes, (outcome, alone))
+        })
+        .collect()
 }

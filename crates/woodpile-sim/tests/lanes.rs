@@ -11,8 +11,10 @@ use woodpile_sim::integrate::{
 };
 use woodpile_sim::model::{Boundary, End, Model, Resonator};
 use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::simulation::{auto_first_step, simulate, simulate_batch, Scenario};
-use woodpile_sim::testing::{fixed_dt, lane_neighbours, paper_scene, tolerance, PaperDefect};
+use woodpile_sim::simulation::{auto_first_step, Scenario};
+use woodpile_sim::testing::{
+    by_lanes_and_alone, fixed_dt, lane_neighbours, paper_scene, tolerance, PaperDefect,
+};
 use woodpile_sim::SimError;
 
 /// F7's chain (defects at 0 and 20) with the resonator masses `eps`, at tolerance 1e-5.
@@ -26,17 +28,9 @@ fn f7_scene((eps1, eps2): (f64, f64)) -> Scenario {
 
 /// Each scene's outcome and recorded samples, by `simulate_batch` and by `simulate` alone.
 fn batched_and_alone(scenes: &[Scenario]) {
-    let refs: Vec<&Scenario> = scenes.iter().collect();
-    let mut series: Vec<FractionSeries> = scenes
-        .iter()
-        .map(|s| FractionSeries::new(&s.model, s.region))
-        .collect();
-    let batched = simulate_batch(&refs, &mut series);
-    for (k, s) in scenes.iter().enumerate() {
-        let mut alone = FractionSeries::new(&s.model, s.region);
-        let expected = simulate(s, &mut alone);
-        assert_eq!(batched[k], expected, "scene {k}: outcome");
-        assert_eq!(series[k], alone, "scene {k}: samples");
+    for (k, (lanes, alone)) in by_lanes_and_alone(scenes).into_iter().enumerate() {
+        assert_eq!(lanes.0, alone.0, "scene {k}: outcome");
+        assert_eq!(lanes.1, alone.1, "scene {k}: samples");
     }
 }
 
