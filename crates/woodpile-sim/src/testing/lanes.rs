@@ -1,0 +1,82 @@
+//! Scenes for the SIMD lanes' checks (`tests/lanes.rs`, the `lanes_audit` example): a sweep's
+//! neighbouring points around a scene, and each run by lanes and alone.
+
+use crate::error::SimError;
+use crate::model::{Model, Resonator};
+use crate::observe::FractionSeries;
+use crate::simulation::{simulate, Scenario};
+
+/// Four neighbouring points of a sweep around `base`, as a sweep hands them to the SIMD lanes
+/// (`crate::simulation::simulate_batch`): the impulse's site two apart from point to point
+/// (so that on a chain of alternating masses the struck sites have the same mass, and the
+/// impact the same energy); for `k % 4 == 3` the last point's resonators also a thousandth
+/// lighter, which may change its first step and keep the group out of lanes.
+pub fn lane_neighbours(base: &Scenario, k: usize) -> Vec<Scenario> {
+    let last = base.model.n_sites() - 1;
+    let mut scenes: Vec<Scenario> = (0..crate::integrate::lanes::LANES)
+        .map(|j| Scenario {
+            impulse_site: (base.impulse_site + 2 * j).min(last),
+            ..base.clone()
+        })
+        .collect();
+    if k % 4 == 3 {
+        let lighter = with_resonator_masses_scaled(&scenes[3], 0.999);
+        scenes[3] = lighter;
+    }
+    scenes
+}
+
+/// `base` with its resonators' masses scaled by `factor`: a neighbouring point of a sweep
+/// over them, on the same chain.
+pub fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
+    let m = &base.model;
+    let resonators = m
+        .resonators()
+        .iter()
+        .map(|r| Resonator {
+            eps: r.eps * factor,
+            ..*r
+        })
+        .collect();
+    let masses = (0..m.n_sites()).map(|i| m.site_mass(i)).collect();
+    let mut model = Model::with_masses(m.n_sites(), m.boundary(), resonators, Some(masses))
+        .expect("the base's chain, valid");
+    if let Some(law) = m.contacts() {
+        model = model
+            .with_contacts(law.clone())
+            .expect("the base's contacts, valid");
+    }
+    if let Some(damping) = m.damping() {
+        model = model
+            .with_damping(damping.clone())
+            .expect("the base's damping, valid");
+    }
+    Scenario {
+        model,
+        ..base.clone()
+    }
+}
+
+/// One scene's run, as an outcome (or the error that stopped it) and its recorded samples.
+pub type RecordedRun = (Result<crate::simulation::Outcome, SimError>, FractionSeries);
+
+/// Each of `scenes` run by `simulate_batch` (four neighbours at a time in SIMD lanes where
+/// they can) and by `simulate` alone, with every sample recorded: pairs that must be equal.
+pub fn by_lanes_and_alone(scenes: &[Scenario]) -> Vec<(RecordedRun, RecordedRun)> {
+    let refs: Vec<&Scenario> = scenes.iter().collect();
+    let mut series: Vec<FractionSeries> = scenes
+        .iter()
+        .map(|s| FractionSeries::new(&s.model, s.region))
+        .collect();
+    let batched = crate::simulation::simulate_batch(&refs, &mut series);
+    batched
+        .into_iter()
+        .zip(series)
+        .zip(scenes)
+        .map(|(lanes, s)| {
+            let mut alone = FractionSeries::new(&s.model, s.region);
+            let outcome = simulate(s, &mut alone);
+            (lanes, (outcome, alone))
+        })
+        .collect()
+}
