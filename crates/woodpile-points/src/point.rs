@@ -6,7 +6,7 @@ use woodpile_scene::Scene;
 use woodpile_sim::integrate::Observer;
 use woodpile_sim::integrate::StepControl;
 use woodpile_sim::observe::FractionSeries;
-use woodpile_sim::simulation::{simulate, simulate_batch, Outcome, Scenario};
+use woodpile_sim::simulation::{simulate_batch, Outcome, Scenario};
 use woodpile_sim::{Model, SimError};
 
 use crate::canonical::{code_version, scene_json, Key};
@@ -92,17 +92,7 @@ pub fn simulate_point_until(
     kind: Shares,
     stop: &dyn Fn() -> bool,
 ) -> Option<PointResult> {
-    let s = &scene.scenario;
-    let series = match kind.recorder(s) {
-        Ok(series) => series,
-        Err(reason) => return Some(Err(reason)),
-    };
-    let mut watched = Stoppable { series, stop };
-    match simulate(s, &mut watched) {
-        Err(SimError::Cancelled { .. }) => None,
-        Err(e) => Some(Err(e.to_string())),
-        Ok(out) => Some(Ok(PointData::of(s, &out, watched.series))),
-    }
+    simulate_points_until(&[scene], kind, stop).pop().flatten()
 }
 
 /// [`simulate_point_until`] of each of `scenes`, four neighbours at a time in lanes where they

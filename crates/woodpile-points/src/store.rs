@@ -18,7 +18,7 @@ use woodpile_scene::Scene;
 use crate::atomic;
 use crate::canonical::Key;
 use crate::error::{FileError, Result};
-use crate::point::{simulate_point_until, simulate_points_until, PointData, PointResult, Shares};
+use crate::point::{simulate_points_until, PointData, PointResult, Shares};
 
 const MAGIC: &[u8; 4] = b"WPPT";
 /// The largest point file read: far beyond a series of the sample budget's length.
@@ -70,16 +70,27 @@ impl PointStore {
     /// The result of `scene` (whose key is `key`, from [`crate::point_key`]): from the cache,
     /// or simulated and saved. Every kind that simulates scenes goes through here, so a scene
     /// is simulated once whichever stage asks for it first.
-    pub fn get_or_simulate(&self, key: &Key, scene: &Scene, series: Shares) -> Result<Fetched> {
-        let fetched = self.get_or_simulate_until(key, scene, series, &|| false)?;
-        Ok(fetched.unwrap_or(Fetched {
+    /// Several points at once (`keys[k]` is the key of `scenes[k]`): the ones not cached are
+    /// simulated together (four neighbours at a time in SIMD lanes), so a stage hands its
+    /// points over in groups of four.
+    pub fn get_or_simulate_all(
+        &self,
+        points: (&[&Key], &[&Scene]),
+        series: Shares,
+    ) -> Result<Vec<Fetched>> {
+        let fetched = self.get_or_simulate_many(points, series, &|| false)?;
+        let cancelled = || Fetched {
             result: Err("cancelled".into()),
             simulated: false,
-        }))
+        };
+        Ok(fetched
+            .into_iter()
+            .map(|f| f.unwrap_or_else(cancelled))
+            .collect())
     }
 
-    /// [`PointStore::get_or_simulate`], stopped once `stop()` says so: `None` then, and
-    /// nothing is saved.
+    /// The point `key` of `scene`, stopped once `stop()` says so: `None` then, and nothing
+    /// is saved ([`PointStore::get_or_simulate_many`] of one point).
     pub fn get_or_simulate_until(
         &self,
         key: &Key,
@@ -87,26 +98,15 @@ impl PointStore {
         series: Shares,
         stop: &dyn Fn() -> bool,
     ) -> Result<Option<Fetched>> {
-        if let Some(cached) = self.load(key) {
-            return Ok(Some(Fetched {
-                result: cached,
-                simulated: false,
-            }));
-        }
-        let Some(result) = simulate_point_until(scene, series, stop) else {
-            return Ok(None);
-        };
-        self.save(key, &result)?;
-        Ok(Some(Fetched {
-            result,
-            simulated: true,
-        }))
+        let mut one = self.get_or_simulate_many((&[key], &[scene]), series, stop)?;
+        Ok(one.pop().flatten())
     }
 
-    /// [`PointStore::get_or_simulate_until`] of several points (`keys[k]` is the key of
-    /// `scenes[k]`), those not cached simulated together ([`simulate_points_until`]: four
-    /// neighbours at a time in lanes), and saved once all are simulated (callers pass a group
-    /// of four; the first failed save ends the call).
+    /// Points `keys[k]` of `scenes[k]`: from the cache, or simulated together
+    /// ([`simulate_points_until`]: four neighbours at a time in lanes) and saved, each with
+    /// whether it was simulated now; `None` for a point stopped by `stop()` (nothing saved).
+    /// Saved once all are simulated (callers pass a group of four; the first failed save ends
+    /// the call).
     pub fn get_or_simulate_many(
         &self,
         (keys, scenes): (&[&Key], &[&Scene]),

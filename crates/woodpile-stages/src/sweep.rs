@@ -287,22 +287,11 @@ impl PointGrid for Sweep {
                     .collect::<Result<_>>()?;
                 let scenes: Vec<&Scene> = scenes.iter().collect();
                 let group_keys: Vec<&Key> = group.iter().map(|&i| &keys[i]).collect();
-                let fetched =
-                    store.get_or_simulate_many((&group_keys, &scenes), self.series, &|| false)?;
-                Ok(group
-                    .iter()
-                    .zip(fetched)
-                    .map(|(&i, f)| {
-                        events.point_done();
-                        (
-                            i,
-                            f.unwrap_or(Fetched {
-                                result: Err("cancelled".into()),
-                                simulated: false,
-                            }),
-                        )
-                    })
-                    .collect::<Vec<_>>())
+                let fetched = store.get_or_simulate_all((&group_keys, &scenes), self.series)?;
+                for _ in group {
+                    events.point_done();
+                }
+                Ok(group.iter().copied().zip(fetched).collect::<Vec<_>>())
             })
             .collect::<Result<Vec<_>>>()?
             .into_iter()

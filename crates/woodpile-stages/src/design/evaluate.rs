@@ -5,7 +5,7 @@ use woodpile_scene::Scene;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
-use woodpile_points::{point_key, Fetched, Key, PointResult, PointStore, Shares};
+use woodpile_points::{point_key, Key, PointResult, PointStore, Shares};
 use woodpile_sim::integrate::lanes::LANES;
 
 use super::{Design, Evaluated, Layout, Search};
@@ -104,14 +104,11 @@ impl Design {
             .iter()
             .map(|s| point_key(s, Shares::Energy))
             .collect();
-        let fetched = store.get_or_simulate_many(
-            (
-                &keys.iter().collect::<Vec<_>>(),
-                &scenes.iter().collect::<Vec<_>>(),
-            ),
-            Shares::Energy,
-            &|| false,
-        )?;
+        let points = (
+            &keys.iter().collect::<Vec<_>>()[..],
+            &scenes.iter().collect::<Vec<_>>()[..],
+        );
+        let fetched = store.get_or_simulate_all(points, Shares::Energy)?;
         let mut simulated = keys.into_iter().zip(fetched);
         let evaluated = layouts.iter().map(|layout| {
             if let Some(reason) = over_bound(layout) {
@@ -125,10 +122,6 @@ impl Design {
                 };
             }
             let (key, fetched) = simulated.next().expect("a result per feasible layout");
-            let fetched = fetched.unwrap_or(Fetched {
-                result: Err("cancelled".into()),
-                simulated: false,
-            });
             events.point_done();
             let score = self.score(&fetched.result);
             Evaluated {
