@@ -4,9 +4,10 @@
 //! runs. Every result is its scene's [`simulate`] result bit for bit; only the time differs.
 //!
 //! Four scenes take lanes together when each asks for `auto`, plans the same method
-//! (`rkn6-contact`, or `erkn6-contact` for light harmonic resonators) at the same first step, runs for as long with the same samples, and all share a chain that takes
-//! lanes ([`crate::integrate::lanes::takes_lanes`]). A sweep's neighbouring points mostly do;
-//! any other group runs scene by scene.
+//! (`rkn6-contact`, or `erkn6-contact` for light harmonic resonators) at the same first step,
+//! runs for as long with the same samples, and all share a chain that takes lanes
+//! ([`crate::integrate::lanes::takes_lanes`]). A sweep's neighbouring points mostly do; any
+//! other group runs scene by scene.
 
 use super::ladder::{verified, FirstPair};
 use super::{auto_first_step, budget, outcome_of, simulate, Outcome, Scenario};
@@ -113,14 +114,15 @@ impl<'s> LaneGroup<'s> {
         let models = self.scenarios.map(|s| &s.model);
         let stats = drive_lanes(plan.method, models, &mut ys, &cfg, observers)
             .expect("a lane group shares a chain and a fixed step");
-        let mut ys = ys.map(Some);
-        std::array::from_fn(|l| {
-            let y = ys[l].take().expect("each lane's state is taken once");
-            let start = (y, self.starts[l].1);
-            stats[l]
-                .clone()
-                .map(|stats| outcome_of(self.scenarios[l], plan, start, stats))
-        })
+        let mut outcomes = stats
+            .into_iter()
+            .zip(ys)
+            .enumerate()
+            .map(|(l, (stats, y))| {
+                let start = (y, self.starts[l].1);
+                stats.map(|stats| outcome_of(self.scenarios[l], plan, start, stats))
+            });
+        std::array::from_fn(|_| outcomes.next().expect("one outcome per lane"))
     }
 }
 
@@ -143,27 +145,30 @@ fn in_lanes<O: Observer>(
     );
     // A lane whose coarse run failed for good (not by blowing up) ends there, as its ladder
     // would before making the fine run: its observer sees no more.
-    let shown: Vec<FineObserver<'_, O>> = observers
-        .iter_mut()
-        .zip(&coarse)
-        .map(|(observer, coarse)| match coarse {
+    let mut each = observers.iter_mut();
+    let mut shown: [FineObserver<'_, O>; LANES] = std::array::from_fn(|l| {
+        let observer = each.next().expect("an observer per lane");
+        match &coarse[l] {
             Err(e) if !blew_up(e) => FineObserver::Hidden(observer),
             _ => {
                 observer.reset();
                 FineObserver::Shown(observer)
             }
-        })
-        .collect();
-    let mut shown: [FineObserver<'_, O>; LANES] = shown.try_into().ok()?;
+        }
+    });
     let fine = group.run(
         &guarded.with_dt(group.dt),
         shown.each_mut().map(|o| o as &mut dyn Observer),
     );
-    let mut pairs = coarse.into_iter().zip(fine).map(Some).collect::<Vec<_>>();
+    let mut ladders = coarse.into_iter().zip(fine).zip(observers.iter_mut());
     Some(std::array::from_fn(|l| {
-        let (coarse, fine) = pairs[l].take().expect("each pair is taken once");
-        let first = FirstPair { coarse, fine };
-        verified(scenarios[l], group.plan, &mut observers[l], Some(first))
+        let ((coarse, fine), observer) = ladders.next().expect("a pair per lane");
+        verified(
+            scenarios[l],
+            group.plan,
+            observer,
+            Some(FirstPair { coarse, fine }),
+        )
     }))
 }
 

@@ -10,8 +10,8 @@ use crate::integrate::{DriveConfig, Method, Observer, Stats, StepControl};
 use crate::model::{Model, Window};
 
 /// Integrates four states `ys` (`[q, q']` each, of `models`, one per lane) from t = 0 to
-/// `cfg.t_end` by `method` (`rkn6-contact` or `erkn6-contact`) at `cfg`'s fixed step, calling each lane's observer at the
-/// samples, and leaves each lane's final state in `ys`. Each lane's result is its scalar run's
+/// `cfg.t_end` by `method` (`rkn6-contact` or `erkn6-contact`) at `cfg`'s fixed step, calling
+/// each lane's observer at the samples, and leaves each lane's final state in `ys`. Each lane's result is its scalar run's
 /// ([`crate::integrate::drive`] with [`crate::integrate::Plan::stepper`]) bit for bit: its
 /// statistics, or the error that stopped it (which stops that lane only).
 ///
@@ -76,8 +76,6 @@ struct LaneBatch<'m> {
     stepper: LaneRkn6,
     q: Vec<Lanes>,
     v: Vec<Lanes>,
-    /// The lanes still running.
-    live: [bool; LANES],
 }
 
 impl<'m> LaneBatch<'m> {
@@ -93,19 +91,18 @@ impl<'m> LaneBatch<'m> {
             stepper,
             q,
             v,
-            live: [true; LANES],
         }
     }
 
-    /// Stops lane `l` with `error`: its state and its stepper's forces are set to rest, so
-    /// that it costs nothing more (no drift into huge or subnormal values).
+    /// Stops lane `l` (whose run the caller has dropped) with `error`: its state and its
+    /// stepper's forces are set to rest, so that it costs nothing more (no drift into huge or
+    /// subnormal values).
     fn stop(
         &mut self,
         l: usize,
         results: &mut [Option<Result<Stats, SimError>>; LANES],
         error: SimError,
     ) {
-        self.live[l] = false;
         results[l] = Some(Err(error));
         for x in self.q.iter_mut().chain(self.v.iter_mut()) {
             x[l] = 0.0;
@@ -144,11 +141,12 @@ impl<'m> LaneBatch<'m> {
                 }
             }
             let Some(union) = union(&windows) else { return };
+            let live = windows.map(|w| w.is_some());
             self.stepper.step(
                 &self.models,
                 (&mut self.q, &mut self.v),
                 h_eq,
-                (union, self.live),
+                (union, live),
             );
             let sums = self.finite_sums(union);
             for l in 0..LANES {
