@@ -11,7 +11,9 @@ use super::contact_event::{
     BondPath,
 };
 use super::contact_scan::{block_changes, block_of, changes_contact};
-use super::exact_resonator::{fast_mode_correction, Dofs, ExactResonators, FastModeCorrection};
+use super::exact_resonator::{
+    fast_mode_correction, Dofs, DofsMut, ExactResonators, FastModeCorrection,
+};
 use crate::contact::ContactLaw;
 use crate::model::{Model, Window};
 
@@ -36,16 +38,33 @@ const REFINE_PASSES: usize = 2;
 
 /// Adds each correction to the end state: the bond pushes its left member back and its right
 /// member on.
-fn apply(model: &Model, corrections: &[Correction], (new_q, new_v): (&mut [f64], &mut [f64])) {
-    let inv_mass = model.inv_mass();
+/// The end state may be a lane of four (`super::lanes`): it is written through [`DofsMut`].
+pub(super) fn apply<D: DofsMut + ?Sized>(
+    inv_mass: &[f64],
+    corrections: &[Correction],
+    (new_q, new_v): (&mut D, &mut D),
+) {
     for &(left, right, impulse, moment) in corrections {
         if let Some(i) = left {
-            new_v[i] -= impulse * inv_mass[i];
-            new_q[i] -= moment * inv_mass[i];
+            new_v.sub(i, impulse * inv_mass[i]);
+            new_q.sub(i, moment * inv_mass[i]);
         }
         if let Some(i) = right {
-            new_v[i] += impulse * inv_mass[i];
-            new_q[i] += moment * inv_mass[i];
+            new_v.add(i, impulse * inv_mass[i]);
+            new_q.add(i, moment * inv_mass[i]);
+        }
+    }
+}
+
+/// Adds the fast-mode parts of the corrections to the end state (host and resonator).
+pub(super) fn apply_fast<D: DofsMut + ?Sized>(
+    fast: impl IntoIterator<Item = FastModeCorrection>,
+    (new_q, new_v): (&mut D, &mut D),
+) {
+    for fast in fast {
+        for k in 0..2 {
+            new_v.add(fast.sites[k], fast.velocity[k]);
+            new_q.add(fast.sites[k], fast.position[k]);
         }
     }
 }
@@ -233,13 +252,8 @@ impl<const S: usize> ContactEvents<S> {
             // D follows the velocities, at index n_dof of them.
             new_v[n] += dissipated;
         }
-        apply(model, &pending, (new_q, new_v));
-        for fast in self.pending_fast.drain(..) {
-            for k in 0..2 {
-                new_v[fast.sites[k]] += fast.velocity[k];
-                new_q[fast.sites[k]] += fast.position[k];
-            }
-        }
+        apply(model.inv_mass(), &pending, (&mut *new_q, &mut *new_v));
+        apply_fast(self.pending_fast.drain(..), (&mut *new_q, &mut *new_v));
         if model.is_dissipative() {
             self.refine(model, (start, end), h, (&mut pending, &mut corrected));
         }
@@ -283,7 +297,7 @@ impl<const S: usize> ContactEvents<S> {
                 *lost_before = lost;
             }
             new_v[n] += dissipated;
-            apply(model, &deltas, (new_q, new_v));
+            apply(model.inv_mass(), &deltas, (new_q, new_v));
         }
     }
 

@@ -50,6 +50,11 @@ pub(crate) trait DofsMut: Dofs {
     fn add(&mut self, k: usize, x: f64) {
         self.set(k, self.at(k) + x);
     }
+    /// Entry `k` −= `x`.
+    #[inline(always)]
+    fn sub(&mut self, k: usize, x: f64) {
+        self.set(k, self.at(k) - x);
+    }
 }
 
 impl Dofs for [f64] {

@@ -3,11 +3,11 @@
 //! [`crate::integrate::event_correction`]'s order and with its functions, so that a lane's end
 //! state is corrected exactly as its scalar run's is.
 
-use super::{lanewise, Lane, Lanes, LANES, S};
+use super::{lanewise, Lane, LaneMut, Lanes, LANES, S};
 use crate::contact::ContactLaw;
 use crate::integrate::contact_scan::changes_contact;
 use crate::integrate::event_correction::{
-    bond_integrals, bond_path, end_force, negligible, BondSites, Correction,
+    apply, apply_fast, bond_integrals, bond_path, end_force, negligible, BondSites, Correction,
 };
 use crate::integrate::exact_resonator::{
     fast_mode_correction, ExactResonators, FastModeCorrection,
@@ -80,13 +80,10 @@ impl LaneEvents {
                     }
                 }
             }
-            apply(model.inv_mass(), &pending, (new_q, new_v), l);
-            for fast in self.pending_fast.drain(..) {
-                for k in 0..2 {
-                    new_v[fast.sites[k]][l] += fast.velocity[k];
-                    new_q[fast.sites[k]][l] += fast.position[k];
-                }
-            }
+            let end = (&mut LaneMut(new_q, l), &mut LaneMut(new_v, l));
+            apply(model.inv_mass(), &pending, end);
+            let end = (&mut LaneMut(new_q, l), &mut LaneMut(new_v, l));
+            apply_fast(self.pending_fast.drain(..), end);
             let touched = &mut self.touched[l];
             for &(left, right, ..) in &pending {
                 touched.extend(left.into_iter().chain(right));
@@ -169,26 +166,6 @@ impl LaneEvents {
             if mask != 0 {
                 self.changed.push(((n_sites, Some(last), None), mask));
             }
-        }
-    }
-}
-
-/// Adds lane `l`'s corrections to the end state, as the scalar `apply` does: the bond pushes
-/// its left member back and its right member on.
-fn apply(
-    inv_mass: &[f64],
-    corrections: &[Correction],
-    (new_q, new_v): (&mut [Lanes], &mut [Lanes]),
-    l: usize,
-) {
-    for &(left, right, impulse, moment) in corrections {
-        if let Some(i) = left {
-            new_v[i][l] -= impulse * inv_mass[i];
-            new_q[i][l] -= moment * inv_mass[i];
-        }
-        if let Some(i) = right {
-            new_v[i][l] += impulse * inv_mass[i];
-            new_q[i][l] += moment * inv_mass[i];
         }
     }
 }
