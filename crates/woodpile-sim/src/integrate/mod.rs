@@ -30,6 +30,7 @@ mod rk4_fused;
 mod rkn;
 mod rkn4;
 mod stage_step;
+mod stage_sum;
 mod symplectic;
 
 pub use active_sites::ActiveSites;

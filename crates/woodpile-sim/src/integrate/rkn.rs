@@ -22,6 +22,7 @@
 use super::erkn_weights::NystromWeights;
 use super::event_correction::{ContactEvents, Quadrature};
 use super::exact_resonator::ExactResonators;
+use super::stage_sum::{sum_into, Base, Terms};
 use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
@@ -239,21 +240,12 @@ impl<const S: usize> Rkn<S> {
         for i in 0..S {
             if i > 0 {
                 for r in ranges.clone() {
-                    let qs = &mut self.q_stage[r.clone()];
-                    let (q0, v0) = (&q[r.clone()][..qs.len()], &v[r.clone()][..qs.len()]);
-                    let cv = tab.c[i] * h;
-                    for k in 0..qs.len() {
-                        qs[k] = q0[k] + cv * v0[k];
-                    }
+                    let mut terms = Terms::new();
                     for j in 0..i {
-                        let w = h * h * tab.a[i][j];
-                        if w != 0.0 {
-                            let aj = &self.a[j][r.clone()][..qs.len()];
-                            for k in 0..qs.len() {
-                                qs[k] += w * aj[k];
-                            }
-                        }
+                        terms.push(h * h * tab.a[i][j], &self.a[j][r.clone()]);
                     }
+                    let base = Base::Plus(&q[r.clone()], tab.c[i] * h, &v[r.clone()]);
+                    sum_into(&mut self.q_stage[r], base, &terms);
                 }
                 if let Some(exact) = &self.exact {
                     exact.shift_stage(i, self.q_stage.as_mut_slice());
@@ -286,35 +278,20 @@ impl<const S: usize> Rkn<S> {
         }
         let (new_q, new_v) = self.y_new.split_at_mut(n);
         for r in ranges {
-            let nq = &mut new_q[r.clone()];
-            let nv = &mut new_v[r.clone()][..nq.len()];
-            let (q0, v0) = (&q[r.clone()][..nq.len()], &v[r.clone()][..nq.len()]);
-            // An FSAL tableau's last stage position is the new position, computed by the same
-            // operations in the same order: copy it.
-            let new_q_known = self.fsal;
-            if new_q_known {
-                nq.copy_from_slice(&self.q_stage[r.clone()]);
-            }
-            for k in 0..nq.len() {
-                if !new_q_known {
-                    nq[k] = q0[k] + h * v0[k];
-                }
-                nv[k] = v0[k];
-            }
+            let (mut q_terms, mut v_terms) = (Terms::new(), Terms::new());
             for i in 0..S {
-                let ai = &self.a[i][r.clone()][..nq.len()];
-                let (wq, wv) = (h * h * tab.b[i], h * tab.b_prime[i]);
-                if wq != 0.0 && !new_q_known {
-                    for k in 0..nq.len() {
-                        nq[k] += wq * ai[k];
-                    }
-                }
-                if wv != 0.0 {
-                    for k in 0..nq.len() {
-                        nv[k] += wv * ai[k];
-                    }
-                }
+                q_terms.push(h * h * tab.b[i], &self.a[i][r.clone()]);
+                v_terms.push(h * tab.b_prime[i], &self.a[i][r.clone()]);
             }
+            let nq = &mut new_q[r.clone()];
+            if self.fsal {
+                // An FSAL tableau's last stage position is the new position, computed by the
+                // same operations in the same order: copy it.
+                nq.copy_from_slice(&self.q_stage[r.clone()]);
+            } else {
+                sum_into(nq, Base::Plus(&q[r.clone()], h, &v[r.clone()]), &q_terms);
+            }
+            sum_into(&mut new_v[r.clone()], Base::Of(&v[r]), &v_terms);
         }
         if let Some(exact) = &self.exact {
             exact.shift_velocity(new_v);

@@ -5,10 +5,11 @@
 
 use super::events::LaneEvents;
 use super::force::{accelerations, patch};
-use super::{lanewise, Lane, LaneChain, LaneMut, Lanes, LANES, S, ZERO};
+use super::{Lane, LaneChain, LaneMut, Lanes, LANES, S, ZERO};
 use crate::integrate::erkn_weights::NystromWeights;
 use crate::integrate::exact_resonator::ExactResonators;
 use crate::integrate::rkn::DPRKN6;
+use crate::integrate::stage_sum::{sum_into, Base, Terms};
 use crate::model::{Model, Window};
 
 /// `rkn6-contact` or `erkn6-contact` for four lanes, with its scratch (allocated once).
@@ -159,17 +160,14 @@ impl LaneRkn6 {
         for i in 0..S {
             if i > 0 {
                 for r in ranges.clone() {
-                    let cv = tab.c[i] * h;
-                    let qs = &mut self.q_stage[r.clone()];
-                    for ((qs, q), v) in qs.iter_mut().zip(&q[r.clone()]).zip(&v[r.clone()]) {
-                        *qs = lanewise(*q, *v, |q, v| q + cv * v);
-                    }
+                    // Lane by lane, the scalar path's sums: the lanes are flat f64 slices.
+                    let mut terms = Terms::new();
                     for j in 0..i {
-                        let w = h * h * tab.a[i][j];
-                        if w != 0.0 {
-                            add_scaled(qs, &self.a[j][r.clone()], w);
-                        }
+                        terms.push(h * h * tab.a[i][j], self.a[j][r.clone()].as_flattened());
                     }
+                    let (q, v) = (q[r.clone()].as_flattened(), v[r.clone()].as_flattened());
+                    let qs = self.q_stage[r].as_flattened_mut();
+                    sum_into(qs, Base::Plus(q, tab.c[i] * h, v), &terms);
                 }
                 for (l, exact) in self.exact.iter().enumerate() {
                     if let Some(exact) = exact {
@@ -219,13 +217,12 @@ impl LaneRkn6 {
         for r in ranges {
             // DPRKN6's last stage position is the new position, computed the same way.
             self.new_q[r.clone()].copy_from_slice(&self.q_stage[r.clone()]);
-            self.new_v[r.clone()].copy_from_slice(&v[r.clone()]);
+            let mut terms = Terms::new();
             for i in 0..S {
-                let wv = h * tab.b_prime[i];
-                if wv != 0.0 {
-                    add_scaled(&mut self.new_v[r.clone()], &self.a[i][r.clone()], wv);
-                }
+                terms.push(h * tab.b_prime[i], self.a[i][r.clone()].as_flattened());
             }
+            let new_v = self.new_v[r.clone()].as_flattened_mut();
+            sum_into(new_v, Base::Of(v[r].as_flattened()), &terms);
         }
         for (l, exact) in self.exact.iter().enumerate() {
             if let Some(exact) = exact {
@@ -235,10 +232,3 @@ impl LaneRkn6 {
     }
 }
 
-/// `dst += w x`, lane by lane.
-#[inline(always)]
-fn add_scaled(dst: &mut [Lanes], x: &[Lanes], w: f64) {
-    for (d, x) in dst.iter_mut().zip(x) {
-        *d = lanewise(*d, *x, |d, x| d + w * x);
-    }
-}
