@@ -122,7 +122,7 @@ mod tests {
                     if k % 7 == 0 {
                         -0.0
                     } else {
-                        x * 10f64.powi((k as i32 % 9) - 4)
+                        x * 10f64.powi((k % 9) - 4)
                     }
                 })
                 .collect()
