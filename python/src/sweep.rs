@@ -17,7 +17,7 @@ use woodpile_points::{point_key, simulate_points_until, Key, PointResult, PointS
 use woodpile_scene::grid::{at_point, parse_axes, point, point_count, Axis, AxisValue};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::lanes::LANES;
+use woodpile_sim::simulation::batch_size;
 
 use crate::interrupt::{internal_message, interruptible_keeping};
 use crate::listed::{outcome_rows, table_dict};
@@ -169,11 +169,12 @@ impl Run<'_> {
         let poll = |py: Python<'_>| points_done(py, progress, &self.done, count);
         let (points, signal) = interruptible_keeping(py, &poll, |cancel| {
             crate::pool::run_parallel(|| {
-                // Neighbouring points in groups of four, which run in lanes where they can
-                // (`woodpile_sim::simulation::simulate_batch`), as the pipeline's sweeps do.
+                // Neighbouring points in batches of groups of four, which run in lanes where
+                // they can (`woodpile_sim::simulation::simulate_batch`), as the pipeline's
+                // sweeps do.
                 let indices: Vec<usize> = (0..count).collect();
                 indices
-                    .par_chunks(LANES)
+                    .par_chunks(batch_size(count))
                     .flat_map_iter(|group| self.group(group, cancel))
                     .collect::<Vec<_>>()
             })
@@ -350,8 +351,9 @@ pub(crate) fn simulate_many<'py>(
     let poll = |py: Python<'_>| points_done(py, progress.as_ref(), &done, list.len());
     let (outcomes, signal) = interruptible_keeping(py, &poll, |cancel| {
         crate::pool::run_parallel(|| {
-            // Neighbouring scenes in groups of four, which run in lanes where they can.
-            list.par_chunks(LANES)
+            // Neighbouring scenes in batches of groups of four, which run in lanes where
+            // they can.
+            list.par_chunks(batch_size(list.len()))
                 .flat_map_iter(|group| {
                     let group: Vec<&Scene> = group.iter().collect();
                     let outcomes = crate::listed::simulate_group(&group, cancel);

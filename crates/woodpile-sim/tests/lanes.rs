@@ -69,6 +69,34 @@ fn light_resonators_in_lanes_equal_their_scalar_runs() {
     batched_and_alone(&scenes);
 }
 
+/// Ladders that need a later rung wait for three others at its step, across the batch's
+/// groups of four, and make that rung's run in lanes: eight F7 fine points in two first-pair
+/// groups, five of which need a third run, each equal to its scalar `auto` run.
+#[test]
+fn later_rungs_pooled_across_groups_equal_their_scalar_runs() {
+    let eps = [
+        (0.59, 0.96),
+        (0.29, 0.64),
+        (0.79, 0.92),
+        (0.36, 0.46),
+        (0.57, 0.30),
+        (1.0, 0.42),
+        (0.82, 0.95),
+        (0.57, 0.61),
+    ];
+    let scenes: Vec<Scenario> = eps.iter().map(|&e| f7_scene(e)).collect();
+    let first = first_steps(&scenes);
+    let mut later_rungs = 0;
+    for (k, (lanes, alone)) in by_lanes_and_alone(&scenes).into_iter().enumerate() {
+        assert_eq!(lanes.0, alone.0, "scene {k}: outcome");
+        assert_eq!(lanes.1, alone.1, "scene {k}: samples");
+        if alone.0.unwrap().stats.max_step < 0.75 * first[k].1 {
+            later_rungs += 1;
+        }
+    }
+    assert_eq!(later_rungs, 5, "the scenes that needed a third run");
+}
+
 /// Nine F7 points (two groups of four in lanes, the ninth alone), some passing their first
 /// pair and some needing a third run, each equal to its scalar `auto` run.
 #[test]

@@ -34,8 +34,8 @@ use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::lanes::LANES;
 use woodpile_sim::integrate::MethodChoice;
+use woodpile_sim::simulation::batch_size;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
@@ -277,9 +277,9 @@ impl PointGrid for Sweep {
             .filter(|&i| results[i].is_none() && *first_of.entry(&keys[i]).or_insert(i) == i)
             .collect();
         events.simulating(stage, todo.len(), keys.len() - todo.len());
-        // Neighbouring points in groups of four, which run in lanes where they can.
+        // Neighbouring points in batches of groups of four, which run in lanes where they can.
         let computed: Vec<(usize, Fetched)> = todo
-            .par_chunks(LANES)
+            .par_chunks(batch_size(todo.len()))
             .map(|group| {
                 let scenes: Vec<Scene> = group
                     .iter()

@@ -56,39 +56,12 @@ pub(super) fn verified<O: Observer + ?Sized>(
     first: Option<FirstPair>,
 ) -> Result<Outcome, SimError> {
     let mut ladder = Ladder::start(scenario, plan, observer, first)?;
-    let mut why = Refusal::NoRunKeptEnergy;
-    for halvings_left in (0..=MAX_HALVINGS).rev() {
-        match ladder.rung(halvings_left)? {
-            Rung::Accept(outcome) => return Ok(*outcome),
-            Rung::Refine(reason) => why = reason,
-            Rung::GiveUp(reason) => {
-                why = reason;
-                break;
-            }
+    loop {
+        let fine = ladder.fine_run(observer);
+        if let Some(done) = ladder.judge(fine, observer) {
+            return done;
         }
     }
-    // After a refusal the finest run is the next rung's coarse one.
-    let finest = ladder.coarse.take().map(|run| {
-        let f = run.fractions;
-        Box::new(crate::error::Unverified {
-            shares: [
-                f.reflected,
-                f.transmitted,
-                f.trapped,
-                f.striker,
-                f.dissipated,
-            ],
-            dt: run.stats.max_step,
-            estimate: ladder.estimate,
-        })
-    });
-    Err(SimError::NotConverged {
-        tolerance: ladder.tol,
-        estimate: ladder.estimate,
-        dt: 2.0 * ladder.dt,
-        why,
-        finest,
-    })
 }
 
 /// What one rung of the ladder decided.
@@ -102,20 +75,25 @@ enum Rung {
 }
 
 /// The ladder's state between rungs: the step, the run at twice it, the change between the
-/// two rungs before, what has been spent, and the last estimate.
-struct Ladder<'a, O: Observer + ?Sized> {
+/// two rungs before, what has been spent, and the last estimate. Between rungs it waits for
+/// its rung's fine run ([`Ladder::next_plan`]), which [`verified`] makes at once and
+/// `super::lanes` makes in lanes with other scenes' ladders at the same step.
+pub(super) struct Ladder<'a> {
     scenario: &'a Scenario,
     plan: Plan,
     /// The plan of verification runs: only guarded against blow-up (the accepted run must
     /// also keep energy, checked by the rung).
     guarded: Plan,
-    observer: &'a mut O,
     tol: f64,
     /// The method's observed order on Hertzian chains, and the Richardson denominator 2^q − 1.
     order: f64,
     richardson: f64,
     strictness: Strictness,
     dt: f64,
+    /// The rungs left after this one.
+    halvings_left: u32,
+    /// Why the last rung refused.
+    why: Refusal,
     /// The run at 2 dt (None when it blew up).
     coarse: Option<Outcome>,
     /// The first rung's fine run, when it was made before the ladder started.
@@ -127,13 +105,13 @@ struct Ladder<'a, O: Observer + ?Sized> {
     estimate: f64,
 }
 
-impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
+impl<'a> Ladder<'a> {
     /// The ladder at `auto`'s first step, with the run at twice it made (or taken from
     /// `first`, with the first rung's fine run).
-    fn start(
+    pub(super) fn start<O: Observer + ?Sized>(
         scenario: &'a Scenario,
         plan: Plan,
-        observer: &'a mut O,
+        observer: &O,
         first: Option<FirstPair>,
     ) -> Result<Self, SimError> {
         let tol = scenario.accuracy.tolerance;
@@ -155,12 +133,13 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
             scenario,
             plan,
             guarded,
-            observer,
             tol,
             order,
             richardson: 2f64.powf(order) - 1.0,
             strictness: Strictness::of(&scenario.model, tol),
             dt,
+            halvings_left: MAX_HALVINGS,
+            why: Refusal::NoRunKeptEnergy,
             coarse,
             first_fine,
             previous_change: None,
@@ -169,12 +148,90 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
         })
     }
 
-    /// One rung: the run at dt against the one at 2 dt, with `halvings_left` rungs after it.
-    /// A refusal halves the step for the next rung, or gives up when no rung left can accept;
-    /// a scene error (not a blow-up) ends the ladder.
-    fn rung(&mut self, halvings_left: u32) -> Result<Rung, SimError> {
+    /// The scene the ladder verifies.
+    pub(super) fn scenario(&self) -> &'a Scenario {
+        self.scenario
+    }
+
+    /// The plan of the rung's fine run, at the rung's step.
+    pub(super) fn next_plan(&self) -> Plan {
+        self.guarded.with_dt(self.dt)
+    }
+
+    /// The rung's run at dt, shown to `observer` (reset first): made now, or before the
+    /// ladder started.
+    pub(super) fn fine_run<O: Observer + ?Sized>(
+        &mut self,
+        observer: &mut O,
+    ) -> Result<Outcome, SimError> {
+        match self.first_fine.take() {
+            Some(run) => run,
+            None => {
+                observer.reset();
+                run_plan(self.scenario, &self.next_plan(), observer)
+            }
+        }
+    }
+
+    /// Judges the rung whose fine run (shown to `observer`) is `fine`: the scene's result when
+    /// the ladder ends here (accepted, refused, or a scene error), or `None` when it goes on
+    /// to the next rung, at half the step.
+    pub(super) fn judge<O: Observer + ?Sized>(
+        &mut self,
+        fine: Result<Outcome, SimError>,
+        observer: &O,
+    ) -> Option<Result<Outcome, SimError>> {
+        match self.rung(fine, observer) {
+            Err(e) => Some(Err(e)),
+            Ok(Rung::Accept(outcome)) => Some(Ok(*outcome)),
+            Ok(Rung::Refine(reason)) if self.halvings_left > 0 => {
+                self.why = reason;
+                self.halvings_left -= 1;
+                None
+            }
+            Ok(Rung::Refine(reason) | Rung::GiveUp(reason)) => {
+                self.why = reason;
+                Some(Err(self.refused()))
+            }
+        }
+    }
+
+    /// The refusal of a ladder that ended without accepting: after a refusal the finest run
+    /// is the next rung's coarse one.
+    fn refused(&mut self) -> SimError {
+        let finest = self.coarse.take().map(|run| {
+            let f = run.fractions;
+            Box::new(crate::error::Unverified {
+                shares: [
+                    f.reflected,
+                    f.transmitted,
+                    f.trapped,
+                    f.striker,
+                    f.dissipated,
+                ],
+                dt: run.stats.max_step,
+                estimate: self.estimate,
+            })
+        });
+        SimError::NotConverged {
+            tolerance: self.tol,
+            estimate: self.estimate,
+            dt: 2.0 * self.dt,
+            why: std::mem::replace(&mut self.why, Refusal::NoRunKeptEnergy),
+            finest,
+        }
+    }
+
+    /// One rung: the run at dt (`fine`) against the one at 2 dt, with `halvings_left` rungs
+    /// after it. A refusal halves the step for the next rung, or gives up when no rung left
+    /// can accept; a scene error (not a blow-up) ends the ladder.
+    fn rung<O: Observer + ?Sized>(
+        &mut self,
+        fine: Result<Outcome, SimError>,
+        observer: &O,
+    ) -> Result<Rung, SimError> {
         let tol = self.tol;
-        let fine = match self.fine_run() {
+        let fine = match fine {
             Ok(out) => out,
             // Too coarse to even keep the energy: not a failure of the scene, a step to halve.
             Err(e @ (SimError::NonFinite { .. } | SimError::EnergyDrift { .. })) => {
@@ -202,7 +259,7 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
         let enough_runs = self.previous_change.is_some() || !self.strictness.needs_three_runs;
         let pair_passes = estimate <= accept && drift_ok && regular && enough_runs;
         let off_ladder = match pair_passes && self.needs_off_ladder(&fine) {
-            true => Some(self.off_ladder_estimate(&fine)?),
+            true => Some(self.off_ladder_estimate(&fine, observer)?),
             false => None,
         };
         if pair_passes && off_ladder.is_none_or(|e| e <= accept) {
@@ -244,20 +301,8 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
             }
         };
         self.step_down(change, Some(fine));
-        let hopeless = self.out_of_reach(&why, halvings_left);
+        let hopeless = self.out_of_reach(&why, self.halvings_left);
         Ok(hopeless.map_or(Rung::Refine(why), Rung::GiveUp))
-    }
-
-    /// The rung's run at dt, shown to the observer: made now, or before the ladder started.
-    fn fine_run(&mut self) -> Result<Outcome, SimError> {
-        match self.first_fine.take() {
-            Some(run) => run,
-            None => {
-                self.observer.reset();
-                let plan = self.guarded.with_dt(self.dt);
-                run_plan(self.scenario, &plan, self.observer)
-            }
-        }
     }
 
     /// Halves the step: the run just made (`fine`, with its `change` from the coarse one)
@@ -309,9 +354,13 @@ impl<'a, O: Observer + ?Sized> Ladder<'a, O> {
     }
 
     /// The error estimate from the run at 1.5 dt against `fine` (infinite if it blew up).
-    fn off_ladder_estimate(&mut self, fine: &Outcome) -> Result<f64, SimError> {
+    fn off_ladder_estimate<O: Observer + ?Sized>(
+        &mut self,
+        fine: &Outcome,
+        observer: &O,
+    ) -> Result<f64, SimError> {
         let plan = self.guarded.with_dt(1.5 * self.dt);
-        let off = check_run(self.scenario, &plan, self.observer, &mut self.spent)?;
+        let off = check_run(self.scenario, &plan, observer, &mut self.spent)?;
         Ok(off.map_or(f64::INFINITY, |out| {
             out.fractions.largest_difference(&fine.fractions) / (1.5f64.powf(self.order) - 1.0)
         }))

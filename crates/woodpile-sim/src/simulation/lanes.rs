@@ -1,15 +1,18 @@
 //! [`simulate`] of many scenes, four at a time in lanes where they allow it: `auto`'s first
 //! pair of runs (2 dt, then dt) made for four scenes together
-//! ([`crate::integrate::lanes`]), after which each scene's ladder goes on alone from those
-//! runs. Every result is its scene's [`simulate`] result bit for bit; only the time differs.
+//! ([`crate::integrate::lanes`]), then each later rung's fine run made for four ladders at the
+//! same step together, whichever scenes of the batch they verify. Every result is its scene's
+//! [`simulate`] result bit for bit; only the time differs.
 //!
 //! Four scenes take lanes together when each asks for `auto`, plans the same method
 //! (`rkn6-contact`, or `erkn6-contact` for light harmonic resonators) at the same first step,
 //! runs for as long with the same samples, and all share a chain that takes lanes
 //! ([`crate::integrate::lanes::takes_lanes`]). A sweep's neighbouring points mostly do; any
-//! other group runs scene by scene.
+//! other group runs scene by scene. The ladders that need another rung wait for three others
+//! at their step: a sweep's points that need a third run cluster (the F7 grids' light
+//! resonators near ω = 1.5), so most of those runs take lanes too; the few left over run alone.
 
-use super::ladder::{verified, FirstPair};
+use super::ladder::{FirstPair, Ladder};
 use super::{auto_first_step, budget, outcome_of, simulate, Outcome, Scenario};
 use crate::energy::total_energy;
 use crate::error::SimError;
@@ -18,9 +21,16 @@ use crate::integrate::{
     CancelOnly, MethodChoice, Observer, Plan, AUTO_METHOD, BLOW_UP_DRIFT, HARMONIC_AUTO_METHOD,
 };
 
+/// How many of `n` scenes to hand [`simulate_batch`] at a time: whole groups of four, up to
+/// eight groups, so that the ladders needing a later rung find three others at their step;
+/// but no more than leaves about 32 batches, so that the cores finish together.
+pub fn batch_size(n: usize) -> usize {
+    LANES * (n / (32 * LANES)).clamp(1, 8)
+}
+
 /// Simulates each of `scenarios` as [`simulate`] does, showing the samples of each one's
 /// reported run to its own of `observers` (as many), with groups of four consecutive scenes
-/// that allow it stepped together in lanes.
+/// that allow it stepped together in lanes, and their ladders' later rungs four at a time.
 pub fn simulate_batch<O: Observer>(
     scenarios: &[&Scenario],
     observers: &mut [O],
@@ -30,26 +40,109 @@ pub fn simulate_batch<O: Observer>(
         observers.len(),
         "one observer per scenario"
     );
-    let mut results = Vec::with_capacity(scenarios.len());
-    for (group, observers) in scenarios.chunks(LANES).zip(observers.chunks_mut(LANES)) {
-        let batched = match (
+    let mut results: Vec<Option<Result<Outcome, SimError>>> =
+        scenarios.iter().map(|_| None).collect();
+    let mut waiting = Vec::new();
+    for start in (0..scenarios.len()).step_by(LANES) {
+        let end = (start + LANES).min(scenarios.len());
+        let group = &scenarios[start..end];
+        let pairs = match (
             <&[&Scenario; LANES]>::try_from(group),
-            <&mut [O; LANES]>::try_from(&mut *observers),
+            <&mut [O; LANES]>::try_from(&mut observers[start..end]),
         ) {
-            (Ok(group), Ok(observers)) => in_lanes(group, observers),
+            (Ok(group), Ok(observers)) => first_pairs(group, observers),
             _ => None,
         };
-        match batched {
-            Some(outcomes) => results.extend(outcomes),
-            None => results.extend(
-                group
-                    .iter()
-                    .zip(observers.iter_mut())
-                    .map(|(s, o)| simulate(s, o)),
-            ),
+        let Some((plan, pairs)) = pairs else {
+            for k in start..end {
+                results[k] = Some(simulate(scenarios[k], &mut observers[k]));
+            }
+            continue;
+        };
+        for (k, pair) in (start..end).zip(pairs) {
+            let observer = &mut observers[k];
+            let judged = Ladder::start(scenarios[k], plan, observer, Some(pair)).map(|mut ladder| {
+                let fine = ladder.fine_run(observer);
+                (ladder.judge(fine, observer), ladder)
+            });
+            match judged {
+                Err(e) => results[k] = Some(Err(e)),
+                Ok((Some(done), _)) => results[k] = Some(done),
+                Ok((None, ladder)) => waiting.push((k, ladder)),
+            }
         }
     }
+    while !waiting.is_empty() {
+        waiting = next_rungs(waiting, observers, &mut results);
+    }
     results
+        .into_iter()
+        .map(|r| r.expect("every scene ends with a result"))
+        .collect()
+}
+
+/// One more rung of each of the `waiting` ladders (of scene `k`, shown to `observers[k]`):
+/// the fine runs of four ladders at one step and plan in lanes, the rest alone. Each
+/// ladder's result goes to `results[k]`; returns the ladders that go on.
+fn next_rungs<'s, O: Observer>(
+    waiting: Vec<(usize, Ladder<'s>)>,
+    observers: &mut [O],
+    results: &mut [Option<Result<Outcome, SimError>>],
+) -> Vec<(usize, Ladder<'s>)> {
+    let mut open: Vec<Vec<(usize, Ladder<'s>)>> = Vec::new();
+    let mut full = Vec::new();
+    for (k, ladder) in waiting {
+        let plan = ladder.next_plan();
+        match open.iter().position(|g| g[0].1.next_plan() == plan) {
+            Some(i) => {
+                open[i].push((k, ladder));
+                if open[i].len() == LANES {
+                    full.push(open.swap_remove(i));
+                }
+            }
+            None => open.push(vec![(k, ladder)]),
+        }
+    }
+    let mut going_on = Vec::new();
+    let mut judge = |k: usize, mut ladder: Ladder<'s>, fine, observer: &O| match ladder
+        .judge(fine, observer)
+    {
+        Some(done) => results[k] = Some(done),
+        None => going_on.push((k, ladder)),
+    };
+    for group in full {
+        let group: [(usize, Ladder<'s>); LANES] = match group.try_into() {
+            Ok(group) => group,
+            Err(_) => unreachable!("a full group has four ladders"),
+        };
+        let scenes = group.each_ref().map(|(_, ladder)| ladder.scenario());
+        let plan = group[0].1.next_plan();
+        let dt = plan.dt().expect("a ladder's runs have a fixed step");
+        let lanes = LaneGroup::with(&scenes, plan, dt).filter(|_| enabled());
+        let Ok(mut shown) = observers.get_disjoint_mut(group.each_ref().map(|(k, _)| *k)) else {
+            unreachable!("a ladder per scene");
+        };
+        match lanes {
+            Some(lanes) => {
+                shown.iter_mut().for_each(|o| o.reset());
+                let runs = lanes.run(&plan, shown.each_mut().map(|o| *o as &mut dyn Observer));
+                for (((k, ladder), fine), observer) in group.into_iter().zip(runs).zip(shown) {
+                    judge(k, ladder, fine, observer);
+                }
+            }
+            None => {
+                for ((k, mut ladder), observer) in group.into_iter().zip(shown) {
+                    let fine = ladder.fine_run(observer);
+                    judge(k, ladder, fine, observer);
+                }
+            }
+        }
+    }
+    for (k, mut ladder) in open.into_iter().flatten() {
+        let fine = ladder.fine_run(&mut observers[k]);
+        judge(k, ladder, fine, &observers[k]);
+    }
+    going_on
 }
 
 /// Four scenes that can take lanes, their shared plan and first step, and their initial
@@ -62,6 +155,7 @@ struct LaneGroup<'s> {
 }
 
 impl<'s> LaneGroup<'s> {
+    /// Four scenes whose ladders start alike: the same plan at the same first step.
     fn of(scenarios: &'s [&'s Scenario; LANES]) -> Option<Self> {
         let plan_of = |s: &Scenario| {
             let auto = s.method == MethodChoice::Auto;
@@ -75,12 +169,18 @@ impl<'s> LaneGroup<'s> {
         let first = scenarios[0];
         let plan = plan_of(first)?;
         let dt = auto_first_step(first, &plan);
-        let alike = |s: &&Scenario| {
-            plan_of(s) == Some(plan)
-                && auto_first_step(s, &plan) == dt
-                && s.t_end == first.t_end
-                && s.sample_every == first.sample_every
-        };
+        let alike = |s: &&Scenario| plan_of(s) == Some(plan) && auto_first_step(s, &plan) == dt;
+        if !scenarios.iter().all(alike) {
+            return None;
+        }
+        Self::with(scenarios, plan, dt)
+    }
+
+    /// Four scenes to be run by `plan` (at step `dt`) together: `None` unless they run for as
+    /// long with the same samples and share a chain.
+    fn with(scenarios: &'s [&'s Scenario; LANES], plan: Plan, dt: f64) -> Option<Self> {
+        let first = scenarios[0];
+        let alike = |s: &&Scenario| s.t_end == first.t_end && s.sample_every == first.sample_every;
         if !scenarios.iter().all(alike) || !shares_a_chain(&scenarios.map(|s| &s.model)) {
             return None;
         }
@@ -126,11 +226,12 @@ impl<'s> LaneGroup<'s> {
     }
 }
 
-/// `auto` on four scenes whose first pair runs in lanes, or `None` when they cannot.
-fn in_lanes<O: Observer>(
+/// The first pairs of `auto`'s ladders on four scenes, made in lanes, with the plan they
+/// share; `None` when the scenes cannot take lanes.
+fn first_pairs<O: Observer>(
     scenarios: &[&Scenario; LANES],
     observers: &mut [O; LANES],
-) -> Option<[Result<Outcome, SimError>; LANES]> {
+) -> Option<(Plan, [FirstPair; LANES])> {
     let group = LaneGroup::of(scenarios).filter(|_| enabled())?;
     // The ladder's first pair, as `Ladder::start` and its first rung make it: verification
     // runs are guarded against blow-up only.
@@ -160,16 +261,14 @@ fn in_lanes<O: Observer>(
         &guarded.with_dt(group.dt),
         shown.each_mut().map(|o| o as &mut dyn Observer),
     );
-    let mut ladders = coarse.into_iter().zip(fine).zip(observers.iter_mut());
-    Some(std::array::from_fn(|l| {
-        let ((coarse, fine), observer) = ladders.next().expect("a pair per lane");
-        verified(
-            scenarios[l],
-            group.plan,
-            observer,
-            Some(FirstPair { coarse, fine }),
-        )
-    }))
+    let mut pairs = coarse.into_iter().zip(fine);
+    Some((
+        group.plan,
+        std::array::from_fn(|_| {
+            let (coarse, fine) = pairs.next().expect("a pair per lane");
+            FirstPair { coarse, fine }
+        }),
+    ))
 }
 
 /// Whether a run failed by blowing up or losing its energy: a step too coarse, which the

@@ -14,7 +14,7 @@ mod lanes;
 
 pub use ladder::accepted_estimate;
 use ladder::verified;
-pub use lanes::simulate_batch;
+pub use lanes::{batch_size, simulate_batch};
 
 use crate::energy::{Fractions, Region};
 use crate::error::SimError;
