@@ -22,10 +22,11 @@ use crate::integrate::{
 };
 
 /// How many of `n` scenes to hand [`simulate_batch`] at a time: whole groups of four, up to
-/// eight groups, so that the ladders needing a later rung find three others at their step;
-/// but no more than leaves about 32 batches, so that the cores finish together.
+/// sixteen groups, so that the ladders needing a later rung find three others at their step
+/// (on F7's grids one in five or six of the points need one); but no more than leaves about
+/// 32 batches, so that the cores finish together. A stopped run loses the batches under way.
 pub fn batch_size(n: usize) -> usize {
-    LANES * (n / (32 * LANES)).clamp(1, 8)
+    LANES * (n / (32 * LANES)).clamp(1, 16)
 }
 
 /// Simulates each of `scenarios` as [`simulate`] does, showing the samples of each one's
