@@ -67,12 +67,11 @@ impl PointStore {
         decode(&bytes, key)
     }
 
-    /// The result of `scene` (whose key is `key`, from [`crate::point_key`]): from the cache,
-    /// or simulated and saved. Every kind that simulates scenes goes through here, so a scene
-    /// is simulated once whichever stage asks for it first.
-    /// Several points at once (`keys[k]` is the key of `scenes[k]`): the ones not cached are
-    /// simulated together (four neighbours at a time in SIMD lanes), so a stage hands its
-    /// points over in groups of four.
+    /// Several points at once (`keys[k]` is the key of `scenes[k]`): from the cache, or
+    /// simulated together (four neighbours at a time in SIMD lanes) and saved. Every kind that
+    /// simulates scenes goes through here, so a scene is simulated once whichever stage asks
+    /// for it first; a stage hands its points over in batches of groups of four
+    /// (`woodpile_sim::simulation::batch_size`).
     pub fn get_or_simulate_all(
         &self,
         points: (&[&Key], &[&Scene]),
@@ -105,7 +104,7 @@ impl PointStore {
     /// Points `keys[k]` of `scenes[k]`: from the cache, or simulated together
     /// ([`simulate_points_until`]: four neighbours at a time in lanes) and saved, each with
     /// whether it was simulated now; `None` for a point stopped by `stop()` (nothing saved).
-    /// Saved once all are simulated (callers pass a group of four; the first failed save ends
+    /// Saved once all are simulated (callers pass a batch of groups of four; the first failed save ends
     /// the call).
     pub fn get_or_simulate_many(
         &self,

@@ -22,7 +22,7 @@
 use super::erkn_weights::NystromWeights;
 use super::event_correction::{ContactEvents, Quadrature};
 use super::exact_resonator::ExactResonators;
-use super::stage_sum::{sum_into, Base, Terms};
+use super::stage_sum::{sum_into, Base, Terms, MAX_TERMS};
 use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
@@ -173,6 +173,7 @@ pub struct Rkn<const S: usize> {
 impl<const S: usize> Rkn<S> {
     /// The method of `tableau` for states of `model`, treating contact events by `mode`.
     pub fn new(model: &Model, tableau: RknTableau<S>, mode: ContactMode) -> Self {
+        const { assert!(S <= MAX_TERMS, "a stage sum takes at most MAX_TERMS terms") };
         let n = model.n_dof();
         Self {
             tableau,
@@ -222,8 +223,8 @@ impl<const S: usize> Rkn<S> {
     crate::simd::dispatched! {
         /// One step of the tableau from `y` into `self.y_new` (uncorrected), recording the
         /// stage forces when contacts are tracked. Each stage position and the new state are
-        /// built by whole-slice passes (one per nonzero coefficient), which vectorise: in
-        /// their AVX2 copy where the CPU has one (`crate::simd`).
+        /// summed in one pass per range ([`super::stage_sum`]), which vectorises: in its AVX2
+        /// copy where the CPU has one (`crate::simd`).
         fn raw_step[&mut self](model: &Model, t: f64, y: &[f64], h: f64, window: Window)
             => raw_step_body, raw_step_avx2
     }
@@ -278,18 +279,21 @@ impl<const S: usize> Rkn<S> {
         }
         let (new_q, new_v) = self.y_new.split_at_mut(n);
         for r in ranges {
-            let (mut q_terms, mut v_terms) = (Terms::new(), Terms::new());
-            for i in 0..S {
-                q_terms.push(h * h * tab.b[i], &self.a[i][r.clone()]);
-                v_terms.push(h * tab.b_prime[i], &self.a[i][r.clone()]);
-            }
             let nq = &mut new_q[r.clone()];
             if self.fsal {
                 // An FSAL tableau's last stage position is the new position, computed by the
                 // same operations in the same order: copy it.
                 nq.copy_from_slice(&self.q_stage[r.clone()]);
             } else {
+                let mut q_terms = Terms::new();
+                for i in 0..S {
+                    q_terms.push(h * h * tab.b[i], &self.a[i][r.clone()]);
+                }
                 sum_into(nq, Base::Plus(&q[r.clone()], h, &v[r.clone()]), &q_terms);
+            }
+            let mut v_terms = Terms::new();
+            for i in 0..S {
+                v_terms.push(h * tab.b_prime[i], &self.a[i][r.clone()]);
             }
             sum_into(&mut new_v[r.clone()], Base::Of(&v[r]), &v_terms);
         }

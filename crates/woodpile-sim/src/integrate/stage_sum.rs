@@ -38,7 +38,8 @@ impl<'a> Terms<'a> {
     }
 
     /// Adds `w·a` after the terms already there; a zero `w` adds nothing (the pass-by-pass form
-    /// skips it too).
+    /// skips it too). At most [`MAX_TERMS`] nonzero terms (`Rkn::new` checks its tableau's
+    /// stages against it).
     pub(crate) fn push(&mut self, w: f64, a: &'a [f64]) {
         if w != 0.0 {
             self.weights[self.len] = w;
@@ -58,6 +59,7 @@ pub(crate) fn sum_into(out: &mut [f64], base: Base<'_>, terms: &Terms<'_>) {
     }
 }
 
+/// [`sum_into`] with the number of terms made a constant, one copy of the loop per count.
 #[inline(always)]
 fn by_count<const PLUS: bool>(out: &mut [f64], base: (&[f64], f64, &[f64]), terms: &Terms<'_>) {
     match terms.len {

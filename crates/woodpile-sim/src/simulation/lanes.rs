@@ -43,6 +43,24 @@ pub fn simulate_batch<O: Observer>(
     );
     let mut results: Vec<Option<Result<Outcome, SimError>>> =
         scenarios.iter().map(|_| None).collect();
+    let mut waiting = first_rungs(scenarios, observers, &mut results);
+    while !waiting.is_empty() {
+        waiting = next_rungs(waiting, observers, &mut results);
+    }
+    results
+        .into_iter()
+        .map(|r| r.expect("every scene ends with a result"))
+        .collect()
+}
+
+/// The first rung of each of `scenarios` (shown to `observers[k]`): each group of four that
+/// can take lanes makes its first pairs there and judges them, any other scene runs
+/// [`simulate`] whole. Each scene's result goes to `results[k]`; returns the ladders that go on.
+fn first_rungs<'s, O: Observer>(
+    scenarios: &[&'s Scenario],
+    observers: &mut [O],
+    results: &mut [Option<Result<Outcome, SimError>>],
+) -> Vec<(usize, Ladder<'s>)> {
     let mut waiting = Vec::new();
     for start in (0..scenarios.len()).step_by(LANES) {
         let end = (start + LANES).min(scenarios.len());
@@ -73,13 +91,7 @@ pub fn simulate_batch<O: Observer>(
             }
         }
     }
-    while !waiting.is_empty() {
-        waiting = next_rungs(waiting, observers, &mut results);
-    }
-    results
-        .into_iter()
-        .map(|r| r.expect("every scene ends with a result"))
-        .collect()
+    waiting
 }
 
 /// One more rung of each of the `waiting` ladders (of scene `k`, shown to `observers[k]`):
@@ -90,6 +102,8 @@ fn next_rungs<'s, O: Observer>(
     observers: &mut [O],
     results: &mut [Option<Result<Outcome, SimError>>],
 ) -> Vec<(usize, Ladder<'s>)> {
+    // Grouped by plan alone: four ladders on different chains fill a group that then runs
+    // alone (a sweep's ladders share one chain).
     let mut open: Vec<Vec<(usize, Ladder<'s>)>> = Vec::new();
     let mut full = Vec::new();
     for (k, ladder) in waiting {
@@ -178,7 +192,9 @@ impl<'s> LaneGroup<'s> {
     }
 
     /// Four scenes to be run by `plan` (at step `dt`) together: `None` unless they run for as
-    /// long with the same samples and share a chain.
+    /// long with the same samples and share a chain. The caller has checked the rest of what
+    /// [`LaneGroup::of`] checks (`auto`, its method, a nonzero impulse, the budget): a later
+    /// rung's ladders all started in a group that passed it.
     fn with(scenarios: &'s [&'s Scenario; LANES], plan: Plan, dt: f64) -> Option<Self> {
         let first = scenarios[0];
         let alike = |s: &&Scenario| s.t_end == first.t_end && s.sample_every == first.sample_every;
@@ -325,5 +341,37 @@ mod tests {
         let other = scene(4.0, 21);
         let mixed: [&Scenario; LANES] = [&scenes[0], &scenes[1], &other, &scenes[3]];
         assert!(LaneGroup::of(&mixed).is_none());
+    }
+
+    /// The F7 fine points whose first pairs do not pass, from two groups of four, wait for
+    /// their third run at one plan and form a lane group for it (`tests/lanes.rs` holds their
+    /// results to `simulate` alone).
+    #[test]
+    fn waiting_ladders_from_two_groups_form_a_lane_group() {
+        let scene = |(eps1, eps2): (f64, f64)| {
+            let defects = [PaperDefect::linear(0, eps1, 1.0), PaperDefect::linear(20, eps2, 1.0)];
+            paper_scene(&defects, MethodChoice::Auto, tolerance(1e-5))
+        };
+        let eps = [
+            (0.59, 0.96),
+            (0.29, 0.64),
+            (0.79, 0.92),
+            (0.36, 0.46),
+            (0.57, 0.30),
+            (1.0, 0.42),
+            (0.82, 0.95),
+            (0.57, 0.61),
+        ];
+        let scenes: Vec<Scenario> = eps.into_iter().map(scene).collect();
+        let refs: Vec<&Scenario> = scenes.iter().collect();
+        let mut observers = vec![(); scenes.len()];
+        let mut results: Vec<Option<Result<Outcome, SimError>>> = vec![None; scenes.len()];
+        let waiting = first_rungs(&refs, &mut observers, &mut results);
+        let waiting_at: Vec<usize> = waiting.iter().map(|(k, _)| *k).collect();
+        assert_eq!(waiting_at, [0, 2, 4, 6, 7]);
+        let plan = waiting[0].1.next_plan();
+        assert!(waiting.iter().all(|(_, ladder)| ladder.next_plan() == plan));
+        let four: [&Scenario; LANES] = std::array::from_fn(|l| waiting[l].1.scenario());
+        assert!(LaneGroup::with(&four, plan, plan.dt().unwrap()).is_some());
     }
 }
