@@ -92,7 +92,10 @@ fn rows_of(n: usize, seed: &str, tolerances: &[f64]) -> Vec<Row> {
         (0..n).map(|_| audit_scene(&mut rng)).collect()
     };
     let n = scenes.len();
-    let ramped = scenes.iter().filter(|s| s.model.is_time_dependent()).count();
+    let ramped = scenes
+        .iter()
+        .filter(|s| s.model.is_time_dependent())
+        .count();
     println!("seed {seed}: {ramped} of {n} scenes have a ramped coupling and are left out");
     on_two_cores(&scenes, |s| measure(s, tolerances))
         .into_iter()

@@ -22,8 +22,8 @@
 use super::erkn_weights::NystromWeights;
 use super::event_correction::{ContactEvents, Quadrature};
 use super::exact_resonator::ExactResonators;
-use super::stage_sum::{sum_into, Base, Terms, MAX_TERMS};
 use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
+use super::stage_sum::{sum_into, Base, Terms, MAX_TERMS};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::{Model, Window};
 

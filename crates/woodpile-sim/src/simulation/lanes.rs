@@ -80,10 +80,11 @@ fn first_rungs<'s, O: Observer>(
         };
         for (k, pair) in (start..end).zip(pairs) {
             let observer = &mut observers[k];
-            let judged = Ladder::start(scenarios[k], plan, observer, Some(pair)).map(|mut ladder| {
-                let fine = ladder.fine_run(observer);
-                (ladder.judge(fine, observer), ladder)
-            });
+            let judged =
+                Ladder::start(scenarios[k], plan, observer, Some(pair)).map(|mut ladder| {
+                    let fine = ladder.fine_run(observer);
+                    (ladder.judge(fine, observer), ladder)
+                });
             match judged {
                 Err(e) => results[k] = Some(Err(e)),
                 Ok((Some(done), _)) => results[k] = Some(done),
@@ -119,12 +120,11 @@ fn next_rungs<'s, O: Observer>(
         }
     }
     let mut going_on = Vec::new();
-    let mut judge = |k: usize, mut ladder: Ladder<'s>, fine, observer: &O| match ladder
-        .judge(fine, observer)
-    {
-        Some(done) => results[k] = Some(done),
-        None => going_on.push((k, ladder)),
-    };
+    let mut judge =
+        |k: usize, mut ladder: Ladder<'s>, fine, observer: &O| match ladder.judge(fine, observer) {
+            Some(done) => results[k] = Some(done),
+            None => going_on.push((k, ladder)),
+        };
     for group in full {
         let group: [(usize, Ladder<'s>); LANES] = match group.try_into() {
             Ok(group) => group,
@@ -349,7 +349,10 @@ mod tests {
     #[test]
     fn waiting_ladders_from_two_groups_form_a_lane_group() {
         let scene = |(eps1, eps2): (f64, f64)| {
-            let defects = [PaperDefect::linear(0, eps1, 1.0), PaperDefect::linear(20, eps2, 1.0)];
+            let defects = [
+                PaperDefect::linear(0, eps1, 1.0),
+                PaperDefect::linear(20, eps2, 1.0),
+            ];
             paper_scene(&defects, MethodChoice::Auto, tolerance(1e-5))
         };
         let eps = [
