@@ -17,26 +17,19 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
-use woodpile_bench::on_two_cores;
+use woodpile_bench::{at_fixed_step, auto_first_step_at, on_two_cores};
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::energy::Fractions;
-use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::simulation::{accepted_estimate, auto_first_step, simulate, Scenario};
-use woodpile_sim::testing::{audit_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT};
+use woodpile_sim::integrate::Method;
+use woodpile_sim::simulation::{accepted_estimate, Scenario};
+use woodpile_sim::testing::{audit_scene, Lcg, AUDIT_REFERENCE_DT};
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;
 
 /// `scene` by `method` at the fixed step `dt`: its fractions and force evaluations, or `None`
 /// when the run blew up or lost its energy (an estimate that would then say "halve").
 fn at_step(scene: &Scenario, method: Method, dt: f64) -> Option<(Fractions, u64)> {
-    let s = Scenario {
-        method: MethodChoice::Named(method),
-        accuracy: fixed_dt(dt),
-        ..scene.clone()
-    };
-    simulate(&s, &mut ())
-        .ok()
-        .map(|o| (o.fractions, o.stats.rhs_evals))
+    at_fixed_step(scene, method, dt).map(|o| (o.fractions, o.stats.rhs_evals))
 }
 
 /// One decision of the ladder: (tolerance, the error of the run at dt, the estimate from the
@@ -53,14 +46,9 @@ fn measure(scene: &Scenario, tolerances: &[f64]) -> Vec<Row> {
     let q = Method::Rkn6Contact.observed_order();
     let mut rows = Vec::new();
     for &tol in tolerances {
-        let s = Scenario {
-            accuracy: tolerance(tol),
-            ..scene.clone()
-        };
-        let Ok(plan) = Plan::choose(&s.model, s.method, s.accuracy) else {
+        let Some(dt0) = auto_first_step_at(scene, tol) else {
             continue;
         };
-        let dt0 = auto_first_step(&s, &plan);
         for rung in 0..2 {
             let dt = dt0 / f64::from(1 << rung);
             let Some((fine, fine_evals)) = at_step(scene, Method::Rkn6Contact, dt) else {

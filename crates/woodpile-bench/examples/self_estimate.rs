@@ -21,11 +21,11 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
-use woodpile_bench::on_two_cores;
+use woodpile_bench::{at_fixed_step, auto_first_step_at, on_two_cores};
 use woodpile_pipeline::Pipeline;
-use woodpile_sim::integrate::{Method, MethodChoice, Plan};
-use woodpile_sim::simulation::{accepted_estimate, auto_first_step, simulate, Outcome, Scenario};
-use woodpile_sim::testing::{audit_scene, fixed_dt, tolerance, Lcg, AUDIT_REFERENCE_DT};
+use woodpile_sim::integrate::Method;
+use woodpile_sim::simulation::{accepted_estimate, Scenario};
+use woodpile_sim::testing::{audit_scene, Lcg, AUDIT_REFERENCE_DT};
 use woodpile_stages::sampling::sampled_sweep_scenes;
 use woodpile_stages::KINDS;
 
@@ -33,38 +33,23 @@ use woodpile_stages::KINDS;
 /// estimate, the largest estimate accepted, evaluations of the runs at dt and 2 dt).
 type Row = (f64, f64, f64, f64, f64, [u64; 2]);
 
-/// `scene` by `method` at the fixed step `dt`, or `None` when it blew up or lost its energy.
-fn at_step(scene: &Scenario, method: Method, dt: f64) -> Option<Outcome> {
-    let s = Scenario {
-        method: MethodChoice::Named(method),
-        accuracy: fixed_dt(dt),
-        ..scene.clone()
-    };
-    simulate(&s, &mut ()).ok()
-}
-
 /// The first rung of `auto`'s ladder on `scene` at each of `tolerances`.
 fn measure(scene: &Scenario, tolerances: &[f64]) -> Vec<Row> {
     if scene.model.is_time_dependent() {
         return Vec::new(); // A ramped coupling: no conserved energy, no drift to judge by.
     }
-    let Some(reference) = at_step(scene, Method::Rk4Contact, AUDIT_REFERENCE_DT) else {
+    let Some(reference) = at_fixed_step(scene, Method::Rk4Contact, AUDIT_REFERENCE_DT) else {
         return Vec::new();
     };
     let q = Method::Rkn6Contact.observed_order();
     let mut rows = Vec::new();
     for &tol in tolerances {
-        let s = Scenario {
-            accuracy: tolerance(tol),
-            ..scene.clone()
-        };
-        let Ok(plan) = Plan::choose(&s.model, s.method, s.accuracy) else {
+        let Some(dt) = auto_first_step_at(scene, tol) else {
             continue;
         };
-        let dt = auto_first_step(&s, &plan);
         let (Some(fine), Some(coarse)) = (
-            at_step(scene, Method::Rkn6Contact, dt),
-            at_step(scene, Method::Rkn6Contact, 2.0 * dt),
+            at_fixed_step(scene, Method::Rkn6Contact, dt),
+            at_fixed_step(scene, Method::Rkn6Contact, 2.0 * dt),
         ) else {
             continue;
         };

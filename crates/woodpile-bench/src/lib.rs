@@ -7,10 +7,10 @@ pub mod paper;
 pub mod sweeps;
 
 use woodpile_sim::integrate::{
-    drive, Accuracy, DriveConfig, Method, MethodChoice, Stats, StepControl, Stepper,
+    drive, Accuracy, DriveConfig, Method, MethodChoice, Plan, Stats, StepControl, Stepper,
 };
-use woodpile_sim::simulation::{simulate, Outcome, Scenario};
-use woodpile_sim::testing::{fixed_dt, paper_scene, PaperDefect};
+use woodpile_sim::simulation::{auto_first_step, simulate, Outcome, Scenario};
+use woodpile_sim::testing::{fixed_dt, paper_scene, tolerance, PaperDefect};
 use woodpile_sim::SimError;
 
 /// The standard scene integrated by `method` with `accuracy`.
@@ -26,6 +26,28 @@ pub fn fixed(method: Method, dt: f64) -> Scenario {
 /// Simulates `scenario` without observers.
 pub fn run(scenario: &Scenario) -> Result<Outcome, SimError> {
     simulate(scenario, &mut ())
+}
+
+/// `scene` by `method` at the fixed step `dt`, or `None` when the run blew up or lost its
+/// energy (an estimate would then say "halve"): the experiments on `auto`'s estimates.
+pub fn at_fixed_step(scene: &Scenario, method: Method, dt: f64) -> Option<Outcome> {
+    let s = Scenario {
+        method: MethodChoice::Named(method),
+        accuracy: fixed_dt(dt),
+        ..scene.clone()
+    };
+    run(&s).ok()
+}
+
+/// The first step of `auto`'s ladder on `scene` at tolerance `tol` (`None` when `auto` has
+/// no plan for it).
+pub fn auto_first_step_at(scene: &Scenario, tol: f64) -> Option<f64> {
+    let s = Scenario {
+        accuracy: tolerance(tol),
+        ..scene.clone()
+    };
+    let plan = Plan::choose(&s.model, s.method, s.accuracy).ok()?;
+    Some(auto_first_step(&s, &plan))
 }
 
 /// `scene` from its impulse to its end by `stepper` at the fixed step `dt`, on the active

@@ -15,7 +15,10 @@ use crate::model::{Boundary, Coupling, Model, Resonator};
 use crate::simulation::{simulate, Scenario};
 
 mod lanes;
-pub use lanes::{by_lanes_and_alone, lane_neighbours, with_resonator_masses_scaled, RecordedRun};
+pub use lanes::{
+    by_lanes_and_alone, lane_neighbours, with_resonator_masses_scaled, RecordedRun,
+    THIRD_RUN_POINTS,
+};
 
 /// Half-width N of the paper's chains (sites -N..N).
 pub const PAPER_N: usize = 100;

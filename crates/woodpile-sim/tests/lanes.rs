@@ -14,6 +14,7 @@ use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::simulation::{auto_first_step, Scenario};
 use woodpile_sim::testing::{
     by_lanes_and_alone, fixed_dt, lane_neighbours, paper_scene, tolerance, PaperDefect,
+    THIRD_RUN_POINTS,
 };
 use woodpile_sim::SimError;
 
@@ -74,17 +75,7 @@ fn light_resonators_in_lanes_equal_their_scalar_runs() {
 /// groups, five of which need a third run, each equal to its scalar `auto` run.
 #[test]
 fn later_rungs_pooled_across_groups_equal_their_scalar_runs() {
-    let eps = [
-        (0.59, 0.96),
-        (0.29, 0.64),
-        (0.79, 0.92),
-        (0.36, 0.46),
-        (0.57, 0.30),
-        (1.0, 0.42),
-        (0.82, 0.95),
-        (0.57, 0.61),
-    ];
-    let scenes: Vec<Scenario> = eps.iter().map(|&e| f7_scene(e)).collect();
+    let scenes: Vec<Scenario> = THIRD_RUN_POINTS.into_iter().map(f7_scene).collect();
     let first = first_steps(&scenes);
     let mut later_rungs = 0;
     for (k, (lanes, alone)) in by_lanes_and_alone(&scenes).into_iter().enumerate() {

@@ -323,7 +323,7 @@ impl<O: Observer> Observer for FineObserver<'_, O> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{paper_scene, tolerance, PaperDefect};
+    use crate::testing::{paper_scene, tolerance, PaperDefect, THIRD_RUN_POINTS};
 
     /// Neighbouring F7 points take lanes; a point of another chain keeps its group out.
     #[test]
@@ -355,17 +355,7 @@ mod tests {
             ];
             paper_scene(&defects, MethodChoice::Auto, tolerance(1e-5))
         };
-        let eps = [
-            (0.59, 0.96),
-            (0.29, 0.64),
-            (0.79, 0.92),
-            (0.36, 0.46),
-            (0.57, 0.30),
-            (1.0, 0.42),
-            (0.82, 0.95),
-            (0.57, 0.61),
-        ];
-        let scenes: Vec<Scenario> = eps.into_iter().map(scene).collect();
+        let scenes: Vec<Scenario> = THIRD_RUN_POINTS.into_iter().map(scene).collect();
         let refs: Vec<&Scenario> = scenes.iter().collect();
         let mut observers = vec![(); scenes.len()];
         let mut results: Vec<Option<Result<Outcome, SimError>>> = vec![None; scenes.len()];

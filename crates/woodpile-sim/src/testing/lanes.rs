@@ -6,6 +6,20 @@ use crate::model::{Model, Resonator};
 use crate::observe::FractionSeries;
 use crate::simulation::{simulate, Scenario};
 
+/// Eight F7 fine points (ε1, ε2; defects at 0 and 20, tolerance 1e-5) in two groups of four,
+/// the five at 0, 2, 4, 6 and 7 needing a third run: ladders that wait for a later rung
+/// together, across groups.
+pub const THIRD_RUN_POINTS: [(f64, f64); 8] = [
+    (0.59, 0.96),
+    (0.29, 0.64),
+    (0.79, 0.92),
+    (0.36, 0.46),
+    (0.57, 0.30),
+    (1.0, 0.42),
+    (0.82, 0.95),
+    (0.57, 0.61),
+];
+
 /// Four neighbouring points of a sweep around `base`, as a sweep hands them to the SIMD lanes
 /// (`crate::simulation::simulate_batch`): the impulse's site two apart from point to point
 /// (so that on a chain of alternating masses the struck sites have the same mass, and the
