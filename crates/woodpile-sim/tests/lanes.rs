@@ -44,6 +44,15 @@ fn first_steps(scenes: &[Scenario]) -> Vec<(Method, f64)> {
         .collect()
 }
 
+/// The first four of `scenes` plan `method` at one first step, as a lane group must.
+fn assert_first_group_plans_alike(scenes: &[Scenario], method: Method) {
+    let first = first_steps(&scenes[..LANES]);
+    assert!(
+        first.iter().all(|&f| f == (method, first[0].1)),
+        "{first:?}"
+    );
+}
+
 /// Eight F7 fine points (light resonators, run by `erkn6-contact`) in two lane groups, each
 /// equal to its scalar `auto` run: the exact pair steps and their fast-mode corrections per
 /// lane.
@@ -60,13 +69,7 @@ fn light_resonators_in_lanes_equal_their_scalar_runs() {
         (0.25, 1.0),
     ];
     let scenes: Vec<Scenario> = eps.iter().map(|&e| f7_scene(e)).collect();
-    let first = first_steps(&scenes[..LANES]);
-    assert!(
-        first
-            .iter()
-            .all(|&f| f == (Method::Erkn6Contact, first[0].1)),
-        "{first:?}"
-    );
+    assert_first_group_plans_alike(&scenes, Method::Erkn6Contact);
     batched_and_alone(&scenes);
 }
 
@@ -107,13 +110,7 @@ fn sweep_points_in_lanes_equal_their_scalar_runs() {
     let models: Vec<&Model> = scenes.iter().map(|s| &s.model).collect();
     assert!(shares_a_chain(&models[..LANES].try_into().unwrap()));
     // The first group takes lanes: one method and one first step.
-    let first = first_steps(&scenes[..LANES]);
-    assert!(
-        first
-            .iter()
-            .all(|&f| f == (Method::Rkn6Contact, first[0].1)),
-        "{first:?}"
-    );
+    assert_first_group_plans_alike(&scenes, Method::Rkn6Contact);
     batched_and_alone(&scenes);
 }
 
