@@ -75,7 +75,7 @@ impl Model {
             acc: &mut [f64],
             window: Window,
             bond_force: Option<&mut [f64]>,
-        ) => accelerations_impl, accelerations_avx2
+        ) => accelerations_impl, accelerations_avx2, accelerations_avx512
     }
 
     #[inline(always)]

@@ -327,14 +327,14 @@ pub(super) fn check_finite_in(
     ranges: &[std::ops::Range<usize>],
 ) -> Result<(), SimError> {
     #[cfg(target_arch = "x86_64")]
-    if crate::simd::avx2() {
-        // SAFETY: `avx2()` is true only when the CPU has AVX2 and FMA.
+    if crate::simd::tier() >= crate::simd::Tier::Avx2 {
+        // SAFETY: `tier()` is AVX2 or above only when the CPU has AVX2 and FMA.
         return unsafe { check_finite_avx2(y, t, ranges) };
     }
     check_finite_body(y, t, ranges)
 }
 
-/// [`check_finite_in`] compiled with AVX2 (`crate::simd`).
+/// [`check_finite_in`] compiled with AVX2 (`crate::simd`), which the AVX-512 tier runs too.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn check_finite_avx2(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {

@@ -374,7 +374,7 @@ impl<const S: usize> ContactEvents<S> {
         /// Lists in `self.changed` every bond of `window` whose contact opened or closed during
         /// the step, as (bond, left site, right site) with `None` for a wall; `new_q` are the
         /// end positions.
-        fn scan[&mut self](model: &Model, new_q: &[f64], window: Window) => scan_body, scan_avx2
+        fn scan[&mut self](model: &Model, new_q: &[f64], window: Window) => scan_body, scan_avx2, scan_avx512
     }
 
     #[inline(always)]

@@ -226,7 +226,7 @@ impl<const S: usize> Rkn<S> {
         /// summed in one pass per range ([`super::stage_sum`]), which vectorises: in its AVX2
         /// copy where the CPU has one (`crate::simd`).
         fn raw_step[&mut self](model: &Model, t: f64, y: &[f64], h: f64, window: Window)
-            => raw_step_body, raw_step_avx2
+            => raw_step_body, raw_step_avx2, raw_step_avx512
     }
 
     #[inline(always)]

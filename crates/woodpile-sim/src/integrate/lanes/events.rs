@@ -105,7 +105,7 @@ impl LaneEvents {
             stage_force: &[Vec<Lanes>; S],
             window: Window,
             live_mask: u32,
-        ) => scan_body, scan_avx2
+        ) => scan_body, scan_avx2, scan_avx512
     }
 
     #[inline(always)]

@@ -127,7 +127,7 @@ impl LaneRkn6 {
             h: f64,
             window: Window,
             live: [bool; LANES],
-        ) => raw_step_body, raw_step_avx2
+        ) => raw_step_body, raw_step_avx2, raw_step_avx512
     }
 
     #[inline(always)]
