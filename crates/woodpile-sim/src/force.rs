@@ -68,7 +68,7 @@ impl Model {
     }
 
     crate::simd::dispatched! {
-        /// The force loop, in its AVX2 copy where the CPU has one (`crate::simd`).
+        /// The force loop, in its AVX2 or AVX-512 copy where the CPU has one (`crate::simd`).
         fn accelerations_dispatched[&self](
             t: f64,
             q: &[f64],

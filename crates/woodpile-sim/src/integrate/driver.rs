@@ -345,6 +345,10 @@ fn check_finite_avx2(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Re
 #[allow(clippy::eq_op)] // x - x is the point: it is NaN exactly when x is not finite
 fn check_finite_body(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Result<(), SimError> {
     let mut lanes = [0.0f64; 8];
+    // The tails have a sum of their own: added into `lanes`, they were compiled as a masked
+    // store to the stack read back at once, a stall (the check took 4.5% of the paper
+    // sample's time, 3.2% without it; `perf`).
+    let mut tails = 0.0f64;
     for range in ranges {
         let part = &y[range.clone()];
         let chunks = part.chunks_exact(8);
@@ -354,11 +358,11 @@ fn check_finite_body(y: &[f64], t: f64, ranges: &[std::ops::Range<usize>]) -> Re
                 *lane += x - x;
             }
         }
-        for (lane, &x) in lanes.iter_mut().zip(tail) {
-            *lane += x - x;
+        for &x in tail {
+            tails += x - x;
         }
     }
-    if lanes.iter().sum::<f64>() == 0.0 {
+    if lanes.iter().sum::<f64>() + tails == 0.0 {
         return Ok(());
     }
     let site = y.iter().position(|x| !x.is_finite()).unwrap_or(0);

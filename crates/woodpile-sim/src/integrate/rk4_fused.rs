@@ -155,9 +155,15 @@ impl Rk4Fused {
         );
     }
 
-    /// RK4's four stages from `y` over `span`, the new state (uncorrected) left in the
-    /// scratch's `y_new`.
-    fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan) {
+    crate::simd::dispatched! {
+        /// RK4's four stages from `y` over `span`, the new state (uncorrected) left in the
+        /// scratch's `y_new`; in its AVX2 or AVX-512 copy where the CPU has one (`crate::simd`).
+        fn stages[&mut self](model: &Model, y: &[f64], span: StepSpan)
+            => stages_body, stages_avx2, stages_avx512
+    }
+
+    #[inline(always)]
+    fn stages_body(&mut self, model: &Model, y: &[f64], span: StepSpan) {
         let StepSpan { t, h, window } = span;
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);

@@ -224,7 +224,7 @@ impl<const S: usize> Rkn<S> {
         /// One step of the tableau from `y` into `self.y_new` (uncorrected), recording the
         /// stage forces when contacts are tracked. Each stage position and the new state are
         /// summed in one pass per range ([`super::stage_sum`]), which vectorises: in its AVX2
-        /// copy where the CPU has one (`crate::simd`).
+        /// or AVX-512 copy where the CPU has one (`crate::simd`).
         fn raw_step[&mut self](model: &Model, t: f64, y: &[f64], h: f64, window: Window)
             => raw_step_body, raw_step_avx2, raw_step_avx512
     }

@@ -76,6 +76,29 @@ impl Stepper for Rkn4 {
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        self.three_stage_step(model, y, span);
+        StepOutcome::Accepted { h_next: span.h }
+    }
+
+    fn reach(&self) -> usize {
+        3
+    }
+
+    fn rhs_evals(&self) -> u64 {
+        self.scratch.evals
+    }
+}
+
+impl Rkn4 {
+    crate::simd::dispatched! {
+        /// One step over `span`, corrected for contact events when they are kept; in its AVX2
+        /// or AVX-512 copy where the CPU has one (`crate::simd`).
+        fn three_stage_step[&mut self](model: &Model, y: &mut [f64], span: StepSpan)
+            => three_stage_step_body, three_stage_step_avx2, three_stage_step_avx512
+    }
+
+    #[inline(always)]
+    fn three_stage_step_body(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
         let StepSpan { t, h, window } = span;
         let n = model.n_dof();
         let ranges = window.dof_ranges(model);
@@ -138,14 +161,5 @@ impl Stepper for Rkn4 {
             h,
             window,
         );
-        StepOutcome::Accepted { h_next: h }
-    }
-
-    fn reach(&self) -> usize {
-        3
-    }
-
-    fn rhs_evals(&self) -> u64 {
-        self.scratch.evals
     }
 }

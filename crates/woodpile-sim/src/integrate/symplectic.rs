@@ -86,6 +86,28 @@ impl Stepper for SymplecticStepper {
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+        self.composed_step(model, y, span)
+    }
+
+    fn reach(&self) -> usize {
+        self.composition.gammas.len() + 1
+    }
+
+    fn rhs_evals(&self) -> u64 {
+        self.evals
+    }
+}
+
+impl SymplecticStepper {
+    crate::simd::dispatched! {
+        /// One step: the composition's kick-drift-kick substeps over `span`'s window, in its
+        /// AVX2 or AVX-512 copy where the CPU has one (`crate::simd`).
+        fn composed_step[&mut self](model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome
+            => composed_step_body, composed_step_avx2, composed_step_avx512
+    }
+
+    #[inline(always)]
+    fn composed_step_body(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
         let StepSpan { t, h, window } = span;
         let n_dof = model.n_dof();
         let (q, v) = y.split_at_mut(n_dof);
@@ -118,14 +140,6 @@ impl Stepper for SymplecticStepper {
         // sum is irrelevant to a cache keyed by that value.
         self.cached_at = Some(t + h);
         StepOutcome::Accepted { h_next: h }
-    }
-
-    fn reach(&self) -> usize {
-        self.composition.gammas.len() + 1
-    }
-
-    fn rhs_evals(&self) -> u64 {
-        self.evals
     }
 }
 

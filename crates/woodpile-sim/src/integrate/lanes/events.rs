@@ -97,8 +97,8 @@ impl LaneEvents {
     crate::simd::dispatched! {
         /// Lists in `self.changed` every bond of `window` whose contact opened or closed during
         /// the step in some lane of `live_mask`, as the scalar scan does per lane (a bond outside a
-        /// lane's own window is at rest there, and never changes). In its AVX2 copy where the CPU has
-        /// one (`crate::simd`).
+        /// lane's own window is at rest there, and never changes). In its AVX2 or AVX-512 copy
+        /// where the CPU has one (`crate::simd`).
         fn scan[&mut self](
             model: &Model,
             new_q: &[Lanes],

@@ -120,7 +120,7 @@ impl LaneRkn6 {
 
     crate::simd::dispatched! {
         /// The uncorrected step into `new_q`, `new_v`, recording every stage's bond forces, in
-        /// its AVX2 copy where the CPU has one (`crate::simd`).
+        /// its AVX2 or AVX-512 copy where the CPU has one (`crate::simd`).
         fn raw_step[&mut self](
             q: &[Lanes],
             v: &[Lanes],
