@@ -5,6 +5,7 @@
 //! ```toml
 //! kind = "workprecision"
 //! repeats = 3                      # wall time is the best of this many runs
+//! threads = 1                      # optional: runs timed at once (default: one per physical core)
 //! reference_tolerance = 1e-13      # the reference: dop853 at this tolerance
 //! [[scene]]
 //! name = "one defect, eps = 10"
@@ -17,10 +18,12 @@
 //! tolerance = [1e-6, 1e-8, 1e-10]       # adaptive ones and `auto` take tolerance
 //! ```
 //!
-//! One row per scene, method and setting. Runs are sequential (one thread) so that wall times
-//! are comparable; a run that fails (blow-up, drift beyond its bound) is a row with its reason in
-//! `failure` and null numbers. The manifest notes the reference values, the machine (CPU model
-//! and cores) and the runs counted. Wall times differ between machines and runs: `make check`
+//! One row per scene, method and setting. Each setting's runs are made one after another on one
+//! thread, and as many settings are timed at once as there are physical cores (`threads = N`
+//! sets it; `threads = 1` times each run alone), so that no two timed runs share a core; a run
+//! that fails (blow-up, drift beyond its bound) is a row with its reason in `failure` and null
+//! numbers. The manifest notes the reference values, the machine (CPU model and cores), the
+//! threads that timed and the runs counted. Wall times differ between machines and runs: `make check`
 //! compares every other column exactly and the `wall_ms` columns not at all.
 
 // Comparisons are written `!(x > 0.0)` on purpose: a NaN must fail them.
@@ -29,6 +32,7 @@
 use std::path::Path;
 use std::time::Instant;
 
+use rayon::prelude::*;
 use serde_json::json;
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
@@ -45,6 +49,8 @@ use woodpile_pipeline::Output;
 pub struct WorkPrecision {
     /// Runs per setting; the best wall time is kept.
     pub repeats: usize,
+    /// Runs timed at once; `None`: one per physical core ([`timing_threads`]).
+    pub threads: Option<usize>,
     /// Tolerance of the DOP853 reference.
     pub reference_tolerance: f64,
     /// The scenes, named.
@@ -145,6 +151,12 @@ impl WorkPrecision {
         if !(1..=100).contains(&repeats) {
             return Err(fields.error("repeats", "expected 1 to 100"));
         }
+        let threads = match fields.optional::<i64>("threads")? {
+            Some(n) if !(1..=1024).contains(&n) => {
+                return Err(fields.error("threads", "expected 1 to 1024"))
+            }
+            n => n.map(|n| n as usize),
+        };
         let reference_tolerance = fields
             .optional::<f64>("reference_tolerance")?
             .unwrap_or(1e-13);
@@ -161,6 +173,7 @@ impl WorkPrecision {
         }
         Ok(WorkPrecision {
             repeats: repeats as usize,
+            threads,
             reference_tolerance,
             scenes,
             settings,
@@ -168,60 +181,133 @@ impl WorkPrecision {
     }
 
     pub(crate) fn compute(&self, stage: &str) -> Result<Output> {
-        let mut rows = Vec::new();
-        let mut references = Vec::new();
-        let mut simulated = 0;
-        for (index, (name, scene)) in self.scenes.iter().enumerate() {
-            let (e_ref, ref_drift) =
-                reference(&scene.scenario, self.reference_tolerance).map_err(|e| {
-                    PipelineError::stage(stage, format!("scene `{name}`: reference failed: {e}"))
-                })?;
-            simulated += 1;
-            references.push(
-                json!({"scene": index, "name": name, "E_tr": e_ref, "energy_drift": ref_drift}),
-            );
-            for setting in &self.settings {
-                let mut scenario = scene.scenario.clone();
-                scenario.method = setting.choice;
-                scenario.accuracy = setting.accuracy;
-                let mut best = f64::INFINITY;
-                let mut outcome: Option<std::result::Result<Outcome, String>> = None;
-                for _ in 0..self.repeats {
-                    let t0 = Instant::now();
-                    simulated += 1;
-                    let result = measured_run(&scenario).map_err(|e| e.to_string());
-                    best = best.min(t0.elapsed().as_secs_f64() * 1e3);
-                    let failed = result.is_err();
-                    outcome = Some(result);
-                    if failed {
-                        break;
-                    }
+        let threads = self.threads.unwrap_or_else(timing_threads);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .map_err(|e| PipelineError::stage(stage, format!("no timing threads: {e}")))?;
+        let references = pool.install(|| {
+            self.scenes
+                .par_iter()
+                .map(|(name, scene)| {
+                    reference(&scene.scenario, self.reference_tolerance).map_err(|e| {
+                        PipelineError::stage(
+                            stage,
+                            format!("scene `{name}`: reference failed: {e}"),
+                        )
+                    })
+                })
+                .collect::<Result<Vec<_>>>()
+        })?;
+        let jobs: Vec<(usize, &Setting)> = (0..self.scenes.len())
+            .flat_map(|index| self.settings.iter().map(move |setting| (index, setting)))
+            .collect();
+        let timed: Vec<(Timed, &Setting, usize)> = pool.install(|| {
+            jobs.par_iter()
+                .map(|&(index, setting)| (self.timed(index, setting), setting, index))
+                .collect()
+        });
+        let simulated = self.scenes.len() + timed.iter().map(|(t, _, _)| t.runs).sum::<usize>();
+        let rows: Vec<Run> = timed
+            .into_iter()
+            .map(|(timed, setting, index)| {
+                let scene = &self.scenes[index];
+                Run {
+                    scene: index,
+                    name: &scene.0,
+                    setting,
+                    e_ref: references[index].0,
+                    wall_ms: timed.best_ms,
+                    outcome: timed.outcome,
+                    conserves_energy: !scene.1.scenario.model.is_time_dependent(),
                 }
-                if let Some(outcome) = outcome {
-                    rows.push(Run {
-                        scene: index,
-                        name,
-                        setting,
-                        e_ref,
-                        wall_ms: best,
-                        outcome,
-                        conserves_energy: !scenario.model.is_time_dependent(),
-                    });
-                }
-            }
-        }
+            })
+            .collect();
+        let references: Vec<_> = references
+            .iter()
+            .zip(&self.scenes)
+            .enumerate()
+            .map(|(index, ((e_ref, drift), (name, _)))| {
+                json!({"scene": index, "name": name, "E_tr": e_ref, "energy_drift": drift})
+            })
+            .collect();
         Ok(Output::table(
             rows_frame(&rows)?,
             json!({
                 "reference": {"method": Method::Dop853.name(), "tolerance": self.reference_tolerance},
                 "references": references,
                 "repeats": self.repeats,
+                "timing_threads": threads,
                 "machine": machine(),
                 "runs": self.scenes.len() * self.settings.len() * self.repeats,
             }),
         )
         .with_simulated(simulated))
     }
+
+    /// Scene `index` by `setting`, [`WorkPrecision::repeats`] times on this thread (fewer if
+    /// it fails): its best wall time and its last outcome.
+    fn timed(&self, index: usize, setting: &Setting) -> Timed {
+        let mut scenario = self.scenes[index].1.scenario.clone();
+        scenario.method = setting.choice;
+        scenario.accuracy = setting.accuracy;
+        let mut best_ms = f64::INFINITY;
+        let mut runs = 0;
+        loop {
+            let t0 = Instant::now();
+            runs += 1;
+            let outcome = measured_run(&scenario).map_err(|e| e.to_string());
+            best_ms = best_ms.min(t0.elapsed().as_secs_f64() * 1e3);
+            if outcome.is_err() || runs == self.repeats {
+                return Timed {
+                    best_ms,
+                    runs,
+                    outcome,
+                };
+            }
+        }
+    }
+}
+
+/// What [`WorkPrecision::timed`] measured of one setting.
+struct Timed {
+    /// Best wall time of the runs, in ms.
+    best_ms: f64,
+    /// Runs made.
+    runs: usize,
+    /// The last run's outcome.
+    outcome: std::result::Result<Outcome, String>,
+}
+
+/// How many runs are timed at once when the stage does not say: one per physical core, so that
+/// no two share a core's execution units, as two hardware threads of one core would (Linux's
+/// `thread_siblings_list`; one run at a time where the topology is unknown). On this project's
+/// 2-core machine two runs at once time within 1.5% of one alone, inside the 4.5% that two
+/// runs alone differ by (docs/performance.md, "The whole paper from a cold cache").
+fn timing_threads() -> usize {
+    let logical = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let siblings =
+        std::fs::read_to_string("/sys/devices/system/cpu/cpu0/topology/thread_siblings_list")
+            .ok()
+            .and_then(|list| cpus_in_list(&list));
+    match siblings {
+        Some(per_core) if per_core > 0 => (logical / per_core).max(1),
+        _ => 1,
+    }
+}
+
+/// The number of CPUs in a Linux CPU list such as `0-3,8`; `None` if it does not parse.
+fn cpus_in_list(list: &str) -> Option<usize> {
+    list.trim()
+        .split(',')
+        .map(|part| match part.split_once('-') {
+            Some((lo, hi)) => {
+                let (lo, hi) = (lo.parse::<usize>().ok()?, hi.parse::<usize>().ok()?);
+                (hi >= lo).then_some(hi - lo + 1)
+            }
+            None => part.parse::<usize>().ok().map(|_| 1),
+        })
+        .sum()
 }
 
 /// E_tr (and the energy drift) of DOP853 at `tolerance`. At 1e-13 round-off alone drifts the
@@ -334,5 +420,19 @@ impl Kind for WorkPrecision {
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         self.compute(ctx.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cpus_in_list;
+
+    #[test]
+    fn cpu_lists_count_their_cpus() {
+        assert_eq!(cpus_in_list("0\n"), Some(1));
+        assert_eq!(cpus_in_list("0,8"), Some(2));
+        assert_eq!(cpus_in_list("0-3,8,10-11"), Some(7));
+        assert_eq!(cpus_in_list("3-1"), None);
+        assert_eq!(cpus_in_list("zero"), None);
     }
 }
