@@ -49,6 +49,7 @@
 
 use std::path::{Path, PathBuf};
 
+use rayon::prelude::*;
 use serde_json::json;
 use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64};
 
@@ -134,8 +135,16 @@ impl Design {
             events,
         };
         let (mut rows, starts) = self.search(at)?;
-        for (label, start, score) in starts {
-            rows.extend(self.refine_from(stage, label, &start, score, store, events)?);
+        // Each refinement is a sequence of single evaluations; the two (from the evolution's
+        // best and from the random search's) are independent, so they run side by side.
+        let refined: Vec<Result<Vec<Evaluated>>> = starts
+            .par_iter()
+            .map(|(label, start, score)| {
+                self.refine_from(stage, *label, start, *score, store, events)
+            })
+            .collect();
+        for refinement in refined {
+            rows.extend(refinement?);
         }
         // The best design of the searches; the robustness study is around it.
         let best = rows
