@@ -10,6 +10,8 @@
 //! Arguments: the tolerance every scene runs at, the scenes drawn from each of the paper's
 //! sweeps (seed 2026, as `woodpile-bench --paper N`), and the passes.
 
+#![allow(clippy::print_stdout)]
+
 use std::time::Instant;
 
 use woodpile_bench::paper::paper_sample;
