@@ -282,12 +282,20 @@ fn endless_runs_and_standing_impulses_exit_2_naming_the_key() {
 
 /// The binary carries three copies of its hot loops, for AVX-512, for AVX2 and for the x86-64
 /// baseline, and picks the best the CPU has at run time (`WOODPILE_SIMD` caps it): every copy
-/// this CPU runs gives the same bits, on a scene with contact events, two resonators and
-/// `auto`'s verification runs.
+/// this CPU runs gives the same bits, on a scene with contact events and two resonators, by
+/// `auto` (its verification runs) and by each fixed-step method with its own stage sums.
 #[test]
 fn every_simd_path_gives_the_same_bits() {
-    let path = scene_file(
-        r#"
+    let runs = [
+        "method = \"auto\"\ntolerance = 1e-7",
+        "method = \"rk4\"\ndt = 0.02",
+        "method = \"rk4-contact\"\ndt = 0.05",
+        "method = \"rkn4-contact\"\ndt = 0.05",
+        "method = \"yoshida4\"\ndt = 0.02",
+    ];
+    for method in runs {
+        let path = scene_file(&format!(
+            r#"
 [chain]
 n = 60
 [impulse]
@@ -295,8 +303,7 @@ site = -20
 velocity = 1.3
 [run]
 t_end = 60.0
-method = "auto"
-tolerance = 1e-7
+{method}
 [[defect]]
 site = 0
 eps = 0.67
@@ -304,22 +311,23 @@ eps = 0.67
 site = 12
 eps = 3.0
 p = 3
-"#,
-    );
-    let run = |simd: &str| {
-        let out = simulate_command(&path)
-            .env("WOODPILE_SIMD", simd)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        assert!(out.status.success(), "{stderr}");
-        let mut json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        json.as_object_mut().unwrap().remove("wall_s");
-        json
-    };
-    let best = run("auto");
-    assert_eq!(run("avx2"), best);
-    assert_eq!(run("baseline"), best);
+"#
+        ));
+        let run = |simd: &str| {
+            let out = simulate_command(&path)
+                .env("WOODPILE_SIMD", simd)
+                .output()
+                .unwrap();
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "{method}, {simd}: {stderr}");
+            let mut json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+            json.as_object_mut().unwrap().remove("wall_s");
+            json
+        };
+        let best = run("auto");
+        assert_eq!(run("avx2"), best, "{method}");
+        assert_eq!(run("baseline"), best, "{method}");
+    }
 }
 
 /// `--series` and `--field` never rename over what is not theirs to replace: a FIFO, a device,

@@ -1,8 +1,9 @@
 //! Run-time CPU dispatch: one binary runs on every x86-64 and still uses the widest vectors
 //! the CPU has. The workspace is compiled for the x86-64 baseline (SSE2); the few loops where
-//! the time goes (the force loop, the stage sums, the contact scans, the finite check:
-//! docs/performance.md, "Where a scene's time goes") are compiled twice more, with AVX2 and
-//! FMA and with AVX-512, and [`tier`] picks the copy at each call.
+//! the time goes (the force loop, the stage sums, the contact scans: docs/performance.md,
+//! "Where a scene's time goes") are compiled twice more, with AVX2 and FMA and with AVX-512,
+//! and [`tier`] picks the copy at each call; the finite check has an AVX2 copy, which the
+//! AVX-512 tier runs too.
 //!
 //! Every copy computes the same bits: every operation is element-wise, Rust never fuses a
 //! multiply and an add on its own, and no loop is reassociated. `WOODPILE_SIMD=baseline` or

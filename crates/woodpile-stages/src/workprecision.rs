@@ -20,7 +20,7 @@
 //!
 //! One row per scene, method and setting. Each setting's runs are made one after another on one
 //! thread, and as many settings are timed at once as there are physical cores (`threads = N`
-//! sets it; `threads = 1` times each run alone), so that no two timed runs share a core; a run
+//! sets it; `threads = 1` times each run alone), so that timed runs need not share a core; a run
 //! that fails (blow-up, drift beyond its bound) is a row with its reason in `failure` and null
 //! numbers. The manifest notes the reference values, the machine (CPU model and cores), the
 //! threads that timed and the runs counted. Wall times differ between machines and runs: `make check`
@@ -181,12 +181,16 @@ impl WorkPrecision {
     }
 
     pub(crate) fn compute(&self, stage: &str) -> Result<Output> {
-        let threads = self.threads.unwrap_or_else(timing_threads);
+        // The user's thread limit (`RAYON_NUM_THREADS`, `--threads`) caps the default.
+        let threads = self
+            .threads
+            .unwrap_or_else(|| timing_threads().min(rayon::current_num_threads()));
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .map_err(|e| PipelineError::stage(stage, format!("no timing threads: {e}")))?;
-        let references = pool.install(|| {
+        // Collected whole, so that the first failure in scene order is the one reported.
+        let references: Vec<Result<_>> = pool.install(|| {
             self.scenes
                 .par_iter()
                 .map(|(name, scene)| {
@@ -197,8 +201,9 @@ impl WorkPrecision {
                         )
                     })
                 })
-                .collect::<Result<Vec<_>>>()
-        })?;
+                .collect()
+        });
+        let references = references.into_iter().collect::<Result<Vec<_>>>()?;
         let jobs: Vec<(usize, &Setting)> = (0..self.scenes.len())
             .flat_map(|index| self.settings.iter().map(move |setting| (index, setting)))
             .collect();
@@ -280,8 +285,9 @@ struct Timed {
 }
 
 /// How many runs are timed at once when the stage does not say: one per physical core, so that
-/// no two share a core's execution units, as two hardware threads of one core would (Linux's
-/// `thread_siblings_list`; one run at a time where the topology is unknown). On this project's
+/// the runs need not share a core's execution units, as two hardware threads of one core do
+/// (Linux's `thread_siblings_list`; one run at a time where the topology is unknown). The
+/// threads are not pinned: the scheduler spreads them over idle cores. On this project's
 /// 2-core machine two runs at once time within 1.5% of one alone, inside the 4.5% that two
 /// runs alone differ by (docs/performance.md, "The whole paper from a cold cache").
 fn timing_threads() -> usize {

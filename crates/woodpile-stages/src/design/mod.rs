@@ -157,7 +157,14 @@ impl Design {
         }
         rows.extend(self.robustness_around(at, &best)?);
         let (best, verified, best_file) = self.verify_and_write(ctx, at, &mut rows, best)?;
-        let simulated = rows.iter().filter(|r| r.simulated).count();
+        // Distinct points: the two refinements, side by side, may both simulate a point that
+        // run one after the other they would have simulated once.
+        let simulated = rows
+            .iter()
+            .filter(|r| r.simulated)
+            .map(|r| r.key.as_str())
+            .collect::<std::collections::HashSet<_>>()
+            .len();
         Ok(Output::table(
             self.frame(&rows)?,
             self.summary(&rows, &best, &verified, &best_file),
