@@ -267,3 +267,35 @@ fn a_stage_scene_file_stays_inside_the_project_and_is_never_echoed() {
     let e = p.run(&[]).unwrap_err().to_string();
     assert!(e.contains("line 1, column") && !e.contains("abc123"), "{e}");
 }
+
+/// A work-precision stage's timing threads are 1 to 1024: anything else is refused at load,
+/// naming the file and the key.
+#[test]
+fn work_precision_threads_out_of_range_are_refused() {
+    let stage = |threads: &str| {
+        format!(
+            r#"
+kind = "workprecision"
+threads = {threads}
+[[scene]]
+name = "short"
+chain = {{ n = 12 }}
+impulse = {{ site = -6 }}
+run = {{ t_end = 1.0 }}
+[[method]]
+name = "rk4"
+dt = [0.1]
+"#
+        )
+    };
+    for bad in ["0", "-1", "1025"] {
+        let err = load_error(&[("wp", &stage(bad))]);
+        assert!(
+            err.contains("wp.toml") && err.contains("threads") && err.contains("1 to 1024"),
+            "{err}"
+        );
+    }
+    let p = Project::new(&[("wp", &stage("2"))]);
+    let loaded = Pipeline::load(&p.pipeline(), KINDS);
+    assert!(loaded.is_ok(), "{:?}", loaded.err().map(|e| e.to_string()));
+}
