@@ -34,6 +34,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use serde_json::json;
+use woodpile_scene::threads::MAX_THREADS;
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::simulation::{run_with_plan, simulate, Outcome, Scenario};
@@ -152,8 +153,8 @@ impl WorkPrecision {
             return Err(fields.error("repeats", "expected 1 to 100"));
         }
         let threads = match fields.optional::<i64>("threads")? {
-            Some(n) if !(1..=1024).contains(&n) => {
-                return Err(fields.error("threads", "expected 1 to 1024"))
+            Some(n) if !(1..=MAX_THREADS as i64).contains(&n) => {
+                return Err(fields.error("threads", format!("expected 1 to {MAX_THREADS}")));
             }
             n => n.map(|n| n as usize),
         };
@@ -207,15 +208,16 @@ impl WorkPrecision {
         let jobs: Vec<(usize, &Setting)> = (0..self.scenes.len())
             .flat_map(|index| self.settings.iter().map(move |setting| (index, setting)))
             .collect();
-        let timed: Vec<(Timed, &Setting, usize)> = pool.install(|| {
+        let timed: Vec<Timed> = pool.install(|| {
             jobs.par_iter()
-                .map(|&(index, setting)| (self.timed(index, setting), setting, index))
+                .map(|&(index, setting)| self.timed(index, setting))
                 .collect()
         });
-        let simulated = self.scenes.len() + timed.iter().map(|(t, _, _)| t.runs).sum::<usize>();
+        let simulated = self.scenes.len() + timed.iter().map(|t| t.runs).sum::<usize>();
         let rows: Vec<Run> = timed
             .into_iter()
-            .map(|(timed, setting, index)| {
+            .zip(jobs)
+            .map(|(timed, (index, setting))| {
                 let scene = &self.scenes[index];
                 Run {
                     scene: index,
