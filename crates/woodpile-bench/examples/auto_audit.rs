@@ -23,8 +23,12 @@
 //! `rk4-contact` at dt = 2.5e-4 checked against itself at twice that step: its error is a
 //! fraction of their difference, which is reported as the bound.
 //!
+//! With `--linear` first, the scenes are the plain ones with every resonator made linear and
+//! constant (`woodpile_sim::testing::linear_audit_scene`): the scenes whose first pair may
+//! judge its fine run by a coarse run at 4 dt.
+//!
 //! ```text
-//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped] SCENES [SEED [TOLERANCES [ONLY]]]]
+//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear] SCENES [SEED [TOLERANCES [ONLY]]]]
 //! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
@@ -35,8 +39,8 @@ use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::Coupling;
 use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{
-    audit_scene, chain_audit_scene, damped_audit_scene, fixed_dt, tolerance, Lcg,
-    AUDIT_REFERENCE_DT as REFERENCE_DT,
+    audit_scene, chain_audit_scene, damped_audit_scene, fixed_dt, linear_audit_scene, tolerance,
+    Lcg, AUDIT_REFERENCE_DT as REFERENCE_DT,
 };
 use woodpile_sim::SimError;
 
@@ -158,6 +162,10 @@ fn main() {
         Some("--damped") => {
             args.next();
             damped_audit_scene
+        }
+        Some("--linear") => {
+            args.next();
+            linear_audit_scene
         }
         _ => audit_scene,
     };

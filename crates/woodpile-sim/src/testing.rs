@@ -309,6 +309,28 @@ pub fn audit_scene(rng: &mut Lcg) -> Scenario {
     random_scene(rng, &AUDIT_RANGES, 1e-8)
 }
 
+/// One scene of the audit of `auto`'s longer first pair (`auto_audit --linear`): an audit
+/// scene ([`audit_scene`], the same draws) with every resonator linear (p = 1) and its coupling
+/// constant at the ramp's final value: the scenes whose first coarse run may step 4 dt.
+pub fn linear_audit_scene(rng: &mut Lcg) -> Scenario {
+    let base = audit_scene(rng);
+    let resonators = base
+        .model
+        .resonators()
+        .iter()
+        .map(|r| Resonator {
+            p: 1,
+            coupling: Coupling::Constant(r.coupling.at(f64::INFINITY)),
+            ..*r
+        })
+        .collect();
+    let (n_sites, boundary) = (base.model.n_sites(), base.model.boundary());
+    Scenario {
+        model: Model::new(n_sites, boundary, resonators).expect("a valid survey model"),
+        ..base
+    }
+}
+
 /// Scene `k` of the audit drawn with `seed` (the scenes before it are drawn and dropped).
 pub fn audit_scene_at(seed: u64, k: usize) -> Scenario {
     let mut rng = Lcg(seed);
