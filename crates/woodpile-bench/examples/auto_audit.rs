@@ -24,8 +24,8 @@
 //! fraction of their difference, which is reported as the bound.
 //!
 //! With `--linear` first, the scenes are the plain ones with every resonator made linear and
-//! constant (`woodpile_sim::testing::linear_audit_scene`): the scenes whose first pair may
-//! judge its fine run by a coarse run at 4 dt.
+//! constant (`woodpile_sim::testing::linear_audit_scene`): the paper's kind of scene, judged
+//! without the stricter rules of a nonlinear or ramped resonator.
 //!
 //! ```text
 //! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear] SCENES [SEED [TOLERANCES [ONLY]]]]
