@@ -313,18 +313,14 @@ pub fn audit_scene(rng: &mut Lcg) -> Scenario {
 /// ([`audit_scene`], the same draws) with every resonator linear (p = 1) and its coupling
 /// constant at the ramp's final value. These are the paper's kind of scene, which `auto`
 /// judges by its first pair at half the tolerance, without the stricter rules a nonlinear
-/// or ramped resonator brings; the plain audit's draws rarely have one.
+/// or ramped resonator brings; the plain audit rarely draws such a scene.
 pub fn linear_audit_scene(rng: &mut Lcg) -> Scenario {
     let base = audit_scene(rng);
     let resonators = base
         .model
         .resonators()
         .iter()
-        .map(|r| Resonator {
-            p: 1,
-            coupling: Coupling::Constant(r.coupling.at(f64::INFINITY)),
-            ..*r
-        })
+        .map(|r| Resonator::constant(r.site, r.eps, r.coupling.at(f64::INFINITY), 1))
         .collect();
     let (n_sites, boundary) = (base.model.n_sites(), base.model.boundary());
     Scenario {
