@@ -45,9 +45,15 @@ pub(super) fn block_changes<const S: usize, const N: usize>(
             high[i] = if f[i] > high[i] { f[i] } else { high[i] };
         }
     }
+    let changed: [bool; N] = std::array::from_fn(|i| (high[i] > 0.0) & (low[i] <= 0.0));
+    // Nearly every block has no change: one test of the whole block (an OR reduction, which
+    // compiles to a single mask test) before the bits are gathered one by one.
+    if !changed.iter().fold(false, |any, &c| any | c) {
+        return 0;
+    }
     let mut mask = 0;
-    for i in 0..N {
-        mask |= u32::from((high[i] > 0.0) & (low[i] <= 0.0)) << i;
+    for (i, &c) in changed.iter().enumerate() {
+        mask |= u32::from(c) << i;
     }
     mask
 }

@@ -69,8 +69,14 @@ pub(super) fn apply_fast<D: DofsMut + ?Sized>(
     }
 }
 
-pub(super) fn negligible<const S: usize>(stage_forces: [f64; S], end_force: f64) -> bool {
-    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force < NEGLIGIBLE_FORCE
+/// Whether a changed bond's forces, at every stage and at the end of its path, all stay below
+/// [`NEGLIGIBLE_FORCE`]. `end_force` (a square root or a power) is evaluated only when every
+/// stage force is below it: a bond that pushed at some stage is kept without it.
+pub(super) fn negligible<const S: usize>(
+    stage_forces: [f64; S],
+    end_force: impl FnOnce() -> f64,
+) -> bool {
+    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force() < NEGLIGIBLE_FORCE
 }
 
 /// A bond's elastic force at the end of its path, and its impulse and moment along it: the
@@ -221,7 +227,7 @@ impl<const S: usize> ContactEvents<S> {
         for &(bond, left, right) in &self.changed {
             let stage = self.stage_forces(bond);
             let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(stage, end_force(model, bond, &path)) {
+            if negligible(stage, || end_force(model, bond, &path)) {
                 continue;
             }
             let (impulse, moment, lost) = bond_integrals(model, bond, &path, h);
@@ -350,7 +356,7 @@ impl<const S: usize> ContactEvents<S> {
         let mut first: Option<(f64, BondSites)> = None;
         for &(bond, left, right) in &self.changed {
             let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(self.stage_forces(bond), end_force(model, bond, &path)) {
+            if negligible(self.stage_forces(bond), || end_force(model, bond, &path)) {
                 continue;
             }
             if let Some(x) = moment(bond, &path).filter(|&x| first.is_none_or(|(f, _)| x < f)) {
@@ -405,13 +411,17 @@ impl<const S: usize> ContactEvents<S> {
         let mut start = 0;
         if offsets.is_none() {
             const BLOCK: usize = 4;
+            // Every slice cut to `n_bonds` here, once, so that the blocks below need no
+            // bounds checks: `start + BLOCK <= n_bonds` proves each in range.
+            let stage: [&[f64]; S] = std::array::from_fn(|s| &stage_slices[s][..n_bonds]);
+            let (left, right) = (&left_q[..n_bonds], &right_q[..n_bonds]);
             while start + BLOCK <= n_bonds {
                 let block = start..start + BLOCK;
                 let forces: [&[f64; BLOCK]; S] =
-                    std::array::from_fn(|s| block_of(&stage_slices[s][block.clone()]));
+                    std::array::from_fn(|s| block_of(&stage[s][block.clone()]));
                 let mut mask = block_changes(
-                    block_of(&left_q[block.clone()]),
-                    block_of(&right_q[block]),
+                    block_of(&left[block.clone()]),
+                    block_of(&right[block]),
                     forces,
                 );
                 while mask != 0 {

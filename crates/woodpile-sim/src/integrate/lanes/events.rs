@@ -62,7 +62,7 @@ impl LaneEvents {
                     (&Lane(new_q, l), &Lane(new_v, l)),
                 );
                 let path = bond_path(model, bond, start, end, (left, right));
-                if negligible(stage, end_force(model, bond, &path)) {
+                if negligible(stage, || end_force(model, bond, &path)) {
                     continue;
                 }
                 let (impulse, moment, _) = bond_integrals(model, bond, &path, h);
@@ -138,9 +138,13 @@ impl LaneEvents {
                 low = lanewise(low, f, |low, f| if f < low { f } else { low });
                 high = lanewise(high, f, |high, f| if f > high { f } else { high });
             }
-            let mask = (0..LANES).fold(0, |m, l| {
-                m | (u32::from((high[l] > 0.0) & (low[l] <= 0.0)) << l)
-            }) & live_mask;
+            let changed: [bool; LANES] = std::array::from_fn(|l| (high[l] > 0.0) & (low[l] <= 0.0));
+            // Nearly every bond changed in no lane: one test of all four (an OR reduction, a
+            // single mask test) before the bits are gathered one by one.
+            if !changed.iter().fold(false, |any, &c| any | c) {
+                continue;
+            }
+            let mask = (0..LANES).fold(0, |m, l| m | (u32::from(changed[l]) << l)) & live_mask;
             if mask != 0 {
                 self.changed
                     .push(((bond, Some(bond - 1), Some(bond)), mask));
