@@ -10,7 +10,7 @@ use super::contact_event::{
     damped_path_integrals, first_crossing, first_switch, path_integrals, path_integrals_of,
     BondPath,
 };
-use super::contact_scan::{block_changes, block_of, changes_contact};
+use super::contact_scan::{block_changes, block_of, changes_contact, negligible};
 use super::exact_resonator::{
     fast_mode_correction, Dofs, DofsMut, ExactResonators, FastModeCorrection,
 };
@@ -19,13 +19,6 @@ use crate::model::{Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
 pub(crate) type Quadrature<const S: usize> = fn([f64; S], f64) -> (f64, f64);
-
-/// Largest contact force for which an opening or closing is left to the method: the correction
-/// of such a bond is below |force| h, under 1e-15 in a dimensionless chain struck at unit
-/// velocity. Four in five contact changes on the paper's scenes are grazing touches of the
-/// quiet chain behind the wave, with forces below 1e-16; skipping them changes no fraction by
-/// more than 1e-16 and saves most of the correction's cost.
-const NEGLIGIBLE_FORCE: f64 = 1e-14;
 
 /// A bond and its members: (bond, left site or None for a wall, right site or None).
 pub(crate) type BondSites = (usize, Option<usize>, Option<usize>);
@@ -66,29 +59,6 @@ pub(super) fn apply_fast<D: DofsMut + ?Sized>(
             new_v.add(fast.sites[k], fast.velocity[k]);
             new_q.add(fast.sites[k], fast.position[k]);
         }
-    }
-}
-
-/// Whether a changed bond's forces, at every stage and at the end of its path, all stay below
-/// [`NEGLIGIBLE_FORCE`]. `end_force` (a square root or a power) is evaluated only when every
-/// stage force is below it: a bond that pushed at some stage is kept without it.
-pub(super) fn negligible<const S: usize>(
-    stage_forces: [f64; S],
-    end_force: impl FnOnce() -> f64,
-) -> bool {
-    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force() < NEGLIGIBLE_FORCE
-}
-
-/// A bond's elastic force at the end of its path, and its impulse and moment along it: the
-/// paper's \[d\]_+^{3/2}, or the chain's [`ContactLaw`] (coefficient, exponent, and the static
-/// overlap added to the path by [`bond_path`]).
-pub(super) fn end_force(model: &Model, bond: usize, path: &BondPath) -> f64 {
-    match model.contacts() {
-        None => {
-            let end = path.d1.max(0.0);
-            end * end.sqrt()
-        }
-        Some(law) => law.coefficient(bond) * law.power(path.d1),
     }
 }
 
@@ -227,7 +197,7 @@ impl<const S: usize> ContactEvents<S> {
         for &(bond, left, right) in &self.changed {
             let stage = self.stage_forces(bond);
             let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(stage, || end_force(model, bond, &path)) {
+            if negligible(model, bond, stage, &path) {
                 continue;
             }
             let (impulse, moment, lost) = bond_integrals(model, bond, &path, h);
@@ -356,7 +326,7 @@ impl<const S: usize> ContactEvents<S> {
         let mut first: Option<(f64, BondSites)> = None;
         for &(bond, left, right) in &self.changed {
             let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(self.stage_forces(bond), || end_force(model, bond, &path)) {
+            if negligible(model, bond, self.stage_forces(bond), &path) {
                 continue;
             }
             if let Some(x) = moment(bond, &path).filter(|&x| first.is_none_or(|(f, _)| x < f)) {

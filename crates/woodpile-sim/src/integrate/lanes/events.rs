@@ -5,9 +5,9 @@
 
 use super::{lanewise, Lane, LaneMut, Lanes, LANES, S};
 use crate::contact::ContactLaw;
-use crate::integrate::contact_scan::changes_contact;
+use crate::integrate::contact_scan::{changes_contact, negligible};
 use crate::integrate::event_correction::{
-    apply, apply_fast, bond_integrals, bond_path, end_force, negligible, BondSites, Correction,
+    apply, apply_fast, bond_integrals, bond_path, BondSites, Correction,
 };
 use crate::integrate::exact_resonator::{
     fast_mode_correction, ExactResonators, FastModeCorrection,
@@ -62,7 +62,7 @@ impl LaneEvents {
                     (&Lane(new_q, l), &Lane(new_v, l)),
                 );
                 let path = bond_path(model, bond, start, end, (left, right));
-                if negligible(stage, || end_force(model, bond, &path)) {
+                if negligible(model, bond, stage, &path) {
                     continue;
                 }
                 let (impulse, moment, _) = bond_integrals(model, bond, &path, h);
