@@ -215,6 +215,105 @@ impl Model {
         }
     }
 
+    /// The forces of positions `q` near `sites`, whose positions a contact correction moved
+    /// after `acc` and `record` (a whole evaluation's on `window`, as
+    /// [`Model::accelerations_recording`] writes them) were taken: the bonds beside them and
+    /// the accelerations of them and their neighbours, each by the operations the whole
+    /// evaluation makes of it, so that the patched forces are a whole evaluation's bit for bit
+    /// (tested). Each bond is evaluated once, in the chain loop's order. Returns the sites
+    /// whose accelerations it wrote. Every force of the chain acts between neighbours or
+    /// within a site and its resonators, which is why one site more on each side suffices.
+    pub(crate) fn patch_accelerations(
+        &self,
+        t: f64,
+        q: &[f64],
+        (acc, record): (&mut [f64], &mut [f64]),
+        window: Window,
+        sites: std::ops::RangeInclusive<usize>,
+    ) -> std::ops::RangeInclusive<usize> {
+        let n = self.n_sites();
+        let (lo, hi) = (window.lo, window.hi);
+        let (u, v) = q.split_at(n);
+        let (acc_u, acc_v) = acc.split_at_mut(n);
+        let [left_wall, right_wall] = self.walls();
+        let law = self.contacts();
+        // A bond's (recorded, acting) force: the paper's d√d, or the law's elastic part and
+        // that less its static part, as the two chain loops compute them.
+        let bond = |b: usize| match law {
+            None => {
+                let d = (u[b - 1] - u[b]).max(0.0);
+                let f = d * d.sqrt();
+                (f, f)
+            }
+            Some(law) => {
+                let elastic = law.elastic(b, u[b - 1] - u[b]);
+                (elastic, elastic - law.static_force(b))
+            }
+        };
+        let wall = |b: usize, d: f64| match law {
+            None => hertz_force(d),
+            Some(law) => law.elastic(b, d),
+        };
+        if *sites.start() == 0 && lo == 0 && left_wall {
+            record[0] = wall(0, -u[0]);
+        }
+        if *sites.end() == n - 1 && hi == n - 1 && right_wall {
+            record[n] = wall(n, u[n - 1]);
+        }
+        let patched = sites.start().saturating_sub(1).max(lo)..=(sites.end() + 1).min(hi);
+        let mut left = (0.0, 0.0);
+        if *patched.start() > lo {
+            left = bond(*patched.start());
+            record[*patched.start()] = left.0;
+        }
+        for k in patched.clone() {
+            let mut a = left.1;
+            if k < hi {
+                let right = bond(k + 1);
+                record[k + 1] = right.0;
+                a = left.1 - right.1;
+                left = right;
+            }
+            a = self.patched_ends(k, u, a);
+            for (j, r) in self.resonators().iter().enumerate() {
+                if r.site == k {
+                    let f = r.coupling.at(t) * odd_power(u[k] - v[j], r.p);
+                    a -= f;
+                    acc_v[j] = f / r.eps;
+                }
+            }
+            if let Some(masses) = self.site_masses() {
+                a /= masses[k];
+            }
+            acc_u[k] = a;
+        }
+        patched
+    }
+
+    /// Site `k`'s acceleration `a` (its bonds' part) with what a wall or a soft end adds there,
+    /// in the whole evaluation's order: the wall's contact, then the spring.
+    fn patched_ends(&self, k: usize, u: &[f64], mut a: f64) -> f64 {
+        let last = self.n_sites() - 1;
+        let [left_wall, right_wall] = self.walls();
+        let wall = |b: usize, d: f64| match self.contacts() {
+            None => hertz_force(d),
+            Some(law) => law.elastic(b, d) - law.static_force(b),
+        };
+        if k == 0 && left_wall {
+            a += wall(0, -u[0]);
+        }
+        if k == last && right_wall {
+            a -= wall(last + 1, u[last]);
+        }
+        if let (0, Some((spring, _))) = (k, self.boundary().left().soft()) {
+            a -= spring * u[0];
+        }
+        if let (true, Some((spring, _))) = (k == last, self.boundary().right().soft()) {
+            a -= spring * u[last];
+        }
+        a
+    }
+
     /// The springs of soft ends (without dashpots: a model with one is dissipative and runs
     /// [`Model::damped_accelerations_in`]), added to the window's end sites. Out of line: the
     /// force loop of chains without them should not carry it.
@@ -285,6 +384,83 @@ mod tests {
                 "dof {i}: {force} vs {}",
                 mass * acc[i]
             );
+        }
+    }
+
+    /// A chain of the audit's kinds (walls or free ends, resonators of every exponent, the
+    /// experiment's contact laws, masses, precompression), given soft ends without dashpots on
+    /// every third.
+    fn patch_test_model(rng: &mut crate::testing::Lcg, k: usize) -> Model {
+        use crate::testing::{audit_scene, chain_audit_scene};
+        let model = match k % 2 {
+            0 => chain_audit_scene(rng).model,
+            _ => audit_scene(rng).model,
+        };
+        if !k.is_multiple_of(3) {
+            return model;
+        }
+        let soft = |spring| crate::End::Soft {
+            spring,
+            damping: 0.0,
+        };
+        let n = model.n_sites();
+        let masses = (0..n).map(|i| model.site_mass(i)).collect();
+        let ends = Boundary::ends(soft(0.07), soft(0.03));
+        let soft_model = Model::with_masses(n, ends, model.resonators().to_vec(), Some(masses));
+        match (soft_model, model.contacts()) {
+            (Ok(m), None) => m,
+            (Ok(m), Some(law)) => m.with_contacts(law.clone()).unwrap_or(model),
+            (Err(_), _) => model,
+        }
+    }
+
+    #[test]
+    fn a_patched_evaluation_is_the_whole_evaluation_bit_for_bit() {
+        let mut rng = crate::testing::Lcg(2026);
+        for k in 0..90 {
+            let model = patch_test_model(&mut rng, k);
+            let (n, t) = (model.n_sites(), 7.5);
+            let q: Vec<f64> = (0..model.n_dof())
+                .map(|_| 0.02 * (rng.uniform() - 0.5))
+                .collect();
+            let (lo, hi) = match k % 3 {
+                0 => (0, n - 1),
+                1 => (n / 4, n - 1),
+                _ => (0, 3 * n / 4),
+            };
+            let window = Window { lo, hi };
+            let (mut acc, mut record) = (vec![0.0; model.n_dof()], vec![0.0; n + 1]);
+            model.accelerations_recording(t, &q, &mut acc, window, &mut record);
+            for first in [lo, lo + 1, (lo + hi) / 2, hi - 1, hi] {
+                // A corrected bond moves its two members (one at a wall), and an exactly
+                // integrated resonator's host moves it too.
+                let sites = first..=(first + 1).min(hi);
+                let mut moved = q.clone();
+                for site in sites.clone() {
+                    moved[site] += 3e-3 * (rng.uniform() - 0.3);
+                }
+                for (j, r) in model.resonators().iter().enumerate() {
+                    if sites.contains(&r.site) {
+                        moved[n + j] -= 2e-3 * rng.uniform();
+                    }
+                }
+                let (mut whole_acc, mut whole_record) = (acc.clone(), record.clone());
+                model.accelerations_recording(t, &moved, &mut whole_acc, window, &mut whole_record);
+                let (mut patched_acc, mut patched_record) = (acc.clone(), record.clone());
+                let forces = (&mut patched_acc[..], &mut patched_record[..]);
+                model.patch_accelerations(t, &moved, forces, window, sites);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(&patched_acc),
+                    bits(&whole_acc),
+                    "chain {k}, site {first}"
+                );
+                assert_eq!(
+                    bits(&patched_record),
+                    bits(&whole_record),
+                    "chain {k}, site {first}"
+                );
+            }
         }
     }
 

@@ -159,6 +159,33 @@ impl<const S: usize> ContactEvents<S> {
         !self.pending.is_empty()
     }
 
+    /// Makes a reused first stage (`acc`, and the recorded forces of stage 0) the forces of
+    /// the positions `q` the last step's corrections moved: each corrected bond's members
+    /// evaluated again by [`Model::patch_accelerations`], and an exact resonator's spring taken
+    /// out at the sites patched. The same bits as evaluating the stage whole, at a few sites'
+    /// cost: a step after a corrected one would otherwise evaluate its first stage again.
+    pub(super) fn patch_reused_stage(
+        &mut self,
+        model: &Model,
+        (t, q, window): (f64, &[f64], Window),
+        acc: &mut [f64],
+        mut exact: Option<&mut ExactResonators<S>>,
+    ) {
+        for &(left, right, ..) in &self.pending {
+            let Some(first) = left.or(right) else {
+                continue;
+            };
+            let sites = first..=right.unwrap_or(first);
+            let forces = (&mut *acc, &mut self.stage_force[0][..]);
+            let patched = model.patch_accelerations(t, q, forces, window, sites);
+            if let Some(exact) = exact.as_deref_mut() {
+                for k in patched {
+                    exact.remove_spring_at((0, k), q, acc);
+                }
+            }
+        }
+    }
+
     /// Makes stage `to`'s recorded bond forces those of stage `from` (the stage vectors are
     /// swapped; `from`'s are overwritten before they are read again): for a method whose first
     /// stage reuses its previous step's last.

@@ -163,6 +163,11 @@ pub struct Rkn<const S: usize> {
     /// Whether the last stage's accelerations are those of the current state: the previous step
     /// was FSAL and no contact correction moved its end state.
     last_stage_current: bool,
+    /// Whether they are, but for the few sites the previous step's corrections moved: the next
+    /// step reuses them and evaluates those sites again
+    /// ([`ContactEvents::patch_reused_stage`]). Not on a model whose coupling ramps (a stage's
+    /// time would then matter).
+    patch_first_stage: bool,
     contact: Option<ContactEvents<S>>,
     /// The harmonic resonators integrated exactly (`erkn6-contact`), if any.
     exact: Option<ExactResonators<S>>,
@@ -185,6 +190,7 @@ impl<const S: usize> Rkn<S> {
             cuts: 0,
             fsal: tableau.c[S - 1] == 1.0 && tableau.a[S - 1] == tableau.b,
             last_stage_current: false,
+            patch_first_stage: false,
             contact: (mode != ContactMode::Plain)
                 .then(|| ContactEvents::new(model, tableau.quadrature)),
             exact: None,
@@ -252,15 +258,24 @@ impl<const S: usize> Rkn<S> {
                     exact.shift_stage(i, self.q_stage.as_mut_slice());
                 }
             }
-            if i == 0 && self.last_stage_current {
+            if i == 0 && (self.last_stage_current || self.patch_first_stage) {
                 // The new state of the previous step is this one, bit for bit (c = 1 and the
-                // last row of `a` is `b`, accumulated in the same order): its forces are known.
+                // last row of `a` is `b`, accumulated in the same order): its forces are known,
+                // or known but at the sites its corrections moved.
                 self.a.swap(0, S - 1);
                 if let Some(c) = self.contact.as_mut() {
                     c.reuse_stage(S - 1, 0);
                 }
                 if let Some(exact) = self.exact.as_mut() {
                     exact.reuse_stage(S - 1, 0);
+                }
+                if self.patch_first_stage {
+                    // Counted as the evaluation it stands for, as the lanes count it.
+                    self.evals += 1;
+                    if let Some(c) = self.contact.as_mut() {
+                        let acc = self.a[0].as_mut_slice();
+                        c.patch_reused_stage(model, (t, q, window), acc, self.exact.as_mut());
+                    }
                 }
                 continue;
             }
@@ -305,6 +320,7 @@ impl<const S: usize> Rkn<S> {
     /// The located step: sub-steps that each end at the next contact event, or at `t + h`.
     fn located_step(&mut self, model: &Model, t: f64, y: &mut [f64], h: f64, window: Window) {
         self.last_stage_current = false;
+        self.patch_first_stage = false;
         let mut done = 0.0;
         let mut cuts = 0;
         while done < h {
@@ -350,11 +366,12 @@ impl<const S: usize> Stepper for Rkn<S> {
                 let events = (self.contact.as_mut(), self.exact.as_ref());
                 finish_step(events, model, (y, &mut y_new), h, window);
                 self.y_new = y_new;
-                self.last_stage_current = self.fsal
-                    && !self
-                        .contact
-                        .as_ref()
-                        .is_some_and(ContactEvents::corrected_last_step);
+                let corrected = self
+                    .contact
+                    .as_ref()
+                    .is_some_and(ContactEvents::corrected_last_step);
+                self.last_stage_current = self.fsal && !corrected;
+                self.patch_first_stage = self.fsal && corrected && !model.is_time_dependent();
             }
         }
         StepOutcome::Accepted { h_next: h }
