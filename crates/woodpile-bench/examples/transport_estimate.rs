@@ -7,7 +7,9 @@
 //! takes the same steps and has each step's local error taken off as it goes. The change of
 //! the fractions between the run and its shadow is what a perfect adjoint (or forward
 //! error-transport) estimate fed by those local errors would compute, to first order, with no
-//! transport error of its own. Four shadows differ in which local errors they are fed:
+//! transport error of its own (a shadow evaluates each step's first stage afresh, never
+//! reusing forces of the state before its local error was taken off). Five shadows differ in
+//! which local errors they are fed:
 //! - *doubled*: every step is also taken as two half steps from the same state, and their
 //!   difference times 2^6 / (2^6 − 1) is the step's local error (events included: both sides
 //!   correct their contacts). Two extra runs' worth of work.
@@ -15,7 +17,9 @@
 //!   contact, or of the rest only: where the error comes from.
 //! - *rebased coarse*: every other state is stepped once by 2 h, and the two fine steps'
 //!   local error is the difference times 2 / (2^7 − 2) (the smooth local order 7): what the
-//!   coarse run's half a run of work would give as local errors.
+//!   coarse run's half a run of work would give as local errors; and the same with the factor
+//!   of local order 3.5 wherever the pair, its coarse step or the step before corrected a
+//!   contact.
 //!
 //! Each is set beside the run's error against the independent reference (`rk4-contact` at
 //! dt = 2.5e-4) and beside `auto`'s Richardson estimate from the run at 2 dt, on the scenes
@@ -132,6 +136,7 @@ fn run_and_shadows(scene: &Scenario, method: Method, dt: f64) -> (Vec<f64>, [Vec
                     }
                     _ => {}
                 }
+                shadow.forget_last_stage();
             }
             t = if i + 1 == n_steps { target } else { t + h };
         }

@@ -431,35 +431,37 @@ mod tests {
             let window = Window { lo, hi };
             let (mut acc, mut record) = (vec![0.0; model.n_dof()], vec![0.0; n + 1]);
             model.accelerations_recording(t, &q, &mut acc, window, &mut record);
-            for first in [lo, lo + 1, (lo + hi) / 2, hi - 1, hi] {
-                // A corrected bond moves its two members (one at a wall), and an exactly
-                // integrated resonator's host moves it too.
-                let sites = first..=(first + 1).min(hi);
+            // Corrected bonds: each moves its two members (one alone at a wall or an end), two
+            // beside each other overlap, and an exactly integrated resonator's host moves it too.
+            let mid = (lo + hi) / 2;
+            let corrections = [
+                vec![lo..=lo],
+                vec![lo..=lo + 1],
+                vec![mid..=mid + 1, mid + 1..=mid + 2],
+                vec![hi - 1..=hi],
+                vec![hi..=hi],
+            ];
+            for ranges in corrections {
                 let mut moved = q.clone();
-                for site in sites.clone() {
+                for site in ranges.iter().flat_map(|r| r.clone()) {
                     moved[site] += 3e-3 * (rng.uniform() - 0.3);
-                }
-                for (j, r) in model.resonators().iter().enumerate() {
-                    if sites.contains(&r.site) {
-                        moved[n + j] -= 2e-3 * rng.uniform();
+                    for (j, r) in model.resonators().iter().enumerate() {
+                        if r.site == site {
+                            moved[n + j] -= 2e-3 * rng.uniform();
+                        }
                     }
                 }
                 let (mut whole_acc, mut whole_record) = (acc.clone(), record.clone());
                 model.accelerations_recording(t, &moved, &mut whole_acc, window, &mut whole_record);
                 let (mut patched_acc, mut patched_record) = (acc.clone(), record.clone());
-                let forces = (&mut patched_acc[..], &mut patched_record[..]);
-                model.patch_accelerations(t, &moved, forces, window, sites);
+                for sites in ranges.iter().cloned() {
+                    let forces = (&mut patched_acc[..], &mut patched_record[..]);
+                    model.patch_accelerations(t, &moved, forces, window, sites);
+                }
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-                assert_eq!(
-                    bits(&patched_acc),
-                    bits(&whole_acc),
-                    "chain {k}, site {first}"
-                );
-                assert_eq!(
-                    bits(&patched_record),
-                    bits(&whole_record),
-                    "chain {k}, site {first}"
-                );
+                let what = format!("chain {k}, corrections {ranges:?}");
+                assert_eq!(bits(&patched_acc), bits(&whole_acc), "{what}");
+                assert_eq!(bits(&patched_record), bits(&whole_record), "{what}");
             }
         }
     }

@@ -215,7 +215,8 @@ impl<const S: usize> ExactResonators<S> {
     }
 
     /// [`ExactResonators::remove_springs`] for the pair hosted at `site` only, if any: for a
-    /// stage whose forces were evaluated again at a few sites (`super::lanes`).
+    /// stage whose forces were evaluated again at a few sites (the lanes' patch, and
+    /// `ContactEvents::patch_reused_stage`).
     pub fn remove_spring_at<D: Dofs + ?Sized, A: DofsMut + ?Sized>(
         &mut self,
         (i, site): (usize, usize),

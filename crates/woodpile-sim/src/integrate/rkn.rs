@@ -165,9 +165,12 @@ pub struct Rkn<const S: usize> {
     last_stage_current: bool,
     /// Whether they are, but for the few sites the previous step's corrections moved: the next
     /// step reuses them and evaluates those sites again
-    /// ([`ContactEvents::patch_reused_stage`]). Not on a model whose coupling ramps (a stage's
-    /// time would then matter).
+    /// ([`ContactEvents::patch_reused_stage`]).
     patch_first_stage: bool,
+    /// Whether a corrected step's last stage may be patched: an FSAL tableau on a model whose
+    /// couplings do not ramp (kept out of caution: a patched site's forces are taken at the
+    /// step's start time). Decided once, the model being fixed.
+    patchable: bool,
     contact: Option<ContactEvents<S>>,
     /// The harmonic resonators integrated exactly (`erkn6-contact`), if any.
     exact: Option<ExactResonators<S>>,
@@ -191,6 +194,9 @@ impl<const S: usize> Rkn<S> {
             fsal: tableau.c[S - 1] == 1.0 && tableau.a[S - 1] == tableau.b,
             last_stage_current: false,
             patch_first_stage: false,
+            patchable: tableau.c[S - 1] == 1.0
+                && tableau.a[S - 1] == tableau.b
+                && !model.is_time_dependent(),
             contact: (mode != ContactMode::Plain)
                 .then(|| ContactEvents::new(model, tableau.quadrature)),
             exact: None,
@@ -216,6 +222,14 @@ impl<const S: usize> Rkn<S> {
         self.exact = ExactResonators::of(model, weights);
         self.exact_name = Some(name);
         self
+    }
+
+    /// Makes the next step evaluate its first stage whole: for a caller that changed the state
+    /// between steps (the `transport_estimate` example's shadow runs), which the reused forces
+    /// of the last stage would not see.
+    pub fn forget_last_stage(&mut self) {
+        self.last_stage_current = false;
+        self.patch_first_stage = false;
     }
 
     /// Steps cut short at a contact event (located mode), or bonds corrected (corrected mode).
@@ -371,7 +385,7 @@ impl<const S: usize> Stepper for Rkn<S> {
                     .as_ref()
                     .is_some_and(ContactEvents::corrected_last_step);
                 self.last_stage_current = self.fsal && !corrected;
-                self.patch_first_stage = self.fsal && corrected && !model.is_time_dependent();
+                self.patch_first_stage = self.patchable && corrected;
             }
         }
         StepOutcome::Accepted { h_next: h }
