@@ -183,6 +183,7 @@ impl<const S: usize> Rkn<S> {
     pub fn new(model: &Model, tableau: RknTableau<S>, mode: ContactMode) -> Self {
         const { assert!(S <= MAX_TERMS, "a stage sum takes at most MAX_TERMS terms") };
         let n = model.n_dof();
+        let fsal = tableau.c[S - 1] == 1.0 && tableau.a[S - 1] == tableau.b;
         Self {
             tableau,
             mode,
@@ -191,12 +192,10 @@ impl<const S: usize> Rkn<S> {
             y_new: vec![0.0; 2 * n],
             evals: 0,
             cuts: 0,
-            fsal: tableau.c[S - 1] == 1.0 && tableau.a[S - 1] == tableau.b,
+            fsal,
             last_stage_current: false,
             patch_first_stage: false,
-            patchable: tableau.c[S - 1] == 1.0
-                && tableau.a[S - 1] == tableau.b
-                && !model.is_time_dependent(),
+            patchable: fsal && !model.is_time_dependent(),
             contact: (mode != ContactMode::Plain)
                 .then(|| ContactEvents::new(model, tableau.quadrature)),
             exact: None,
