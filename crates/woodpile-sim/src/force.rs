@@ -236,29 +236,12 @@ impl Model {
         let (u, v) = q.split_at(n);
         let (acc_u, acc_v) = acc.split_at_mut(n);
         let [left_wall, right_wall] = self.walls();
-        let law = self.contacts();
-        // A bond's (recorded, acting) force: the paper's d√d, or the law's elastic part and
-        // that less its static part, as the two chain loops compute them.
-        let bond = |b: usize| match law {
-            None => {
-                let d = (u[b - 1] - u[b]).max(0.0);
-                let f = d * d.sqrt();
-                (f, f)
-            }
-            Some(law) => {
-                let elastic = law.elastic(b, u[b - 1] - u[b]);
-                (elastic, elastic - law.static_force(b))
-            }
-        };
-        let wall = |b: usize, d: f64| match law {
-            None => hertz_force(d),
-            Some(law) => law.elastic(b, d),
-        };
+        let bond = |b: usize| self.contact_forces(b, u[b - 1] - u[b]);
         if *sites.start() == 0 && lo == 0 && left_wall {
-            record[0] = wall(0, -u[0]);
+            record[0] = self.contact_forces(0, -u[0]).0;
         }
         if *sites.end() == n - 1 && hi == n - 1 && right_wall {
-            record[n] = wall(n, u[n - 1]);
+            record[n] = self.contact_forces(n, u[n - 1]).0;
         }
         let patched = sites.start().saturating_sub(1).max(lo)..=(sites.end() + 1).min(hi);
         let mut left = (0.0, 0.0);
@@ -290,20 +273,30 @@ impl Model {
         patched
     }
 
+    /// Contact `b`'s (recorded, acting) force at overlap `d`: the paper's \[d\]_+^{3/2} for
+    /// both, or the law's elastic part and that less its static part, with the operations of
+    /// the chain loops and the walls ([`hertz_force`] gives the loop's max(d, 0)^{3/2} bits for
+    /// every d, NaN included).
+    fn contact_forces(&self, b: usize, d: f64) -> (f64, f64) {
+        match self.contacts() {
+            None => (hertz_force(d), hertz_force(d)),
+            Some(law) => {
+                let elastic = law.elastic(b, d);
+                (elastic, elastic - law.static_force(b))
+            }
+        }
+    }
+
     /// Site `k`'s acceleration `a` (its bonds' part) with what a wall or a soft end adds there,
     /// in the whole evaluation's order: the wall's contact, then the spring.
     fn patched_ends(&self, k: usize, u: &[f64], mut a: f64) -> f64 {
         let last = self.n_sites() - 1;
         let [left_wall, right_wall] = self.walls();
-        let wall = |b: usize, d: f64| match self.contacts() {
-            None => hertz_force(d),
-            Some(law) => law.elastic(b, d) - law.static_force(b),
-        };
         if k == 0 && left_wall {
-            a += wall(0, -u[0]);
+            a += self.contact_forces(0, -u[0]).1;
         }
         if k == last && right_wall {
-            a -= wall(last + 1, u[last]);
+            a -= self.contact_forces(last + 1, u[last]).1;
         }
         if let (0, Some((spring, _))) = (k, self.boundary().left().soft()) {
             a -= spring * u[0];
