@@ -30,6 +30,10 @@ pyo3::create_exception!(
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // NumPy's C API is fetched here, once, rather than at the first array a call returns: a
+    // table built after Ctrl-C would otherwise import it with a second interrupt pending,
+    // and the failed import is a panic, not an exception.
+    numpy::PyArray1::<f64>::zeros(py, 0, false);
     m.add("SceneError", py.get_type::<SceneError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;

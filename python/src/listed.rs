@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use woodpile_points::rows::{columns, Cell, Column, Row};
+use woodpile_points::rows::{columns, sweep, Cell, Column, Row};
 use woodpile_scene::Scene;
 use woodpile_sim::simulation::{simulate, simulate_batch, Outcome};
 
@@ -101,18 +101,21 @@ pub(crate) fn simulate_group(
         .unwrap_or_else(|_| scenes.iter().map(|s| simulate_one(s, cancel)).collect())
 }
 
-/// The rows of `simulate_many`: one per scene, in input order; `D` on every row when any scene
-/// declares damping.
-pub(crate) fn outcome_rows(
-    outcomes: &[Result<Outcome, String>],
-    dissipation: bool,
-) -> Vec<OutcomeRow<'_>> {
+/// The rows of `simulate_many`: one per scene, in input order; `S` on every row when any
+/// scene has a striker, and `D` when any declares damping, as a sweep's table has them.
+pub(crate) fn outcome_rows<'a>(
+    outcomes: &'a [Result<Outcome, String>],
+    scenes: &[Scene],
+) -> Vec<OutcomeRow<'a>> {
+    let striker = scenes.iter().any(|s| s.scenario.region.has_striker());
+    let dissipation = scenes.iter().any(|s| s.scenario.model.is_dissipative());
     outcomes
         .iter()
         .enumerate()
         .map(|(point, outcome)| OutcomeRow {
             point,
             outcome,
+            striker,
             dissipation,
         })
         .collect()
@@ -122,6 +125,7 @@ pub(crate) fn outcome_rows(
 pub(crate) struct OutcomeRow<'a> {
     point: usize,
     outcome: &'a Result<Outcome, String>,
+    striker: bool,
     dissipation: bool,
 }
 
@@ -130,13 +134,16 @@ impl Row for OutcomeRow<'_> {
         let ok = self.outcome.as_ref().ok();
         let share = |pick: fn(&Outcome) -> f64| Cell::from(ok.map(pick));
         let mut cells = vec![
-            ("point", Cell::from(self.point as i64)),
-            ("R", share(|o| o.fractions.reflected)),
-            ("T", share(|o| o.fractions.transmitted)),
-            ("E_tr", share(|o| o.fractions.trapped)),
+            (sweep::POINT, Cell::from(self.point as i64)),
+            (sweep::REFLECTED, share(|o| o.fractions.reflected)),
+            (sweep::TRANSMITTED, share(|o| o.fractions.transmitted)),
+            (sweep::TRAPPED, share(|o| o.fractions.trapped)),
         ];
+        if self.striker {
+            cells.push((sweep::STRIKER, share(|o| o.fractions.striker)));
+        }
         if self.dissipation {
-            cells.push(("D", share(|o| o.fractions.dissipated)));
+            cells.push((sweep::DISSIPATED, share(|o| o.fractions.dissipated)));
         }
         cells.extend([
             ("E_initial", share(|o| o.e_initial)),
@@ -148,7 +155,11 @@ impl Row for OutcomeRow<'_> {
                     .into(),
             ),
             ("steps", ok.map(|o| o.stats.steps as i64).into()),
-            ("rhs_evals", ok.map(|o| o.total_rhs_evals as i64).into()),
+            ("rhs_evals", ok.map(|o| o.stats.rhs_evals as i64).into()),
+            (
+                "total_rhs_evals",
+                ok.map(|o| o.total_rhs_evals as i64).into(),
+            ),
             (
                 "method",
                 ok.map(|o| o.plan.method.name().to_string()).into(),

@@ -367,6 +367,5 @@ pub(crate) fn simulate_many<'py>(
         return Err(signal);
     }
     let outcomes = outcomes.map_err(PyValueError::new_err)?;
-    let dissipation = list.iter().any(|s| s.scenario.model.is_dissipative());
-    table_dict(py, &outcome_rows(&outcomes, dissipation))
+    table_dict(py, &outcome_rows(&outcomes, &list))
 }

@@ -125,7 +125,7 @@ class Pipeline:
             assert process.stderr is not None
             for line in process.stderr:
                 stderr.append(line)
-                if echo:
+                if echo and sys.stderr is not None:
                     sys.stderr.write(line)
                     sys.stderr.flush()
 

@@ -16,21 +16,32 @@ REDRAW_S = 0.2
 
 
 def interactive() -> bool:
-    """Whether someone is watching: a terminal on stderr, or a Jupyter kernel."""
-    return sys.stderr.isatty() or "ipykernel" in sys.modules
+    """Whether someone is watching: a terminal on stderr, or a Jupyter kernel. A process
+    with no stderr at all (``sys.stderr`` is None under some GUIs and notebook launchers)
+    has nobody watching it."""
+    stream = sys.stderr
+    if stream is None:
+        return False
+    return "ipykernel" in sys.modules or bool(getattr(stream, "isatty", lambda: False)())
 
 
 class Progress:
     """One line, redrawn in place, ended by a newline when the run is done.
 
     ``enabled`` is ``True`` (always shown), ``False`` (never) or ``None`` (shown when
-    :func:`interactive`, once the run has taken :data:`QUIET_FOR_S`).
+    :func:`interactive`, once the run has taken :data:`QUIET_FOR_S`). Anything else is
+    refused with a ``TypeError``, a callable included: it would never be called.
     """
 
     def __init__(self, label: str, enabled: Optional[bool]) -> None:
+        if enabled is not None and not isinstance(enabled, bool):
+            raise TypeError(
+                f"{label}: progress must be True, False or None, got {type(enabled).__name__}"
+                " (a callable is not called: read the returned table instead)"
+            )
         self.label = label
         self.always = enabled is True
-        self.enabled = interactive() if enabled is None else bool(enabled)
+        self.enabled = interactive() if enabled is None else enabled
         self.started = time.monotonic()
         self.drawn_at = 0.0
         self.width = 0
@@ -54,10 +65,10 @@ class Progress:
 
     def close(self) -> None:
         """Ends the line, if one was drawn."""
-        if self.width:
+        if self.width and sys.stderr is not None:
             sys.stderr.write("\n")
             sys.stderr.flush()
-            self.width = 0
+        self.width = 0
 
     def _draw(self, text: str, final: bool) -> None:
         if not self.enabled:
@@ -68,8 +79,11 @@ class Progress:
         if not final and now - self.drawn_at < REDRAW_S:
             return
         self.drawn_at = now
-        sys.stderr.write("\r" + text.ljust(self.width))
-        sys.stderr.flush()
+        stream = sys.stderr
+        if stream is None:
+            return
+        stream.write("\r" + text.ljust(self.width))
+        stream.flush()
         self.width = len(text)
 
 

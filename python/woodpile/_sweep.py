@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
-from typing import Any, Dict, Mapping, Optional, Sequence, Union
+import signal
+import threading
+from typing import Any, Dict, Iterator, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import pandas as pd
@@ -72,7 +75,8 @@ def sweep(
     except KeyboardInterrupt as stopped:
         partial = getattr(stopped, "partial", None)
         if isinstance(partial, dict):
-            stopped.partial = _frame(partial)
+            with _interrupts_held():
+                stopped.partial = _frame(partial)
         raise
     finally:
         bar.close()
@@ -89,15 +93,24 @@ def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -
 
     Returns:
         A DataFrame with one row per scene, in input order: ``point`` (the scene's index),
-        ``R``, ``T``, ``E_tr`` (``D`` with damping), ``E_initial``, ``E_final``,
-        ``error_estimate``, ``dt``, ``steps``, ``rhs_evals``, ``method`` and ``failure``. A
+        ``R``, ``T``, ``E_tr`` (``S`` with a striker, ``D`` with damping), ``E_initial``,
+        ``E_final``, ``error_estimate``, ``dt``, ``steps``, ``rhs_evals`` (the reported run's,
+        as ``simulate``'s), ``total_rhs_evals`` (every run ``auto`` made), ``method`` and
+        ``failure``. A
         scene whose simulation failed is a row with NaN fractions and its reason in
         ``failure``; each number is what ``simulate`` gives for that scene, bit for bit.
 
     Raises:
         SceneError: a scene is invalid (the message names its index, ``scenes[i]``).
+        TypeError: ``scenes`` is one scene (a string, path or dict) rather than a list, or
+            ``progress`` is not True, False or None.
         KeyboardInterrupt: Ctrl-C stops the runs within about a second.
     """
+    if isinstance(scenes, (str, bytes, os.PathLike, Mapping)):
+        raise TypeError(
+            "simulate_many: scenes must be a list of scenes (dicts, TOML strings or paths), "
+            f"not one {type(scenes).__name__}; for one scene, pass [scene] or call simulate"
+        )
     bar = Progress("simulate_many", progress)
     try:
         return _frame(_core.simulate_many(list(scenes), bar.points))
@@ -105,8 +118,23 @@ def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -
         bar.close()
 
 
+@contextlib.contextmanager
+def _interrupts_held() -> Iterator[None]:
+    """Ctrl-C pressed again while the finished points become a table is held back, so that
+    a second press does not lose them (the interrupt under way is raised right after). Only
+    the main thread receives signals; elsewhere this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, lambda *_: None)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 #: Integer columns that are null where a point failed: pandas' nullable integers.
-_NULLABLE = ("steps", "rhs_evals")
+_NULLABLE = ("steps", "rhs_evals", "total_rhs_evals")
 
 
 def _frame(raw: Dict[str, Any]) -> pd.DataFrame:

@@ -2,6 +2,7 @@
 //! velocities, with the dissipated power the ledger integrates. Only a scene that declares
 //! dissipation runs this loop; the conservative one ([`crate::force`]) keeps its bits.
 
+pub use crate::error::Dissipator;
 use crate::force::{hertz_force, odd_power};
 use crate::model::{Model, Window};
 
@@ -143,26 +144,44 @@ impl Model {
     /// stay well below its inverse, as below a resonator's period ([`crate::integrate::Plan::resolving_dt`]);
     /// 0 when the chain has none of them.
     pub fn max_dissipation_rate(&self, energy: f64) -> f64 {
+        self.dissipation_rates(energy)
+            .into_iter()
+            .fold(0.0, |rate, (_, r)| rate.max(r))
+    }
+
+    /// What acts fastest among the chain's dashpots and soft ends in a motion of total
+    /// energy `energy`, and its rate ([`Model::max_dissipation_rate`]): what a scene whose
+    /// step they set is told to change. `None` when the chain has none of them.
+    pub fn fastest_dissipation(&self, energy: f64) -> Option<(Dissipator, f64)> {
+        self.dissipation_rates(energy)
+            .into_iter()
+            .filter(|(_, r)| *r > 0.0 || r.is_nan())
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+    }
+
+    /// Each dashpot's and soft end's rate ([`Model::max_dissipation_rate`]), by what it is.
+    fn dissipation_rates(&self, energy: f64) -> Vec<(Dissipator, f64)> {
         let n = self.n_sites();
         let inv = |site: Option<usize>| site.map_or(0.0, |i| self.inv_mass()[i]);
-        let mut rate: f64 = 0.0;
+        let mut rates = Vec::new();
         for (site, end) in [
             (0, self.boundary().left()),
             (n - 1, self.boundary().right()),
         ] {
             if let Some((spring, damping)) = end.soft() {
                 let inv_m = self.inv_mass()[site];
-                rate = rate.max((spring * inv_m).sqrt()).max(damping * inv_m);
+                let rate = (spring * inv_m).sqrt().max(damping * inv_m);
+                rates.push((Dissipator::SoftEnd { last: site > 0 }, rate));
             }
         }
         let Some(d) = self.damping() else {
-            return rate;
+            return rates;
         };
         let lightest = self.inv_mass()[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
-        rate = rate.max(d.ground * lightest);
+        rates.push((Dissipator::Ground, d.ground * lightest));
         for (j, r) in self.resonators().iter().enumerate() {
             let inv_pair = self.inv_mass()[r.site] + 1.0 / r.eps;
-            rate = rate.max(d.resonator(j) * inv_pair);
+            rates.push((Dissipator::Resonator(j), d.resonator(j) * inv_pair));
         }
         if d.contact > 0.0 {
             for bond in 0..=n {
@@ -171,10 +190,13 @@ impl Model {
                     None => (2.5 * energy.max(0.0)).powf(0.4),
                     Some(law) => law.overlap_within(bond, energy),
                 };
-                rate = rate.max(d.law.force(d.contact, overlap, 1.0) * pair);
+                rates.push((
+                    Dissipator::Contact,
+                    d.law.force(d.contact, overlap, 1.0) * pair,
+                ));
             }
         }
-        rate
+        rates
     }
 
     /// The soft ends' spring and dashpot forces on the window's end sites, added to `acc_u`;

@@ -163,6 +163,13 @@ pub enum SimError {
         /// The finest run the ladder made, unverified: what a caller may keep, marked so.
         finest: Option<Box<Unverified>>,
     },
+    /// The run ended, but its shares break the rule every reported run meets
+    /// (`simulation::check_shares`): not all finite, one outside [0, 1], or their sum not 1.
+    #[error("the run's energy shares at t_end cannot be right: {why}; no numbers are reported")]
+    Implausible {
+        /// Which share, and how it breaks the rule.
+        why: String,
+    },
     /// The observer asked for the run to stop (see `Observer::cancelled`).
     #[error("cancelled at t = {t:.6}")]
     Cancelled {
@@ -211,6 +218,25 @@ pub enum StepSetBy {
     /// Resolving the chain's stiffest contact (a [`crate::ContactLaw`]: heavy precompression,
     /// stiff contacts or light sites).
     Contacts,
+    /// Keeping the fastest dashpot or soft end stable.
+    Dissipation(Dissipator),
+}
+
+/// A velocity-dependent force of a chain, by what declares it: what
+/// `Model::fastest_dissipation` names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dissipator {
+    /// A soft end: the first site's (`last = false`) or the last site's.
+    SoftEnd {
+        /// Whether it is the last site's end.
+        last: bool,
+    },
+    /// Ground damping on every site.
+    Ground,
+    /// The dashpot inside resonator `j`.
+    Resonator(usize),
+    /// The contacts' dashpots.
+    Contact,
 }
 
 /// A run refused before it starts.
@@ -225,7 +251,7 @@ pub enum OverBudget {
         limit: u64,
     },
     /// Too many steps.
-    #[error("about {steps:.3e} steps of dt = {dt:.3e} to reach t_end (set by {}), beyond the budget of {limit} steps", set_by.describe())]
+    #[error("{} to reach t_end (set by {}), beyond the budget of {limit} steps", steps_text(*steps, *dt), set_by.describe())]
     Steps {
         /// Estimated steps.
         steps: f64,
@@ -245,7 +271,17 @@ impl StepSetBy {
             StepSetBy::Tolerance => "the tolerance",
             StepSetBy::Resonator(_) => "the fastest resonator's frequency",
             StepSetBy::Contacts => "the chain's stiffest contact",
+            StepSetBy::Dissipation(_) => "the fastest dashpot or soft end",
         }
+    }
+}
+
+/// `about 1.2e9 steps of dt = 3.0e-8`; a step that underflowed to 0 (or below any float's
+/// resolution) says so instead of "inf steps of dt = 0.000e0".
+fn steps_text(steps: f64, dt: f64) -> String {
+    match dt.is_normal() && steps.is_finite() {
+        true => format!("about {steps:.3e} steps of dt = {dt:.3e}"),
+        false => format!("a step of {dt:.3e}, too small for a float to count steps with,"),
     }
 }
 

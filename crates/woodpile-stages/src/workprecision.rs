@@ -50,7 +50,7 @@ use woodpile_pipeline::Output;
 pub struct WorkPrecision {
     /// Runs per setting; the best wall time is kept.
     pub repeats: usize,
-    /// Runs timed at once; `None`: one per physical core ([`timing_threads`]).
+    /// Runs timed at once; `None`: one per physical core (`timing_threads`).
     pub threads: Option<usize>,
     /// Tolerance of the DOP853 reference.
     pub reference_tolerance: f64,

@@ -299,3 +299,24 @@ dt = [0.1]
     let loaded = Pipeline::load(&p.pipeline(), KINDS);
     assert!(loaded.is_ok(), "{:?}", loaded.err().map(|e| e.to_string()));
 }
+
+/// Issue 55, D12: a sweep or vary axis named after an output column (`S`, `D`,
+/// `end_reached_at`, `design`, `design_index`) was refused only at run time, naming another
+/// stage; it is refused at load, naming the stage's file and the axis.
+#[test]
+fn axes_named_after_output_columns_are_refused_at_load() {
+    for name in ["S", "D", "end_reached_at", "design", "design_index"] {
+        let sweep = single_defect_sweep().replace("eps = {", &format!("{name} = [1.0]\neps = {{"));
+        let err = load_error(&[("sweep", &sweep)]);
+        assert!(
+            err.contains("sweep.toml") && err.contains(&format!("axes.{name}")),
+            "{err}"
+        );
+        let vary = format!("kind = \"vary\"\ninputs = [\"sweep\"]\n[axes]\n{name} = [1.0]\n[set]\nrun = {{ t_end = 5.0 }}\n");
+        let err = load_error(&[("sweep", &single_defect_sweep()), ("varied", &vary)]);
+        assert!(
+            err.contains("varied.toml") && err.contains(&format!("axes.{name}")),
+            "{err}"
+        );
+    }
+}

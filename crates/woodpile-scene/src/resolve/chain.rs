@@ -187,7 +187,10 @@ pub(crate) fn segments(
     si: Option<&Si>,
     sites: &mut Sites,
 ) -> Result<(), Invalid> {
-    let mut covered: Vec<(i64, i64, usize)> = Vec::new();
+    // Which segment set each site so far: an overlap is found where a segment meets a site
+    // already set, in time linear in the chain (segments that do not overlap cover each site
+    // at most once), however many segments there are.
+    let mut covered: Vec<Option<usize>> = vec![None; sites.masses.len()];
     for (i, segment) in segments.iter().enumerate() {
         let key = |k: &str| format!("segment[{i}].{k}");
         let range = required(&key("sites"), segment.sites.as_deref())?;
@@ -205,17 +208,17 @@ pub(crate) fn segments(
         }
         let start = layout.index(&key("sites"), lo)?;
         let end = layout.index(&key("sites"), hi)?;
-        if let Some((a, b, j)) = covered.iter().find(|(a, b, _)| lo <= *b && *a <= hi) {
+        if let Some(j) = (start..=end).find_map(|index| covered[index]) {
+            let other = segments[j].sites.as_deref().unwrap_or_default();
             return Err(invalid(
                 key("sites"),
-                format!(
-                    "[{lo}, {hi}] overlaps segment[{j}]'s [{a}, {b}]: segments may not overlap"
-                ),
+                format!("[{lo}, {hi}] overlaps segment[{j}]'s {other:?}: segments may not overlap"),
             ));
         }
-        covered.push((lo, hi, i));
+        covered[start..=end].fill(Some(i));
         if let Some(mass) = &segment.mass {
             let pattern = positive_pattern(&key("mass"), mass)?;
+            fits(&key("mass"), pattern.len(), end - start + 1, "sites")?;
             for (k, index) in (start..=end).enumerate() {
                 if let Some(d) = sites.mass_from_defect[index] {
                     return Err(invalid(
@@ -232,6 +235,12 @@ pub(crate) fn segments(
         }
         if let Some(contact) = &segment.contact {
             let pattern = positive_pattern(&key("contact"), contact)?;
+            fits(
+                &key("contact"),
+                pattern.len(),
+                end - start,
+                "contacts between its sites",
+            )?;
             // The contact between index j and j + 1 is bond j + 1.
             for (k, bond) in (start + 1..=end).enumerate() {
                 let a = pattern[k % pattern.len()];
@@ -240,6 +249,18 @@ pub(crate) fn segments(
         }
     }
     Ok(())
+}
+
+/// Refuses a pattern of `len` values for a segment with only `room` places for them: the
+/// values past the segment's end would be dropped without a word.
+fn fits(key: &str, len: usize, room: usize, what: &str) -> Result<(), Invalid> {
+    match len <= room.max(1) {
+        true => Ok(()),
+        false => Err(invalid(
+            key,
+            format!("{len} values for a segment with {room} {what}: a list may be as long as the segment, or shorter to repeat"),
+        )),
+    }
 }
 
 /// The contact law a scene declares, or `None` when it declares none of the chain's new keys

@@ -132,7 +132,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         accuracy: settings.accuracy,
         sample_every: settings.sample_every,
     };
-    run::within_budget(&scenario, settings.sample_every_given)?;
+    run::within_budget(&scenario, settings.sample_every_given, &file.defect)?;
     let physical = si.map(|si| {
         let mut values = physical_values(si, built.derived, built.striker, &scenario);
         values.derived.extend(built.damping_values);
@@ -216,6 +216,7 @@ fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Resu
             .map_err(|e| invalid("damping", e.to_string()))?;
         damping_values.extend(listed);
     }
+    no_ramp_with_losses(file, &model)?;
     Ok(Built {
         model,
         impulse,
@@ -223,6 +224,36 @@ fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Resu
         striker,
         damping_values,
     })
+}
+
+/// Refuses a κ ramp in a chain that dissipates. A dissipative chain's shares are normalised by
+/// E(0), with D for what the dashpots took, so that they sum to 1; a ramp does work on the
+/// chain that this ledger has no term for, and the shares would sum to far more than 1.
+fn no_ramp_with_losses(file: &raw::SceneFile, model: &Model) -> Result<(), Invalid> {
+    if !(model.is_time_dependent() && model.is_dissipative()) {
+        return Ok(());
+    }
+    let ramp = file
+        .defect
+        .iter()
+        .position(|d| matches!(d.kappa, Some(toml::Value::Table(_))))
+        .unwrap_or(0);
+    let lossy = file
+        .defect
+        .iter()
+        .position(|d| d.damping.is_some() || d.quality_factor.is_some());
+    let losses = match (&file.damping, lossy) {
+        (Some(_), _) => "damping".to_string(),
+        (None, Some(j)) => match file.defect[j].damping {
+            Some(_) => format!("defect[{j}].damping"),
+            None => format!("defect[{j}].quality_factor"),
+        },
+        (None, None) => "chain.boundary".to_string(),
+    };
+    Err(invalid(
+        format!("defect[{ramp}].kappa"),
+        format!("a ramp cannot be combined with losses (`{losses}`): the ramp's work on the chain has no place in the energy ledger of a damped chain, whose shares would then not sum to 1; drop the ramp or the losses"),
+    ))
 }
 
 /// What an SI scene reports under `physical`: its scales, its defects' derived values, and the

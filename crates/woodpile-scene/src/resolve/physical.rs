@@ -12,6 +12,13 @@ use crate::raw;
 /// share of a defect rod's mass its resonator carries when a scene gives no `resonator_share`.
 pub const DEFAULT_RESONATOR_SHARE: f64 = 0.894 / (0.838 + 0.894);
 
+/// The slenderness L/d a defect rod may have: below 3 a "rod" is a stub whose first mode is
+/// no longer a beam's bending mode (Timoshenko's theory, and with it f1, then errs by more than
+/// a few per cent against three-dimensional elasticity), and beyond 100 it is a wire that bends
+/// under its own contacts, which a two-mass resonator of one mode cannot stand for. The paper's
+/// defect rods have 8 (40 mm × 5 mm).
+pub const DEFECT_ROD_SLENDERNESS: std::ops::RangeInclusive<f64> = 3.0..=100.0;
+
 /// What `[physical]` fixes: the rescaling, and the regular rods when given by geometry.
 #[derive(Debug, Clone)]
 pub(crate) struct Si {
@@ -159,6 +166,17 @@ pub(crate) fn rod_resonator(
         (None, Some(r)) => r.material,
         (None, None) => return Err(needs_regular("material")),
     };
+    let slenderness = length / diameter;
+    if !DEFECT_ROD_SLENDERNESS.contains(&slenderness) {
+        return Err(invalid(
+            key("rod.length"),
+            format!(
+                "a rod {length} m long and {diameter} m across has L/d = {slenderness:.3}, outside the {}..{} in which its first bending mode (Timoshenko) and the two-mass resonator stand for it",
+                DEFECT_ROD_SLENDERNESS.start(),
+                DEFECT_ROD_SLENDERNESS.end()
+            ),
+        ));
+    }
     let share = share.unwrap_or(DEFAULT_RESONATOR_SHARE);
     if !(share.is_finite() && share > 0.0 && share < 1.0) {
         return Err(invalid(

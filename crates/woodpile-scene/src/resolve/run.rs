@@ -1,6 +1,7 @@
 //! `[run]` and `[fractions]`: the horizon, the method and its accuracy, the sampling, and the
 //! region whose energy counts as trapped; and the budget check that refuses an endless run.
 
+use woodpile_sim::damped_force::Dissipator;
 use woodpile_sim::integrate::MAX_STEPS;
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice};
 use woodpile_sim::simulation::Scenario;
@@ -132,7 +133,7 @@ pub(crate) fn region(
             }
             [lo, hi]
         }
-        None => default_region(defects),
+        None => default_region(defects, layout),
     };
     let lo = layout.index("fractions.region", region_paper[0])?;
     let hi = layout.index("fractions.region", region_paper[1])?;
@@ -141,7 +142,11 @@ pub(crate) fn region(
 
 /// Refuses a scene whose run could never finish within the simulator's budgets, naming the key
 /// that makes it so (`t_end` when even the largest step of any method would be too many).
-pub(crate) fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Result<(), Invalid> {
+pub(crate) fn within_budget(
+    scenario: &Scenario,
+    sample_every_given: bool,
+    defects: &[raw::Defect],
+) -> Result<(), Invalid> {
     let error = match woodpile_sim::simulation::budget::check(scenario) {
         Ok(()) => return Ok(()),
         Err(SimError::OverBudget(over)) => over,
@@ -162,17 +167,39 @@ pub(crate) fn within_budget(scenario: &Scenario, sample_every_given: bool) -> Re
             StepSetBy::Tolerance => "run.tolerance".to_string(),
             StepSetBy::Resonator(i) => format!("defect[{i}]"),
             StepSetBy::Contacts => "chain".to_string(),
+            StepSetBy::Dissipation(which) => dissipator_key(*which, defects),
         },
     };
     Err(invalid(key, error.to_string()))
 }
 
+/// The key that declares `which` dashpot or soft end.
+fn dissipator_key(which: Dissipator, defects: &[raw::Defect]) -> String {
+    match which {
+        Dissipator::SoftEnd { last: false } => "chain.boundary.left".into(),
+        Dissipator::SoftEnd { last: true } => "chain.boundary.right".into(),
+        Dissipator::Ground => "damping.ground".into(),
+        Dissipator::Contact => "damping.contact".into(),
+        Dissipator::Resonator(j) => match defects.get(j).and_then(|d| d.quality_factor) {
+            Some(_) => format!("defect[{j}].quality_factor"),
+            None => format!("defect[{j}].damping"),
+        },
+    }
+}
+
 /// The paper's region (Eqs. 10 and 11) spans the defects and one neighbour on each side, [min - 1, max + 1]
 /// (adjacent defects 0..L give [-1, L + 1]; separated d1 < d2 give [d1 - 1, d2 + 1]). Without
-/// defects, the single-defect region [-1, 1].
-fn default_region(defects: &[raw::Defect]) -> [i64; 2] {
+/// defects, the single-defect region [-1, 1] around site 0, or around the chain's middle site
+/// when site 0 is not on it. Either is cut to the chain, so that the default fits any chain
+/// (a defect on the first site reads R as 0: nothing lies left of it).
+fn default_region(defects: &[raw::Defect], layout: &Layout) -> [i64; 2] {
+    let (first, last) = (layout.first, layout.last);
+    let centre = match (first..=last).contains(&0) {
+        true => 0,
+        false => first + (last - first) / 2,
+    };
     let sites = defects.iter().filter_map(|d| d.site);
-    let lo = sites.clone().min().unwrap_or(0);
-    let hi = sites.max().unwrap_or(0);
-    [lo - 1, hi + 1]
+    let lo = sites.clone().min().unwrap_or(centre);
+    let hi = sites.max().unwrap_or(centre);
+    [(lo - 1).max(first), (hi + 1).min(last)]
 }

@@ -19,6 +19,12 @@ use crate::model::Model;
 /// there.
 pub const END_ARRIVAL_SPEED: f64 = 1e-3;
 
+/// Between samples, the observer is asked whether to stop each time this many more site-steps
+/// have been taken (about 10 ms of work at the development machine's rate): a run whose samples
+/// are far apart (`sample_every = t_end`) still stops soon after Ctrl-C, at the cost of one
+/// comparison a step.
+pub const CANCEL_POLL_SITE_STEPS: u64 = 1 << 20;
+
 /// The chain's end sites that were at rest at t = 0 (an impulse on an end site starts there,
 /// and says nothing about a wave arriving).
 struct WatchedEnds {
@@ -74,7 +80,7 @@ pub fn drive<S: Stepper + ?Sized, O: Observer + ?Sized>(
     let n_intervals = intervals(cfg.t_end, cfg.sample_every);
     for k in 1..=n_intervals {
         let target = sample_time(cfg, k, n_intervals);
-        run.cover(stepper, y, target)?;
+        run.cover(stepper, y, target, observer)?;
         run.sample(y, observer)?;
     }
     run.stats.rhs_evals = stepper.rhs_evals();
@@ -104,6 +110,9 @@ pub(super) struct Stepping<'a> {
     t: f64,
     /// The next adaptive step (unused by fixed steps).
     h: f64,
+    /// The site-steps at which the observer is next asked whether to stop
+    /// ([`CANCEL_POLL_SITE_STEPS`]).
+    next_poll: u64,
 }
 
 impl<'a> Stepping<'a> {
@@ -133,7 +142,21 @@ impl<'a> Stepping<'a> {
             attempts: 0,
             t: 0.0,
             h,
+            next_poll: CANCEL_POLL_SITE_STEPS,
         })
+    }
+
+    /// Between steps: once every [`CANCEL_POLL_SITE_STEPS`] site-steps, whether `observer`
+    /// wants the run stopped.
+    pub fn poll<O: Observer + ?Sized>(&mut self, observer: &O) -> Result<(), SimError> {
+        if self.stats.site_steps < self.next_poll {
+            return Ok(());
+        }
+        self.next_poll = self.stats.site_steps + CANCEL_POLL_SITE_STEPS;
+        match observer.cancelled() {
+            true => Err(SimError::Cancelled { t: self.t }),
+            false => Ok(()),
+        }
     }
 
     /// The equal steps of at most `dt` that tile the way to `target`: their number and size.
@@ -163,26 +186,30 @@ impl<'a> Stepping<'a> {
         self.t
     }
 
-    /// Advances from `t` to `target` by the step control's strategy.
-    fn cover<S: Stepper + ?Sized>(
+    /// Advances from `t` to `target` by the step control's strategy, asking `observer` now
+    /// and then whether to stop ([`Stepping::poll`]).
+    fn cover<S: Stepper + ?Sized, O: Observer + ?Sized>(
         &mut self,
         stepper: &mut S,
         y: &mut [f64],
         target: f64,
+        observer: &O,
     ) -> Result<(), SimError> {
         match self.cfg.control {
-            StepControl::Fixed { dt } => self.fixed_steps(stepper, y, target, dt),
-            StepControl::Adaptive { h_min } => self.adaptive_steps(stepper, y, target, h_min),
+            StepControl::Fixed { dt } => self.fixed_steps(stepper, y, (target, dt), observer),
+            StepControl::Adaptive { h_min } => {
+                self.adaptive_steps(stepper, y, (target, h_min), observer)
+            }
         }
     }
 
     /// Equal steps of at most `dt` that end exactly on `target`.
-    fn fixed_steps<S: Stepper + ?Sized>(
+    fn fixed_steps<S: Stepper + ?Sized, O: Observer + ?Sized>(
         &mut self,
         stepper: &mut S,
         y: &mut [f64],
-        target: f64,
-        dt: f64,
+        (target, dt): (f64, f64),
+        observer: &O,
     ) -> Result<(), SimError> {
         let (n_steps, h_eq) = self.tiling(target, dt);
         for i in 0..n_steps {
@@ -200,17 +227,18 @@ impl<'a> Stepping<'a> {
             self.active.update(self.model, y, window);
             self.count_fixed_step(i + 1 == n_steps, target, h_eq)?;
             check_finite_in(y, self.t, &window.state_ranges(self.model))?;
+            self.poll(observer)?;
         }
         Ok(())
     }
 
     /// The adaptive method's steps up to `target`, the last shortened to land on it.
-    fn adaptive_steps<S: Stepper + ?Sized>(
+    fn adaptive_steps<S: Stepper + ?Sized, O: Observer + ?Sized>(
         &mut self,
         stepper: &mut S,
         y: &mut [f64],
-        target: f64,
-        h_min: f64,
+        (target, h_min): (f64, f64),
+        observer: &O,
     ) -> Result<(), SimError> {
         while self.t < target {
             let remaining = target - self.t;
@@ -252,6 +280,7 @@ impl<'a> Stepping<'a> {
                     dt: self.h,
                 });
             }
+            self.poll(observer)?;
         }
         Ok(())
     }

@@ -209,6 +209,12 @@ impl Plan {
         step_within(MAX_OMEGA_DT, model.max_contact_omega(energy))
     }
 
+    /// The step the fastest dashpot or soft end of `model` allows in a motion of total
+    /// energy `energy` (infinite without them, [`Model::max_dissipation_rate`]).
+    pub fn dissipation_dt(model: &Model, energy: f64) -> f64 {
+        step_within(MAX_OMEGA_DT, model.max_dissipation_rate(energy))
+    }
+
     /// The cap a method that integrates harmonic resonators exactly keeps on them
     /// ([`MAX_HARMONIC_OMEGA_DT`]); none for other methods, which resolve them by
     /// [`MAX_OMEGA_DT`].

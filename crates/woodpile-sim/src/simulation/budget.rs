@@ -126,8 +126,15 @@ fn cause(scenario: &Scenario, method: Method, dt: f64, for_tolerance: f64) -> St
     let tightest = (0..model.resonators().len())
         .map(|j| (j, Plan::resonator_dt(model, method, j, energy)))
         .min_by(|a, b| a.1.total_cmp(&b.1));
-    match tightest {
-        Some((j, cap)) if cap < Plan::contact_dt(model, energy) => StepSetBy::Resonator(j),
+    let contacts = Plan::contact_dt(model, energy);
+    let dissipation = model
+        .fastest_dissipation(energy)
+        .map(|(which, _)| (which, Plan::dissipation_dt(model, energy)));
+    match (tightest, dissipation) {
+        (Some((j, cap)), d) if cap < contacts && d.is_none_or(|(_, dd)| cap <= dd) => {
+            StepSetBy::Resonator(j)
+        }
+        (_, Some((which, dd))) if dd < contacts => StepSetBy::Dissipation(which),
         _ => StepSetBy::Contacts,
     }
 }

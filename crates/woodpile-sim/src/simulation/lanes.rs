@@ -13,7 +13,9 @@
 //! resonators near ω = 1.5), so most of those runs take lanes too; the few left over run alone.
 
 use super::ladder::{FirstPair, Ladder};
-use super::{auto_first_step, budget, outcome_of, simulate, Outcome, Scenario};
+use super::{
+    auto_first_step, budget, check_shares, outcome_of, simulate_unchecked, Outcome, Scenario,
+};
 use crate::energy::total_energy;
 use crate::error::SimError;
 use crate::integrate::lanes::{drive_lanes, enabled, shares_a_chain, LANES};
@@ -49,7 +51,11 @@ pub fn simulate_batch<O: Observer>(
     }
     results
         .into_iter()
-        .map(|r| r.expect("every scene ends with a result"))
+        .zip(scenarios)
+        .map(|(r, s)| {
+            r.expect("every scene ends with a result")
+                .and_then(|out| check_shares(s, out))
+        })
         .collect()
 }
 
@@ -74,7 +80,7 @@ fn first_rungs<'s, O: Observer>(
         };
         let Some((plan, pairs)) = pairs else {
             for k in start..end {
-                results[k] = Some(simulate(scenarios[k], &mut observers[k]));
+                results[k] = Some(simulate_unchecked(scenarios[k], &mut observers[k]));
             }
             continue;
         };

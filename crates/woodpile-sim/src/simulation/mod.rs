@@ -77,8 +77,67 @@ pub struct Outcome {
     pub final_state: Vec<f64>,
 }
 
-/// Runs `scenario`, showing every sample of the reported run to `observer`.
+/// Runs `scenario`, showing every sample of the reported run to `observer`. The outcome has
+/// passed [`check_shares`]: numbers that fail it come back as [`SimError::Implausible`].
 pub fn simulate<O: Observer + ?Sized>(
+    scenario: &Scenario,
+    observer: &mut O,
+) -> Result<Outcome, SimError> {
+    simulate_unchecked(scenario, observer).and_then(|out| check_shares(scenario, out))
+}
+
+/// The rule every reported run meets, whichever path made it (the CLI, a sweep's points, a
+/// search's trials, Python): every share at t_end is finite, lies in [−a, 1 + a], and they
+/// sum to 1 within a, where a is the run's allowance ([`share_allowance`]). A run that breaks
+/// it (an overflow that left NaN, a ledger missing a term) is no result, however well its
+/// steps went: it becomes [`SimError::Implausible`], which callers report and never write.
+pub fn check_shares(scenario: &Scenario, out: Outcome) -> Result<Outcome, SimError> {
+    let allowance = share_allowance(scenario, &out.plan);
+    let f = &out.fractions;
+    let shares = [
+        ("R", f.reflected),
+        ("T", f.transmitted),
+        ("E_tr", f.trapped),
+        ("S", f.striker),
+        ("D", f.dissipated),
+    ];
+    let why = if let Some((name, x)) = shares.iter().find(|(_, x)| !x.is_finite()) {
+        Some(format!("{name} is {x} (E(0) = {:e})", out.e_initial))
+    } else if let Some((name, x)) = shares
+        .iter()
+        .find(|(_, x)| !(-allowance..=1.0 + allowance).contains(x))
+    {
+        Some(format!(
+            "{name} = {x:e} lies outside [0, 1] by more than {allowance:.1e}"
+        ))
+    } else if (f.sum() - 1.0).abs() > allowance {
+        Some(format!(
+            "the shares sum to {:.15} instead of 1, off by more than {allowance:.1e}",
+            f.sum()
+        ))
+    } else {
+        None
+    };
+    match why {
+        None => Ok(out),
+        Some(why) => Err(SimError::Implausible { why }),
+    }
+}
+
+/// How far the shares of a run by `plan` may stray from [0, 1] and from summing to 1: the
+/// tolerance `auto` verified, or for a named method the energy drift its run was allowed
+/// (the drift bound a named run is held to; at least the tolerance).
+pub fn share_allowance(scenario: &Scenario, plan: &Plan) -> f64 {
+    let tolerance = scenario.accuracy.tolerance;
+    match scenario.method {
+        MethodChoice::Auto => tolerance,
+        MethodChoice::Named(_) => plan.drift_limit.max(tolerance),
+    }
+}
+
+/// [`simulate`] without [`check_shares`]: for [`simulate_batch`], which checks every result
+/// it returns once.
+fn simulate_unchecked<O: Observer + ?Sized>(
     scenario: &Scenario,
     observer: &mut O,
 ) -> Result<Outcome, SimError> {

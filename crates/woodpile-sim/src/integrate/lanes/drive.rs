@@ -49,7 +49,7 @@ pub fn drive_lanes(
     let n_intervals = intervals(cfg.t_end, cfg.sample_every);
     for k in 1..=n_intervals {
         let target = sample_time(cfg, k, n_intervals);
-        batch.cover(&mut runs, &mut results, (target, dt));
+        batch.cover((&mut runs, &mut results), (target, dt), &observers);
         for l in 0..LANES {
             let Some(run) = runs[l].as_mut() else {
                 continue;
@@ -120,12 +120,16 @@ impl<'m> LaneBatch<'m> {
     }
 
     /// Advances every live lane to `target` by equal steps of at most `dt` (the same for all
-    /// lanes: they started together and take the same tiling).
+    /// lanes: they started together and take the same tiling), each lane asking its observer
+    /// now and then whether to stop ([`Stepping::poll`]).
     fn cover(
         &mut self,
-        runs: &mut [Option<Stepping<'_>>; LANES],
-        results: &mut [Option<Result<Stats, SimError>>; LANES],
+        (runs, results): (
+            &mut [Option<Stepping<'_>>; LANES],
+            &mut [Option<Result<Stats, SimError>>; LANES],
+        ),
         (target, dt): (f64, f64),
+        observers: &[&mut dyn Observer; LANES],
     ) {
         let Some(lead) = runs.iter().flatten().next() else {
             return;
@@ -157,8 +161,9 @@ impl<'m> LaneBatch<'m> {
                 run.active
                     .update_by(window, |k| q[k][l] != 0.0 || v[k][l] != 0.0);
                 let counted = run.count_fixed_step(i + 1 == n_steps, target, h_eq);
-                let checked =
-                    counted.and_then(|()| self.check_finite(l, sums[l], (run.t(), window)));
+                let checked = counted
+                    .and_then(|()| self.check_finite(l, sums[l], (run.t(), window)))
+                    .and_then(|()| run.poll(&*observers[l]));
                 if let Err(e) = checked {
                     runs[l] = None;
                     self.stop(l, results, e);
