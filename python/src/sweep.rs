@@ -14,7 +14,10 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use woodpile_points::rows::{SweepPoint, SweepShape};
 use woodpile_points::{point_key, simulate_points_until, Key, PointResult, PointStore, Shares};
-use woodpile_scene::grid::{at_point, parse_axes, point, point_count, Axis, AxisValue};
+use woodpile_scene::grid::{
+    at_point, parse_axes, point, point_count, Axis, AxisValue, MAX_SWEEP_BYTES,
+    PLANNED_BYTES_PER_SITE,
+};
 use woodpile_scene::template::Template;
 use woodpile_scene::Scene;
 use woodpile_sim::simulation::batch_size;
@@ -53,10 +56,8 @@ pub(crate) fn sweep<'py>(
     // every axis's extremes, as a sweep stage checks them.
     let first = grid.scene_at(0).map_err(SceneError::new_err)?;
     let last = grid.scene_at(count - 1).map_err(SceneError::new_err)?;
-    if kind.is_some() {
-        woodpile_scene::grid::check_sweep_memory(count, &last)
-            .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
-    }
+    woodpile_scene::grid::check_sweep_memory(count, &last)
+        .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
     let store = match cache {
         Some(dir) => Some(point_store(dir)?),
         None => None,
@@ -340,13 +341,23 @@ pub(crate) fn simulate_many<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut list = Vec::new();
+    // The scenes planned so far hold their chains: stop as soon as they alone are too many,
+    // before the next is planned (the whole list is checked below).
+    let mut planned = 0.0;
     for (index, item) in scenes.try_iter()?.enumerate() {
+        if planned > MAX_SWEEP_BYTES {
+            woodpile_scene::grid::check_list_memory(&list)
+                .map_err(|reason| SceneError::new_err(format!("scenes: {reason}")))?;
+        }
         let source = Source::of(&item?)?;
         let scene = source
             .scene()
             .map_err(|e| SceneError::new_err(format!("scenes[{index}]: {}", e.value(py))))?;
+        planned += scene.scenario.model.n_sites() as f64 * PLANNED_BYTES_PER_SITE;
         list.push(scene);
     }
+    woodpile_scene::grid::check_list_memory(&list)
+        .map_err(|reason| SceneError::new_err(format!("scenes: {reason}")))?;
     let done = AtomicUsize::new(0);
     let poll = |py: Python<'_>| points_done(py, progress.as_ref(), &done, list.len());
     let (outcomes, signal) = interruptible_keeping(py, &poll, |cancel| {

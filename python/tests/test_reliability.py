@@ -106,3 +106,25 @@ except KeyboardInterrupt:
 """
     done = _python(code, timeout=20)
     assert done.stdout.startswith("stopped"), (done.stdout, done.stderr[-2000:])
+
+
+def test_long_chains_are_refused_before_they_are_planned():
+    """Python had no memory plan for long chains: 16 chains of 5·10⁶ sites reached 8.85 GB
+    (`simulate_many`) and 7.5 GB (`sweep`), and died under a 4 GB cap. Both now refuse them
+    as the CLI does, before they allocate: the process stays under a 2 GB address-space cap."""
+    code = """
+import resource, woodpile
+with open("/proc/self/status") as f:
+    size = next(int(l.split()[1]) for l in f if l.startswith("VmSize:")) * 1024
+resource.setrlimit(resource.RLIMIT_AS, (size + 2 * 2**30, resource.RLIM_INFINITY))
+long = {"chain": {"n": 2500000}, "impulse": {"site": -5}, "run": {"t_end": 1.0, "method": "rk4", "dt": 0.05}}
+for call in (lambda: woodpile.simulate_many([long] * 64),
+             lambda: woodpile.sweep(dict(long, impulse={"site": "$s"}), {"s": list(range(-40, -8))})):
+    try:
+        call()
+        print("ran")
+    except woodpile.SceneError as e:
+        print("refused" if "GB" in str(e) else str(e))
+"""
+    done = _python(code, timeout=120)
+    assert done.stdout.split() == ["refused", "refused"], (done.stdout, done.stderr[-2000:])

@@ -136,7 +136,7 @@ pub fn columns<R: Row>(rows: &[R]) -> Result<Vec<(String, Column)>, String> {
 
 /// The columns of a sweep's table, named where the axes are checked against them
 /// ([`woodpile_scene::grid::RESERVED`]).
-pub use woodpile_scene::grid::columns as sweep;
+pub use woodpile_scene::columns as sweep;
 
 /// What every row of one sweep shares: its axes, and which optional shares it has.
 #[derive(Debug, Clone, Copy)]

@@ -4,6 +4,10 @@
 //! digits, so `0.1 + 2 * 0.1` is the `0.3` a user typed elsewhere and two sweeps that share a
 //! value share its cached point.
 
+use woodpile_sim::simulation::batch_size;
+
+use crate::columns;
+
 /// One value of an axis: integers stay integers (p, L), the rest are floats.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum AxisValue {
@@ -82,74 +86,81 @@ pub const MAX_POINTS: usize = 1_000_000;
 /// Most memory a sweep may need for its points: their planned scenes and their series.
 pub const MAX_SWEEP_BYTES: f64 = 4e9;
 
+/// Bytes a scene holds per site while it runs: its model, its state and its stepper's stages.
+const RUNNING_BYTES_PER_SITE: f64 = 200.0;
+
+/// Bytes a scene holds per site once planned, before it runs (masses, inverse masses, contact
+/// coefficients): what a list of scenes given at once holds for every one of them.
+pub const PLANNED_BYTES_PER_SITE: f64 = 40.0;
+
 /// Refuses, before anything runs, a sweep of `points` scenes like `scene` (its largest) that
 /// would hold more than [`MAX_SWEEP_BYTES`]. What a sweep holds: for every point, its cache key
 /// and outcome (about 1.4 KB, whatever the chain) and its series (five numbers a sample, six with a striker, in the
-/// point and again in the output table); and, while it runs, one scene and its state per
-/// worker thread (about 200 bytes a site). A point's scene and final state are not kept: a
-/// sweep of a long chain would otherwise hold a chain's worth of floats per point. The error is
-/// the reason, with the estimate.
+/// point and again in the output table); and, while it runs, the scenes of one batch per
+/// worker thread (groups of four neighbours, [`batch_size`]), each with its state (about 200
+/// bytes a site). A point's scene and final state are not kept: a sweep of a long chain would
+/// otherwise hold a chain's worth of floats per point. The error is the reason, with the
+/// estimate.
 pub fn check_sweep_memory(points: usize, scene: &crate::Scene) -> Result<(), String> {
+    let bytes = held_bytes(points, scene, 0.0);
+    match bytes > MAX_SWEEP_BYTES {
+        false => Ok(()),
+        true => Err(format!(
+            "{points} points of {} samples on {} sites would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
+            samples(scene),
+            scene.scenario.model.n_sites(),
+            bytes / 1e9,
+            MAX_SWEEP_BYTES / 1e9
+        )),
+    }
+}
+
+/// [`check_sweep_memory`] for a list of scenes given at once (Python's `simulate_many`), which
+/// are all planned before the first runs: each holds its chain until the list is done.
+pub fn check_list_memory(scenes: &[crate::Scene]) -> Result<(), String> {
+    let Some(largest) = scenes.iter().max_by_key(|s| s.scenario.model.n_sites()) else {
+        return Ok(());
+    };
+    let planned: f64 = scenes
+        .iter()
+        .map(|s| s.scenario.model.n_sites() as f64 * PLANNED_BYTES_PER_SITE)
+        .sum();
+    let bytes = held_bytes(scenes.len(), largest, planned);
+    match bytes > MAX_SWEEP_BYTES {
+        false => Ok(()),
+        true => Err(format!(
+            "{} scenes of up to {} sites would take about {:.1} GB in memory, more than the {:.0} GB a call may use; simulate fewer or shorter chains at a time",
+            scenes.len(),
+            largest.scenario.model.n_sites(),
+            bytes / 1e9,
+            MAX_SWEEP_BYTES / 1e9
+        )),
+    }
+}
+
+/// The samples a scene's series records.
+fn samples(scene: &crate::Scene) -> u64 {
     let s = &scene.scenario;
-    let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1;
+    woodpile_sim::integrate::intervals(s.t_end, s.sample_every) + 1
+}
+
+/// What `points` scenes like `scene` (the largest) hold at most, run a batch per thread, with
+/// `planned` bytes held besides.
+fn held_bytes(points: usize, scene: &crate::Scene, planned: f64) -> f64 {
+    let s = &scene.scenario;
     // The workers a run starts: RAYON_NUM_THREADS where set, else one per core.
     let threads = crate::threads::asked_threads()
         .ok()
         .flatten()
         .filter(|&n| n > 0)
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let in_flight = (threads.min(points) * s.model.n_sites()) as f64 * 200.0;
+    let running = points.min(threads.saturating_mul(batch_size(points)));
+    let in_flight = (running * s.model.n_sites()) as f64 * RUNNING_BYTES_PER_SITE;
     let columns = 5 + u64::from(s.region.has_striker());
-    let bytes = points as f64 * (1400.0 + (samples * columns * 8 * 2) as f64) + in_flight;
-    if bytes > MAX_SWEEP_BYTES {
-        return Err(format!(
-            "{points} points of {samples} samples on {} sites would take about {:.1} GB in memory, more than the {:.0} GB a sweep may use; split the grid or sample less often",
-            s.model.n_sites(),
-            bytes / 1e9,
-            MAX_SWEEP_BYTES / 1e9
-        ));
-    }
-    Ok(())
+    points as f64 * (1400.0 + (samples(scene) * columns * 8 * 2) as f64) + in_flight + planned
 }
 
-/// The columns of a sweep's table: one row per sample of each point (or one row with the
-/// reason for a point that failed), after the point's axis values under the axes' names.
-pub mod columns {
-    /// The point's index in the grid.
-    pub const POINT: &str = "point";
-    /// The sample time.
-    pub const TIME: &str = "t";
-    /// The reflected share R.
-    pub const REFLECTED: &str = "R";
-    /// The transmitted share T.
-    pub const TRANSMITTED: &str = "T";
-    /// The trapped share E_tr.
-    pub const TRAPPED: &str = "E_tr";
-    /// The striker's share S (only in sweeps whose scenes have a `[striker]`).
-    pub const STRIKER: &str = "S";
-    /// The dissipated share D (sweeps of scenes with damping).
-    pub const DISSIPATED: &str = "D";
-    /// The total energy (or, for a kinetic series, the kinetic share of the impact energy).
-    pub const ENERGY: &str = "E";
-    /// The method of the reported run.
-    pub const METHOD: &str = "method";
-    /// Its fixed step, if any.
-    pub const DT: &str = "dt";
-    /// Its steps.
-    pub const STEPS: &str = "steps";
-    /// `auto`'s error estimate.
-    pub const ERROR_ESTIMATE: &str = "error_estimate";
-    /// The largest relative energy drift.
-    pub const ENERGY_DRIFT: &str = "energy_drift";
-    /// When the wave first reached an end of the chain (null: not before t_end).
-    pub const END_REACHED_AT: &str = "end_reached_at";
-    /// Why the point failed (null when it did not).
-    pub const FAILURE: &str = "failure";
-    /// The point's cache key.
-    pub const SCENE_KEY: &str = "scene_key";
-}
-
-/// Column names an axis may not take: every column a sweep's table ([`columns`]), a vary
+/// Column names an axis may not take: every column a sweep's table ([`crate::columns`]), a vary
 /// stage or Python's `simulate_many` writes beside the axes, so that no axis value is ever
 /// overwritten by a result of its name, nor a result by an axis.
 pub const RESERVED: &[&str] = &[

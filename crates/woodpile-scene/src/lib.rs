@@ -6,6 +6,7 @@
 //! reason.
 #![warn(missing_docs)]
 
+pub mod columns;
 pub mod grid;
 mod raw;
 pub mod report;

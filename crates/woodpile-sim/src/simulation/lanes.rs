@@ -1,8 +1,8 @@
-//! [`simulate`] of many scenes, four at a time in lanes where they allow it: `auto`'s first
+//! [`simulate`](super::simulate) of many scenes, four at a time in lanes where they allow it: `auto`'s first
 //! pair of runs (2 dt, then dt) made for four scenes together
 //! ([`crate::integrate::lanes`]), then each later rung's fine run made for four ladders at the
 //! same step together, whichever scenes of the batch they verify. Every result is its scene's
-//! [`simulate`] result bit for bit; only the time differs.
+//! [`simulate`](super::simulate) result bit for bit; only the time differs.
 //!
 //! Four scenes take lanes together when each asks for `auto`, plans the same method
 //! (`rkn6-contact`, or `erkn6-contact` for light harmonic resonators) at the same first step,
@@ -31,7 +31,7 @@ pub fn batch_size(n: usize) -> usize {
     LANES * (n / (32 * LANES)).clamp(1, 16)
 }
 
-/// Simulates each of `scenarios` as [`simulate`] does, showing the samples of each one's
+/// Simulates each of `scenarios` as [`simulate`](super::simulate) does, showing the samples of each one's
 /// reported run to its own of `observers` (as many), with groups of four consecutive scenes
 /// that allow it stepped together in lanes, and their ladders' later rungs four at a time.
 pub fn simulate_batch<O: Observer>(
@@ -61,7 +61,7 @@ pub fn simulate_batch<O: Observer>(
 
 /// The first rung of each of `scenarios` (shown to `observers[k]`): each group of four that
 /// can take lanes makes its first pairs there and judges them, any other scene runs
-/// [`simulate`] whole. Each scene's result goes to `results[k]`; returns the ladders that go on.
+/// [`simulate`](super::simulate) whole. Each scene's result goes to `results[k]`; returns the ladders that go on.
 fn first_rungs<'s, O: Observer>(
     scenarios: &[&'s Scenario],
     observers: &mut [O],
