@@ -1,0 +1,9 @@
+//! woodpile-spectrum (in progress).
+#![warn(missing_docs)]
+
+pub mod bands;
+pub mod chain;
+pub mod condense;
+mod error;
+
+pub use error::SpectrumError;
