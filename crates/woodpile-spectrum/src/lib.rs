@@ -7,3 +7,7 @@ pub mod condense;
 mod error;
 
 pub use error::SpectrumError;
+mod matrices;
+pub mod modes;
+pub mod shape;
+pub mod damped;
