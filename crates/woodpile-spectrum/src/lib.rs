@@ -11,3 +11,5 @@ mod matrices;
 pub mod modes;
 pub mod shape;
 pub mod damped;
+pub mod localised;
+mod tridiagonal;
