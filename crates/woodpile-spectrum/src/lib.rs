@@ -13,3 +13,4 @@ pub mod shape;
 pub mod damped;
 pub mod localised;
 mod tridiagonal;
+pub mod transmission;
