@@ -57,8 +57,8 @@ pub enum SpectrumError {
     /// α a δ0^{α−1} is zero (α > 1) or undefined (α = 1, at the kink): the chain is a sonic
     /// vacuum there and has no linear spectrum.
     #[error(
-        "contact {bond} has no static overlap (δ0 = {overlap}): a chain without static load is \
-         a sonic vacuum and has no linear spectrum; a precompression or gravity is needed"
+        "contact {bond} has no static overlap (δ0 = {overlap}): no static load, so the chain is \
+         a sonic vacuum with no linear spectrum; a precompression or gravity is needed"
     )]
     NoStaticLoad {
         /// The bond (0 = left wall, b joins sites b−1 and b).

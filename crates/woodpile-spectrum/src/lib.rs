@@ -14,3 +14,4 @@ pub mod damped;
 pub mod localised;
 mod tridiagonal;
 pub mod transmission;
+pub mod linearise;
