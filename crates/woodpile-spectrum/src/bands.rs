@@ -144,7 +144,9 @@ impl Cell {
             .chain(self.resonators.iter().map(|r| &r.mass))
             .map(|m| 1.0 / m.sqrt())
             .collect();
-        Mat::from_fn(self.n_dof(), self.n_dof(), |i, j| k[(i, j)] * (scale[i] * scale[j]))
+        Mat::from_fn(self.n_dof(), self.n_dof(), |i, j| {
+            k[(i, j)] * (scale[i] * scale[j])
+        })
     }
 
     /// ω_j(q), ascending (eigenvalues of D(q) below 0 by rounding count as 0).
@@ -200,6 +202,19 @@ impl Cell {
                 upper: pair[1].lower,
             })
             .collect())
+    }
+
+    /// Where a finite chain built on this host can have localised modes below `upper` (for
+    /// instance [`crate::chain::LinearChain::frequency_bound`]): the gaps, and the range from the
+    /// top band's upper edge to `upper` when that is higher. The windows to hand to
+    /// [`crate::localised::localised_modes`].
+    pub fn stop_bands(&self, upper: f64) -> Result<Vec<Interval>, SpectrumError> {
+        let mut windows = self.gaps()?;
+        let top = self.pass_bands()?.last().map_or(0.0, |band| band.upper);
+        if upper > top {
+            windows.push(Interval { lower: top, upper });
+        }
+        Ok(windows)
     }
 
     /// The complex wavenumber at angular frequency `omega` ≥ 0, from the cell's 2×2 transfer

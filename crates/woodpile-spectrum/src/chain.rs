@@ -166,7 +166,9 @@ impl LinearChain {
     pub fn is_damped(&self) -> bool {
         let s = &self.spec;
         let any = |v: &[f64]| v.iter().any(|&c| c > 0.0);
-        any(&s.bond_damping) || any(&s.ground_damping) || s.resonators.iter().any(|r| r.damping > 0.0)
+        any(&s.bond_damping)
+            || any(&s.ground_damping)
+            || s.resonators.iter().any(|r| r.damping > 0.0)
     }
 
     /// An upper bound on every undamped eigenfrequency: Gershgorin's bound on
@@ -249,7 +251,10 @@ pub(crate) fn validate_resonator(
 }
 
 /// For each site, the indices of its resonators, as (start offsets, indices) in CSR form.
-pub(crate) fn index_by_site(resonators: &[LinearResonator], n_sites: usize) -> (Vec<usize>, Vec<usize>) {
+pub(crate) fn index_by_site(
+    resonators: &[LinearResonator],
+    n_sites: usize,
+) -> (Vec<usize>, Vec<usize>) {
     let mut start = vec![0; n_sites + 1];
     for r in resonators {
         start[r.site + 1] += 1;
@@ -301,10 +306,16 @@ mod tests {
         ));
         let mut spec = ChainSpec::uniform(4, 1.0, 1.0);
         spec.bond_stiffness[2] = 0.0;
-        assert!(matches!(LinearChain::new(spec), Err(SpectrumError::NotPositive { .. })));
+        assert!(matches!(
+            LinearChain::new(spec),
+            Err(SpectrumError::NotPositive { .. })
+        ));
         let mut spec = ChainSpec::uniform(4, 1.0, 1.0);
         spec.masses[1] = f64::NAN;
-        assert!(matches!(LinearChain::new(spec), Err(SpectrumError::NotPositive { .. })));
+        assert!(matches!(
+            LinearChain::new(spec),
+            Err(SpectrumError::NotPositive { .. })
+        ));
         let mut spec = ChainSpec::uniform(4, 1.0, 1.0);
         spec.resonators.push(resonator(4));
         assert!(matches!(
@@ -313,10 +324,16 @@ mod tests {
         ));
         let mut spec = ChainSpec::uniform(4, 1.0, 1.0);
         spec.ground_damping = vec![0.1; 3];
-        assert!(matches!(LinearChain::new(spec), Err(SpectrumError::Length { .. })));
+        assert!(matches!(
+            LinearChain::new(spec),
+            Err(SpectrumError::Length { .. })
+        ));
         let mut spec = ChainSpec::uniform(4, 1.0, 1.0);
         spec.bond_damping = vec![-0.1; 5];
-        assert!(matches!(LinearChain::new(spec), Err(SpectrumError::Negative { .. })));
+        assert!(matches!(
+            LinearChain::new(spec),
+            Err(SpectrumError::Negative { .. })
+        ));
     }
 
     #[test]

@@ -150,7 +150,8 @@ mod tests {
         let modes = damped_modes(&LinearChain::new(spec).unwrap()).unwrap();
         assert_eq!(modes.len(), n);
         for (j, mode) in modes.iter().enumerate() {
-            let omega_k = 2.0 * (k / m).sqrt() * ((j + 1) as f64 * PI / (2.0 * (n + 1) as f64)).sin();
+            let omega_k =
+                2.0 * (k / m).sqrt() * ((j + 1) as f64 * PI / (2.0 * (n + 1) as f64)).sin();
             let omega_d = (omega_k * omega_k - a * a / 4.0).sqrt();
             assert!((mode.decay_rate() - a / 2.0).abs() < 1e-10, "mode {j}");
             assert!((mode.omega() - omega_d).abs() < 1e-10 * omega_d, "mode {j}");
@@ -185,7 +186,8 @@ mod tests {
 
     #[test]
     fn refuses_beyond_the_dense_limit() {
-        let chain = LinearChain::new(ChainSpec::uniform(MAX_DENSE_ORDER / 2 + 1, 1.0, 1.0)).unwrap();
+        let chain =
+            LinearChain::new(ChainSpec::uniform(MAX_DENSE_ORDER / 2 + 1, 1.0, 1.0)).unwrap();
         assert!(matches!(
             damped_modes(&chain),
             Err(SpectrumError::TooLargeForDense { .. })

@@ -131,7 +131,9 @@ pub enum SpectrumError {
         cutoff: f64,
     },
     /// A scattering region one of whose end bonds is zero: it is not coupled to that lead.
-    #[error("the scattering region's {side} end bond is zero: it is not coupled to the {side} lead")]
+    #[error(
+        "the scattering region's {side} end bond is zero: it is not coupled to the {side} lead"
+    )]
     Detached {
         /// "left" or "right".
         side: &'static str,

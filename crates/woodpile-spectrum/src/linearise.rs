@@ -108,12 +108,9 @@ fn bonds(model: &Model, overlaps: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Spectr
     let boundary = model.boundary();
     let mut pairs = Vec::with_capacity(n + 1);
     pairs.push(end(boundary.left(), 0));
-    for bond in 1..n {
-        if overlaps[bond] == 0.0 {
-            return Err(SpectrumError::NoStaticLoad {
-                bond,
-                overlap: overlaps[bond],
-            });
+    for (bond, &overlap) in overlaps.iter().enumerate().take(n).skip(1) {
+        if overlap == 0.0 {
+            return Err(SpectrumError::NoStaticLoad { bond, overlap });
         }
         pairs.push(contact(bond));
     }

@@ -62,7 +62,10 @@ pub fn localised_modes(
     }
     if indices.len() > MAX_LOCALISED {
         return Err(SpectrumError::TooManyModes {
-            lower: windows.iter().map(|w| w.lower).fold(f64::INFINITY, f64::min),
+            lower: windows
+                .iter()
+                .map(|w| w.lower)
+                .fold(f64::INFINITY, f64::min),
             upper: windows.iter().map(|w| w.upper).fold(0.0, f64::max),
             count: indices.len(),
             limit: MAX_LOCALISED,
@@ -132,10 +135,17 @@ fn inverse_iteration(
 /// Removes from `x` its M-projection on each vector of `basis`.
 fn orthogonalise(x: &mut [f64], basis: &[&[f64]], masses: &[f64]) {
     for b in basis {
-        let dot: f64 = x.iter().zip(b.iter()).zip(masses).map(|((x, b), m)| x * b * m).sum();
+        let dot: f64 = x
+            .iter()
+            .zip(b.iter())
+            .zip(masses)
+            .map(|((x, b), m)| x * b * m)
+            .sum();
         let norm: f64 = b.iter().zip(masses).map(|(b, m)| b * b * m).sum();
         if norm > 0.0 {
-            x.iter_mut().zip(b.iter()).for_each(|(x, b)| *x -= dot / norm * b);
+            x.iter_mut()
+                .zip(b.iter())
+                .for_each(|(x, b)| *x -= dot / norm * b);
         }
     }
 }
@@ -146,7 +156,9 @@ fn start_vector(len: usize, seed: usize) -> Vec<f64> {
     let mut state = 0x9E37_79B9_7F4A_7C15_u64 ^ (seed as u64).wrapping_mul(0xD1B5_4A32_D192_ED03);
     (0..len)
         .map(|_| {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
             0.5 + (state >> 11) as f64 / (1u64 << 53) as f64
         })
         .collect()

@@ -42,10 +42,13 @@ impl Mode {
     /// over the first `n_sites` entries.
     pub(crate) fn new(omega: f64, mut shape: Vec<f64>, dof_masses: &[f64], n_sites: usize) -> Mode {
         let norm: f64 = shape.iter().zip(dof_masses).map(|(v, m)| m * v * v).sum();
-        let largest = shape.iter().copied().fold(0.0, |a: f64, v| match v.abs() > a.abs() {
-            true => v,
-            false => a,
-        });
+        let largest = shape
+            .iter()
+            .copied()
+            .fold(0.0, |a: f64, v| match v.abs() > a.abs() {
+                true => v,
+                false => a,
+            });
         let scale = largest.signum() / norm.sqrt();
         shape.iter_mut().for_each(|v| *v *= scale);
         let weights: Vec<f64> = shape[..n_sites].iter().map(|u| u * u).collect();

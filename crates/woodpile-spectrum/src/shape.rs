@@ -61,7 +61,7 @@ fn length_of_participation(participation: f64) -> f64 {
         let f = 2.0 * c * c * c - p * c * c - p;
         let slope = 6.0 * c * c - 2.0 * p * c;
         let next = c - f / slope;
-        if !(next < c) {
+        if next.is_nan() || next >= c {
             break;
         }
         c = next;
@@ -94,7 +94,11 @@ mod tests {
                 .collect();
             let got = localisation(&weights);
             assert_eq!(got.peak_site, half);
-            assert!((got.length - xi).abs() < 1e-10 * xi, "ξ {xi}: {}", got.length);
+            assert!(
+                (got.length - xi).abs() < 1e-10 * xi,
+                "ξ {xi}: {}",
+                got.length
+            );
         }
     }
 }

@@ -42,7 +42,8 @@ impl<'a> Condensed<'a> {
             .collect();
         let diagonal = (0..chain.n_sites())
             .map(|site| {
-                let mut d = chain.stiffness(site) + chain.stiffness(site + 1) - sigma * chain.mass(site);
+                let mut d =
+                    chain.stiffness(site) + chain.stiffness(site + 1) - sigma * chain.mass(site);
                 for &j in chain.resonators_on(site) {
                     let k = chain.resonators()[j].stiffness;
                     d += k - k * k / pivots[j];
@@ -88,9 +89,10 @@ impl<'a> Condensed<'a> {
         // Right-hand side of the sites after eliminating the resonators.
         let mut b: Vec<f64> = (0..n)
             .map(|site| {
-                let folded = chain.resonators_on(site).iter().map(|&j| {
-                    resonators[j].stiffness * rhs[n + j] / self.pivots[j]
-                });
+                let folded = chain
+                    .resonators_on(site)
+                    .iter()
+                    .map(|&j| resonators[j].stiffness * rhs[n + j] / self.pivots[j]);
                 rhs[site] + folded.sum::<f64>()
             })
             .collect();
@@ -110,7 +112,13 @@ impl<'a> Condensed<'a> {
 /// Solves T x = b in place for the tridiagonal T with diagonal `d`, subdiagonal `dl`
 /// (dl[i] = T[i+1][i]) and superdiagonal `du` (du[i] = T[i][i+1]), by Gaussian elimination with
 /// partial pivoting as LAPACK `dgtsv`; a zero pivot is replaced by `epsilon`.
-fn solve_tridiagonal(mut d: Vec<f64>, mut dl: Vec<f64>, mut du: Vec<f64>, b: &mut [f64], epsilon: f64) {
+fn solve_tridiagonal(
+    mut d: Vec<f64>,
+    mut dl: Vec<f64>,
+    mut du: Vec<f64>,
+    b: &mut [f64],
+    epsilon: f64,
+) {
     let n = d.len();
     for i in 0..n.saturating_sub(1) {
         if d[i].abs() >= dl[i].abs() {
@@ -180,7 +188,11 @@ mod tests {
         // ω_k² = 4 (K/m) sin²(kπ / (2(N+1))), k = 1..N.
         let (n, m, k) = (30, 1.0, 1.0);
         let chain = LinearChain::new(ChainSpec::uniform(n, m, k)).unwrap();
-        let omega2 = |j: usize| 4.0 * (j as f64 * std::f64::consts::PI / (2.0 * (n + 1) as f64)).sin().powi(2);
+        let omega2 = |j: usize| {
+            4.0 * (j as f64 * std::f64::consts::PI / (2.0 * (n + 1) as f64))
+                .sin()
+                .powi(2)
+        };
         for j in 0..=n {
             let sigma = match j {
                 0 => 0.5 * omega2(1),
@@ -197,21 +209,42 @@ mod tests {
         spec.masses[2] = 0.4;
         spec.bond_stiffness[0] = 0.0;
         spec.resonators = vec![
-            LinearResonator { site: 3, mass: 0.5, stiffness: 0.7, damping: 0.0 },
-            LinearResonator { site: 3, mass: 0.2, stiffness: 1.9, damping: 0.0 },
-            LinearResonator { site: 6, mass: 1.5, stiffness: 0.3, damping: 0.0 },
+            LinearResonator {
+                site: 3,
+                mass: 0.5,
+                stiffness: 0.7,
+                damping: 0.0,
+            },
+            LinearResonator {
+                site: 3,
+                mass: 0.2,
+                stiffness: 1.9,
+                damping: 0.0,
+            },
+            LinearResonator {
+                site: 6,
+                mass: 1.5,
+                stiffness: 0.3,
+                damping: 0.0,
+            },
         ];
         let chain = LinearChain::new(spec).unwrap();
         let k = matrices::stiffness(&chain);
         let masses = chain.dof_masses();
-        let rhs: Vec<f64> = (0..chain.n_dof()).map(|i| (i as f64 * 0.77).sin() + 0.3).collect();
+        let rhs: Vec<f64> = (0..chain.n_dof())
+            .map(|i| (i as f64 * 0.77).sin() + 0.3)
+            .collect();
         // Shifts below, between and above the resonators' own frequencies.
         for sigma in [0.1, 0.9, 1.7, 5.0] {
             let x = Condensed::new(&chain, sigma).solve(&rhs);
             for i in 0..chain.n_dof() {
                 let row: f64 = (0..chain.n_dof()).map(|j| k[(i, j)] * x[j]).sum::<f64>()
                     - sigma * masses[i] * x[i];
-                assert!((row - rhs[i]).abs() < 1e-11, "σ {sigma}, row {i}: {row} vs {}", rhs[i]);
+                assert!(
+                    (row - rhs[i]).abs() < 1e-11,
+                    "σ {sigma}, row {i}: {row} vs {}",
+                    rhs[i]
+                );
             }
         }
     }

@@ -23,7 +23,11 @@ fn monatomic_dispersion_and_cutoff() {
     let bands = cell.bands(33).unwrap();
     for (q, omega) in bands.q.iter().zip(&bands.omega) {
         let expected = 2.0 * (k / m).sqrt() * (q / 2.0).sin().abs();
-        assert!(close(omega[0], expected, 1e-10), "q {q}: {} vs {expected}", omega[0]);
+        assert!(
+            close(omega[0], expected, 1e-10),
+            "q {q}: {} vs {expected}",
+            omega[0]
+        );
     }
     let cutoff = 2.0 * (k / m).sqrt();
     let pass = cell.pass_bands().unwrap();
@@ -42,7 +46,10 @@ fn diatomic_dispersion_and_gap_edges() {
         let q = PI * f64::from(i) / 20.0;
         let root = (s * s - 4.0 * (q / 2.0).sin().powi(2) / (m1 * m2)).sqrt();
         let omega = cell.frequencies(q).unwrap();
-        assert!(close(omega[0], (k * (s - root)).max(0.0).sqrt(), 1e-10), "q {q}");
+        assert!(
+            close(omega[0], (k * (s - root)).max(0.0).sqrt(), 1e-10),
+            "q {q}"
+        );
         assert!(close(omega[1], (k * (s + root)).sqrt(), 1e-10), "q {q}");
     }
     let gaps = cell.gaps().unwrap();
@@ -74,7 +81,12 @@ fn mass_in_mass_dispersion_and_gap() {
         let lower = 2.0 * c / (b + disc);
         let upper = (b + disc) / (2.0 * a);
         let omega = cell.frequencies(q).unwrap();
-        assert!(close(omega[0], lower.sqrt(), 1e-10), "q {q}: {} vs {}", omega[0], lower.sqrt());
+        assert!(
+            close(omega[0], lower.sqrt(), 1e-10),
+            "q {q}: {} vs {}",
+            omega[0],
+            lower.sqrt()
+        );
         assert!(close(omega[1], upper.sqrt(), 1e-10), "q {q}");
     }
     let omega0 = (k2 / m2).sqrt();
@@ -92,11 +104,19 @@ fn wavenumbers_in_bands_and_gaps() {
     let (m, k) = (1.7, 2.3);
     let cell = Cell::new(vec![m], vec![k], vec![]).unwrap();
     let inside = cell.wavenumber(1.1).unwrap();
-    assert!(close(inside.q, (1.0 - 1.1f64.powi(2) * m / (2.0 * k)).acos(), 1e-12));
+    assert!(close(
+        inside.q,
+        (1.0 - 1.1f64.powi(2) * m / (2.0 * k)).acos(),
+        1e-12
+    ));
     assert_eq!(inside.attenuation, 0.0);
     let above = cell.wavenumber(3.0).unwrap();
     assert_eq!(above.q, PI);
-    assert!(close(above.attenuation, (9.0 * m / (2.0 * k) - 1.0).acosh(), 1e-12));
+    assert!(close(
+        above.attenuation,
+        (9.0 * m / (2.0 * k) - 1.0).acosh(),
+        1e-12
+    ));
 
     // Diatomic: cos q = (2K − m1 ω²)(2K − m2 ω²)/(2K²) − 1, below −1 in the gap.
     let (m1, m2, k) = (1.0, 3.0, 2.0);
@@ -124,7 +144,10 @@ fn wavenumbers_in_bands_and_gaps() {
 
 #[test]
 fn refuses_bad_cells() {
-    assert_eq!(Cell::new(vec![], vec![], vec![]), Err(SpectrumError::EmptyChain));
+    assert_eq!(
+        Cell::new(vec![], vec![], vec![]),
+        Err(SpectrumError::EmptyChain)
+    );
     assert!(matches!(
         Cell::new(vec![1.0], vec![1.0, 1.0], vec![]),
         Err(SpectrumError::Length { .. })
@@ -138,6 +161,24 @@ fn refuses_bad_cells() {
         Err(SpectrumError::DampedCell { resonator: 0 })
     );
     let cell = Cell::new(vec![1.0], vec![1.0], vec![]).unwrap();
-    assert_eq!(cell.bands(1), Err(SpectrumError::TooFewWavenumbers { n_q: 1 }));
+    assert_eq!(
+        cell.bands(1),
+        Err(SpectrumError::TooFewWavenumbers { n_q: 1 })
+    );
     assert!(cell.wavenumber(-1.0).is_err());
+}
+
+#[test]
+fn stop_bands_add_the_range_above_the_top_band() {
+    let (m1, m2, k) = (1.0, 3.0, 2.0);
+    let cell = Cell::new(vec![m1, m2], vec![k, k], vec![]).unwrap();
+    let windows = cell.stop_bands(10.0).unwrap();
+    assert_eq!(windows.len(), 2);
+    assert!(close(
+        windows[1].lower,
+        (2.0 * k * (1.0 / m1 + 1.0 / m2)).sqrt(),
+        1e-10
+    ));
+    assert_eq!(windows[1].upper, 10.0);
+    assert_eq!(cell.stop_bands(1.0).unwrap().len(), 1);
 }

@@ -31,7 +31,9 @@ fn the_papers_chain_from_given_overlaps() {
     let masses = Some(vec![1.0, 2.0, 0.5]);
     let boundary = Boundary::ends(End::Free, End::Fixed);
     let model = Model::with_masses(3, boundary, vec![], masses).unwrap();
-    let chain = linearise(&model, &[0.3, 0.04, 0.09, 0.16], 0.0).unwrap().chain;
+    let chain = linearise(&model, &[0.3, 0.04, 0.09, 0.16], 0.0)
+        .unwrap()
+        .chain;
     assert_eq!(chain.stiffness(0), 0.0);
     assert!(close(chain.stiffness(1), 1.5 * 0.2));
     assert!(close(chain.stiffness(2), 1.5 * 0.3));
@@ -97,7 +99,10 @@ fn resonators_dashpots_and_soft_ends() {
     assert_eq!(chain.ground_damping(2), 0.01);
     let r = chain.resonators();
     assert_eq!(r.len(), 2);
-    assert_eq!((r[0].site, r[0].mass, r[0].stiffness, r[0].damping), (1, 0.5, 2.0, 0.1));
+    assert_eq!(
+        (r[0].site, r[0].mass, r[0].stiffness, r[0].damping),
+        (1, 0.5, 2.0, 0.1)
+    );
     // The ramp is at its midpoint at t0.
     assert!(close(r[1].stiffness, 2.0));
     assert_eq!(r[1].damping, 0.3);

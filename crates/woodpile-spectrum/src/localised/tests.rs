@@ -43,7 +43,12 @@ fn agrees_with_the_dense_solver() {
     let sparse = localised_modes(&chain, &everything(&chain)).unwrap();
     assert_eq!(sparse.len(), chain.n_dof());
     for (j, (d, s)) in dense.iter().zip(&sparse).enumerate() {
-        assert!(close(s.omega, d.omega, 1e-10), "mode {j}: {} vs {}", s.omega, d.omega);
+        assert!(
+            close(s.omega, d.omega, 1e-10),
+            "mode {j}: {} vs {}",
+            s.omega,
+            d.omega
+        );
         for (a, b) in d.shape.iter().zip(&s.shape) {
             assert!((a - b).abs() < 1e-8, "mode {j}");
         }
@@ -88,7 +93,9 @@ fn two_distant_identical_defects_give_two_modes() {
     assert_eq!(modes.len(), 2);
     let expected = (4.0 / (light * (2.0 - light))).sqrt();
     let masses = chain.dof_masses();
-    let dot: f64 = (0..n).map(|i| masses[i] * modes[0].shape[i] * modes[1].shape[i]).sum();
+    let dot: f64 = (0..n)
+        .map(|i| masses[i] * modes[0].shape[i] * modes[1].shape[i])
+        .sum();
     assert!(dot.abs() < 1e-8, "{dot}");
     for mode in &modes {
         assert!(close(mode.omega, expected, 1e-12));
@@ -107,7 +114,10 @@ fn two_distant_identical_defects_give_two_modes() {
 fn a_missing_resonator_in_a_mass_in_mass_host() {
     let (n, centre, m1, m2, k2, k) = (401, 200, 1.0, 0.8, 1.0, 1.0);
     let mut spec = ChainSpec::uniform(n, m1, k);
-    spec.resonators = (0..n).filter(|&s| s != centre).map(|s| resonator(s, m2, k2)).collect();
+    spec.resonators = (0..n)
+        .filter(|&s| s != centre)
+        .map(|s| resonator(s, m2, k2))
+        .collect();
     let chain = LinearChain::new(spec).unwrap();
     let host = Cell::new(vec![m1], vec![k], vec![resonator(0, m2, k2)]).unwrap();
     let gaps = host.gaps().unwrap();
@@ -120,7 +130,11 @@ fn a_missing_resonator_in_a_mass_in_mass_host() {
         let ratio = mode.shape[centre + 1] / mode.shape[centre];
         if mode.omega < omega0 {
             let x = m1 / (2.0 * big_m - m1);
-            assert!(close(w2, 4.0 * k * big_m / (m1 * (2.0 * big_m - m1)), 1e-10));
+            assert!(close(
+                w2,
+                4.0 * k * big_m / (m1 * (2.0 * big_m - m1)),
+                1e-10
+            ));
             assert!(close(ratio, -x, 1e-8), "{ratio} vs {}", -x);
         } else {
             let x = m1 / (m1 - 2.0 * big_m);
@@ -148,7 +162,10 @@ fn refuses_bad_windows_and_band_windows() {
     }];
     assert!(matches!(
         localised_modes(&chain, &band),
-        Err(SpectrumError::TooManyModes { limit: MAX_LOCALISED, .. })
+        Err(SpectrumError::TooManyModes {
+            limit: MAX_LOCALISED,
+            ..
+        })
     ));
     assert_eq!(count_below(&chain, 3.0), 1000);
     assert_eq!(count_below(&chain, 0.0), 0);

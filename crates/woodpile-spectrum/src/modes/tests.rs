@@ -19,7 +19,11 @@ fn uniform_chain_between_walls() {
     for (j, mode) in modes.iter().enumerate() {
         let kk = (j + 1) as f64;
         let expected = 2.0 * (k / m).sqrt() * (kk * PI / (2.0 * n1)).sin();
-        assert!(close(mode.omega, expected, 1e-10), "mode {j}: {} vs {expected}", mode.omega);
+        assert!(
+            close(mode.omega, expected, 1e-10),
+            "mode {j}: {} vs {expected}",
+            mode.omega
+        );
         // v_n = ±sqrt(2 / (m (N + 1))) sin(k n π / (N + 1)), n = 1..N.
         let amplitude = (2.0 / (m * n1)).sqrt();
         let sign = mode.shape[0].signum() / (kk * PI / n1).sin().signum();
@@ -54,14 +58,21 @@ fn light_mass_defect_is_localised() {
     let modes = normal_modes(&LinearChain::new(spec).unwrap()).unwrap();
     let top = &modes[n - 1];
     let expected = (4.0 * k * m / (light * (2.0 * m - light))).sqrt();
-    assert!(close(top.omega, expected, 1e-10), "{} vs {expected}", top.omega);
+    assert!(
+        close(top.omega, expected, 1e-10),
+        "{} vs {expected}",
+        top.omega
+    );
     assert!(top.omega > 2.0 * (k / m).sqrt());
     let x = light / (2.0 * m - light);
     assert_eq!(top.localisation.peak_site, 40);
     assert!(close(top.localisation.length, -1.0 / x.ln(), 1e-10));
     for offset in 1..8 {
         let ratio = top.shape[40 + offset] / top.shape[40];
-        assert!(close(ratio, (-x).powi(offset as i32), 1e-9), "offset {offset}");
+        assert!(
+            close(ratio, (-x).powi(offset as i32), 1e-9),
+            "offset {offset}"
+        );
     }
     // Every other mode lies in the host band.
     assert!(modes[..n - 1].iter().all(|mode| mode.omega < 2.0));

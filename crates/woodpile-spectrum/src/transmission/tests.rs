@@ -48,7 +48,11 @@ fn a_mass_defect() {
     let region = LinearChain::new(spec).unwrap();
     for s in scatter(&lead, &region, &band(&lead, 40)).unwrap() {
         let (t, r) = one_site(&lead, s.omega, c64::new(1.7, 0.0));
-        assert!((s.transmission - t).norm() < 1e-10 * t.norm(), "ω {}", s.omega);
+        assert!(
+            (s.transmission - t).norm() < 1e-10 * t.norm(),
+            "ω {}",
+            s.omega
+        );
         assert!((s.reflection - r).norm() < 1e-10);
         let beta = 1.7 * s.omega.powi(2) / (2.0 * 2.0 * lead.wavenumber(s.omega).unwrap().sin());
         assert!((s.transmittance() - 1.0 / (1.0 + beta * beta)).abs() < 1e-10);
@@ -69,7 +73,11 @@ fn a_resonator_defect_and_its_zero() {
     for s in scatter(&lead, &region, &omegas).unwrap() {
         let extra = m2 * omega0 * omega0 / (omega0 * omega0 - s.omega * s.omega);
         let (t, r) = one_site(&lead, s.omega, c64::new(extra, 0.0));
-        assert!((s.transmission - t).norm() < 1e-10 * t.norm().max(1e-3), "ω {}", s.omega);
+        assert!(
+            (s.transmission - t).norm() < 1e-10 * t.norm().max(1e-3),
+            "ω {}",
+            s.omega
+        );
         assert!((s.reflection - r).norm() < 1e-10);
         assert!(s.absorbance().abs() < 1e-12);
     }
@@ -92,7 +100,11 @@ fn a_damped_resonator_absorbs() {
         let k = c64::new(k2, -s.omega * c2);
         let extra = m2 * k / (k - m2 * s.omega * s.omega);
         let (t, r) = one_site(&lead, s.omega, extra);
-        assert!((s.transmission - t).norm() < 1e-10 * t.norm(), "ω {}", s.omega);
+        assert!(
+            (s.transmission - t).norm() < 1e-10 * t.norm(),
+            "ω {}",
+            s.omega
+        );
         assert!((s.reflection - r).norm() < 1e-10);
         assert!(s.absorbance() > 0.0);
         assert!((s.log_transmission - t.norm().ln()).abs() < 1e-10);
@@ -114,7 +126,12 @@ fn energy_is_conserved_without_damping() {
     ];
     let region = LinearChain::new(spec).unwrap();
     for s in scatter(&lead, &region, &band(&lead, 300)).unwrap() {
-        assert!(s.absorbance().abs() < 1e-10, "ω {}: {}", s.omega, s.absorbance());
+        assert!(
+            s.absorbance().abs() < 1e-10,
+            "ω {}: {}",
+            s.omega,
+            s.absorbance()
+        );
     }
 }
 
@@ -139,7 +156,10 @@ fn transmission_through_a_long_region_decays_at_the_gap_rate() {
     };
     let (short, long) = (log_t(200), log_t(700));
     assert!(long < -1000.0, "{long}: below what f64 holds of |t| itself");
-    assert!(((short - long) / 500.0 - kappa).abs() < 1e-10 * kappa, "{short} {long} {kappa}");
+    assert!(
+        ((short - long) / 500.0 - kappa).abs() < 1e-10 * kappa,
+        "{short} {long} {kappa}"
+    );
 }
 
 #[test]
