@@ -6,7 +6,8 @@
 //! ([`crate::tridiagonal`]), to a few ulps of σ = ω²; each shape from inverse iteration at that
 //! σ with the same O(n) solve, M-orthogonalised against the modes already found in a cluster of
 //! (nearly) equal eigenvalues, as LAPACK's `dstein` does, so that two identical defects far
-//! apart still give two independent modes. Shapes are normalised as [`crate::modes`]'s.
+//! apart still give two independent modes; such a cluster is then rotated into its most localised
+//! basis ([`crate::shape`]), one mode per defect. Shapes are normalised as [`crate::modes`]'s.
 
 use std::collections::BTreeSet;
 
@@ -14,6 +15,7 @@ use crate::bands::Interval;
 use crate::chain::LinearChain;
 use crate::error::SpectrumError;
 use crate::modes::Mode;
+use crate::shape::localise_cluster;
 use crate::tridiagonal::Condensed;
 
 /// The most modes one search returns: a window holding more overlaps a pass band, where the
@@ -85,10 +87,34 @@ pub fn localised_modes(
         found.push((sigma, shape));
     }
     let n = chain.n_sites();
-    Ok(found
+    let (sigmas, mut shapes): (Vec<f64>, Vec<Vec<f64>>) = found.into_iter().unzip();
+    for cluster in clusters(&sigmas) {
+        localise_cluster(&mut shapes[cluster], &masses, n);
+    }
+    Ok(sigmas
         .into_iter()
+        .zip(shapes)
         .map(|(sigma, shape)| Mode::new(sigma.max(0.0).sqrt(), shape, &masses, n))
         .collect())
+}
+
+/// The ranges of consecutive ascending eigenvalues closer than [`CLUSTER`] (relative) to their
+/// neighbour, of two or more members.
+pub(crate) fn clusters(sigmas: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let mut ranges = Vec::new();
+    let mut first = 0;
+    for i in 1..=sigmas.len() {
+        let joined = i < sigmas.len()
+            && (sigmas[i] - sigmas[i - 1]).abs()
+                <= CLUSTER * sigmas[i].abs().max(f64::MIN_POSITIVE);
+        if !joined {
+            if i - first > 1 {
+                ranges.push(first..i);
+            }
+            first = i;
+        }
+    }
+    ranges
 }
 
 /// σ_index (0-based, ascending) by bisection between 0 and `upper` (above every eigenvalue),

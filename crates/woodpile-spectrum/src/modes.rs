@@ -3,7 +3,8 @@
 //! diagonal) and solved by faer's self-adjoint eigensolver.
 //!
 //! Normalisation: v = M^{-1/2} y is mass-normalised, v^T M v = 1, and its entry of largest
-//! magnitude is positive. Frequencies are angular, ascending; an eigenvalue below zero by
+//! magnitude is positive; modes whose ω² agree to 1e-8 relative (identical defects far apart)
+//! are rotated into their most localised basis ([`crate::shape`]). Frequencies are angular, ascending; an eigenvalue below zero by
 //! rounding (the rigid mode of a chain free at both ends) gives ω = 0. Dashpots are ignored
 //! here; [`crate::damped`] keeps them.
 //!
@@ -16,13 +17,14 @@ use faer::{Mat, Side};
 use crate::bands::Interval;
 use crate::chain::LinearChain;
 use crate::error::SpectrumError;
+use crate::localised::clusters;
 use crate::matrices;
-use crate::shape::{localisation, Localisation};
+use crate::shape::{localisation, localise_cluster, Localisation};
 
 /// The largest order of a matrix the dense solvers decompose: the degrees of freedom for
 /// [`normal_modes`], twice that for [`crate::damped::damped_modes`]. At 2048 a matrix and its
-/// eigenvectors take 2 × 32 MiB and the decomposition a few seconds on one core; a chain of
-/// 10,000 sites (800 MiB per matrix, minutes) is refused.
+/// eigenvectors take 2 × 32 MiB, and the decomposition takes seconds on one core (measured by
+/// `examples/scale.rs`); a chain of 10,000 sites (800 MiB per matrix, minutes) is refused.
 pub const MAX_DENSE_ORDER: usize = 2048;
 
 /// One undamped normal mode.
@@ -89,11 +91,17 @@ pub fn normal_modes(chain: &LinearChain) -> Result<Vec<Mode>, SpectrumError> {
             what: "reduced stiffness M^-1/2 K M^-1/2",
         })?;
     let (values, vectors) = (eigen.S().column_vector(), eigen.U());
-    Ok((0..order)
-        .map(|j| {
-            let shape = (0..order).map(|i| vectors[(i, j)] * scale[i]).collect();
-            Mode::new(values[j].max(0.0).sqrt(), shape, &masses, chain.n_sites())
-        })
+    let sigmas: Vec<f64> = values.iter().copied().collect();
+    let mut shapes: Vec<Vec<f64>> = (0..order)
+        .map(|j| (0..order).map(|i| vectors[(i, j)] * scale[i]).collect())
+        .collect();
+    for cluster in clusters(&sigmas) {
+        localise_cluster(&mut shapes[cluster], &masses, chain.n_sites());
+    }
+    Ok(sigmas
+        .into_iter()
+        .zip(shapes)
+        .map(|(sigma, shape)| Mode::new(sigma.max(0.0).sqrt(), shape, &masses, chain.n_sites()))
         .collect())
 }
 

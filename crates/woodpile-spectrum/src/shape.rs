@@ -70,9 +70,90 @@ fn length_of_participation(participation: f64) -> f64 {
     1.0 / (1.0 / c).atanh()
 }
 
+/// Rotates a cluster of (numerically) degenerate mode shapes, M-orthonormal, into the most
+/// localised basis of the same span, by the selected columns of the density matrix (Damle, Lin
+/// and Ying, J. Chem. Theory Comput. 11, 1463 (2015)): with Y = M^{1/2} V (orthonormal
+/// columns), a column-pivoted QR of Y^T picks one site per vector, the site most represented
+/// in what is left of the span; each new vector is the projection of that site's unit vector
+/// onto the span, Y Y^T e_s, M-orthonormalised in pivot order. For identical defects far apart,
+/// whose modes agree to rounding so that any basis of their span is what an eigensolver
+/// returns, this gives one mode per defect instead of arbitrary mixtures.
+pub(crate) fn localise_cluster(shapes: &mut [Vec<f64>], masses: &[f64], n_sites: usize) {
+    let k = shapes.len();
+    if k < 2 {
+        return;
+    }
+    let root: Vec<f64> = masses.iter().map(|m| m.sqrt()).collect();
+    let y: Vec<Vec<f64>> = shapes
+        .iter()
+        .map(|v| v.iter().zip(&root).map(|(v, r)| v * r).collect())
+        .collect();
+    // Pivoted QR on the columns (sites) of Y^T: `residual[s]` holds column s with the chosen
+    // directions projected out.
+    let mut residual: Vec<Vec<f64>> = (0..n_sites)
+        .map(|s| y.iter().map(|v| v[s]).collect())
+        .collect();
+    let mut pivots = Vec::with_capacity(k);
+    for _ in 0..k {
+        let norm = |c: &Vec<f64>| c.iter().map(|x| x * x).sum::<f64>();
+        let Some(best) =
+            (0..n_sites).max_by(|&a, &b| norm(&residual[a]).total_cmp(&norm(&residual[b])))
+        else {
+            return;
+        };
+        let size = norm(&residual[best]).sqrt();
+        if size == 0.0 {
+            return;
+        }
+        let q: Vec<f64> = residual[best].iter().map(|x| x / size).collect();
+        for column in residual.iter_mut() {
+            let dot: f64 = column.iter().zip(&q).map(|(c, q)| c * q).sum();
+            column.iter_mut().zip(&q).for_each(|(c, q)| *c -= dot * q);
+        }
+        pivots.push(best);
+    }
+    let mut basis: Vec<Vec<f64>> = Vec::with_capacity(k);
+    for &s in &pivots {
+        let mut w = vec![0.0; masses.len()];
+        for v in &y {
+            w.iter_mut().zip(v).for_each(|(w, x)| *w += v[s] * x);
+        }
+        for b in &basis {
+            let dot: f64 = w.iter().zip(b).map(|(w, b)| w * b).sum();
+            w.iter_mut().zip(b).for_each(|(w, b)| *w -= dot * b);
+        }
+        let size = w.iter().map(|x| x * x).sum::<f64>().sqrt();
+        w.iter_mut().for_each(|x| *x /= size);
+        basis.push(w);
+    }
+    for (shape, w) in shapes.iter_mut().zip(basis) {
+        *shape = w.iter().zip(&root).map(|(w, r)| w / r).collect();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_mixed_pair_is_rotated_back_onto_its_two_sites() {
+        // Two unit vectors on sites 1 and 4, mixed at 45° (unit masses).
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let mut shapes = vec![
+            vec![0.0, h, 0.0, 0.0, h, 0.0],
+            vec![0.0, h, 0.0, 0.0, -h, 0.0],
+        ];
+        localise_cluster(&mut shapes, &[1.0; 6], 6);
+        let peaks: Vec<usize> = shapes
+            .iter()
+            .map(|v| localisation(&v.iter().map(|x| x * x).collect::<Vec<_>>()).peak_site)
+            .collect();
+        assert!(peaks == [1, 4] || peaks == [4, 1], "{peaks:?}");
+        for v in &shapes {
+            assert!((v.iter().map(|x| x * x).sum::<f64>() - 1.0).abs() < 1e-14);
+            assert_eq!(v.iter().filter(|x| x.abs() > 1e-14).count(), 1);
+        }
+    }
 
     #[test]
     fn one_site_and_uniform_modes() {

@@ -118,3 +118,23 @@ fn refuses_dense_problems_beyond_the_limit() {
         })
     );
 }
+
+#[test]
+fn distant_identical_defects_give_one_mode_each() {
+    // Splitting ~ 3^{-300}: degenerate to rounding, so the eigensolver's basis is arbitrary
+    // until rotated.
+    let (n, light) = (401, 0.5);
+    let mut spec = ChainSpec::uniform(n, 1.0, 1.0);
+    spec.masses[50] = light;
+    spec.masses[350] = light;
+    let modes = normal_modes(&LinearChain::new(spec).unwrap()).unwrap();
+    let mut peaks: Vec<usize> = modes[n - 2..]
+        .iter()
+        .map(|mode| {
+            assert!(close(mode.localisation.length, 1.0 / 3f64.ln(), 1e-8));
+            mode.localisation.peak_site
+        })
+        .collect();
+    peaks.sort_unstable();
+    assert_eq!(peaks, [50, 350]);
+}
