@@ -52,11 +52,11 @@ pub fn localised_modes(
             });
         }
         let (first, end) = (count_below(chain, w.lower), count_below(chain, w.upper));
-        if end - first > MAX_LOCALISED {
+        if end.saturating_sub(first) > MAX_LOCALISED {
             return Err(SpectrumError::TooManyModes {
                 lower: w.lower,
                 upper: w.upper,
-                count: end - first,
+                count: end.saturating_sub(first),
                 limit: MAX_LOCALISED,
             });
         }
