@@ -6,7 +6,7 @@
 //! The pieces:
 //! - [`chain`]: [`LinearChain`], the validated description every computation reads (masses,
 //!   bonds with the two ends as springs to rigid supports, dashpots, linear resonators).
-//! - [`linearise`]: a woodpile-sim [`woodpile_sim::Model`] and its static overlaps → a
+//! - [`linearise`](mod@linearise): a woodpile-sim [`woodpile_sim::Model`] and its static overlaps → a
 //!   [`LinearChain`]; the only module that knows the simulator.
 //! - [`bands`]: a periodic [`bands::Cell`]: ω_j(q), pass bands, gaps, and the complex
 //!   wavenumber (attenuation per cell) in a gap.

@@ -15,7 +15,7 @@ use crate::bands::Interval;
 use crate::chain::LinearChain;
 use crate::error::SpectrumError;
 use crate::modes::Mode;
-use crate::shape::localise_cluster;
+use crate::shape::{clusters, localise_cluster, CLUSTER};
 use crate::tridiagonal::Condensed;
 
 /// The most modes one search returns: a window holding more overlaps a pass band, where the
@@ -25,9 +25,6 @@ pub const MAX_LOCALISED: usize = 256;
 /// Inverse-iteration steps per mode: the shift is the eigenvalue to a few ulps, so each step
 /// gains a factor gap/ulps and two already converge; the rest is margin.
 const INVERSE_STEPS: usize = 4;
-
-/// Eigenvalues closer than this (relative) form a cluster whose vectors are orthogonalised.
-const CLUSTER: f64 = 1e-8;
 
 /// The number of undamped eigenfrequencies of `chain` below `omega` (its integrated density of
 /// states), in O(n).
@@ -96,25 +93,6 @@ pub fn localised_modes(
         .zip(shapes)
         .map(|(sigma, shape)| Mode::new(sigma.max(0.0).sqrt(), shape, &masses, n))
         .collect())
-}
-
-/// The ranges of consecutive ascending eigenvalues closer than [`CLUSTER`] (relative) to their
-/// neighbour, of two or more members.
-pub(crate) fn clusters(sigmas: &[f64]) -> Vec<std::ops::Range<usize>> {
-    let mut ranges = Vec::new();
-    let mut first = 0;
-    for i in 1..=sigmas.len() {
-        let joined = i < sigmas.len()
-            && (sigmas[i] - sigmas[i - 1]).abs()
-                <= CLUSTER * sigmas[i].abs().max(f64::MIN_POSITIVE);
-        if !joined {
-            if i - first > 1 {
-                ranges.push(first..i);
-            }
-            first = i;
-        }
-    }
-    ranges
 }
 
 /// σ_index (0-based, ascending) by bisection between 0 and `upper` (above every eigenvalue),

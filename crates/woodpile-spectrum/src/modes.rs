@@ -17,9 +17,8 @@ use faer::{Mat, Side};
 use crate::bands::Interval;
 use crate::chain::LinearChain;
 use crate::error::SpectrumError;
-use crate::localised::clusters;
 use crate::matrices;
-use crate::shape::{localisation, localise_cluster, Localisation};
+use crate::shape::{clusters, localisation, localise_cluster, Localisation};
 
 /// The largest order of a matrix the dense solvers decompose: the degrees of freedom for
 /// [`normal_modes`], twice that for [`crate::damped::damped_modes`]. At 2048 a matrix and its

@@ -131,6 +131,28 @@ pub(crate) fn localise_cluster(shapes: &mut [Vec<f64>], masses: &[f64], n_sites:
     }
 }
 
+/// Eigenvalues closer than this (relative) form a cluster whose vectors are orthogonalised.
+pub(crate) const CLUSTER: f64 = 1e-8;
+
+/// The ranges of consecutive ascending eigenvalues closer than [`CLUSTER`] (relative) to their
+/// neighbour, of two or more members.
+pub(crate) fn clusters(sigmas: &[f64]) -> Vec<std::ops::Range<usize>> {
+    let mut ranges = Vec::new();
+    let mut first = 0;
+    for i in 1..=sigmas.len() {
+        let joined = i < sigmas.len()
+            && (sigmas[i] - sigmas[i - 1]).abs()
+                <= CLUSTER * sigmas[i].abs().max(f64::MIN_POSITIVE);
+        if !joined {
+            if i - first > 1 {
+                ranges.push(first..i);
+            }
+            first = i;
+        }
+    }
+    ranges
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -110,7 +110,7 @@ impl<'a> Condensed<'a> {
 }
 
 /// Solves T x = b in place for the tridiagonal T with diagonal `d`, subdiagonal `dl`
-/// (dl[i] = T[i+1][i]) and superdiagonal `du` (du[i] = T[i][i+1]), by Gaussian elimination with
+/// (`dl[i] = T[i+1][i]`) and superdiagonal `du` (`du[i] = T[i][i+1]`), by Gaussian elimination with
 /// partial pivoting as LAPACK `dgtsv`; a zero pivot is replaced by `epsilon`.
 fn solve_tridiagonal(
     mut d: Vec<f64>,
