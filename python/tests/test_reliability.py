@@ -50,7 +50,8 @@ def test_overflowing_shares_are_a_failed_row_not_numbers():
 def test_simulate_many_has_the_striker_share_and_simulates_rhs_evals():
     """`simulate_many` dropped S and reported `total_rhs_evals` as `rhs_evals`: both as
     `simulate` has them, row by row."""
-    striker = {"chain": {"n": 30}, "striker": {"mass": 2.0, "velocity": 1.0}, "run": {"t_end": 20.0, "tolerance": 1e-6}}
+    striker = {"chain": {"n": 30, "boundary": {"left": "free", "right": "fixed"}},
+               "striker": {"mass": 2.0, "velocity": 1.0}, "run": {"t_end": 20.0, "tolerance": 1e-6}}
     many = woodpile.simulate_many([striker, SMALL])
     one = woodpile.simulate(striker)
     assert many["S"][0] == one.S and many["R"][0] == one.R
