@@ -111,6 +111,29 @@ impl LinearChain {
         })
     }
 
+    /// Sites `sites` as a chain of their own: their masses, resonators and ground dashpots, the
+    /// bonds between them, and as end bonds the bonds that joined them to their neighbours.
+    pub fn sub_chain(&self, sites: std::ops::Range<usize>) -> Result<LinearChain, SpectrumError> {
+        let s = &self.spec;
+        let bonds = sites.start..sites.end + 1;
+        let resonators = s
+            .resonators
+            .iter()
+            .filter(|r| sites.contains(&r.site))
+            .map(|r| LinearResonator {
+                site: r.site - sites.start,
+                ..*r
+            })
+            .collect();
+        LinearChain::new(ChainSpec {
+            masses: s.masses[sites.clone()].to_vec(),
+            bond_stiffness: s.bond_stiffness[bonds.clone()].to_vec(),
+            bond_damping: s.bond_damping[bonds].to_vec(),
+            ground_damping: s.ground_damping[sites].to_vec(),
+            resonators,
+        })
+    }
+
     /// The description it was built from (damping lists at full length).
     pub fn spec(&self) -> &ChainSpec {
         &self.spec

@@ -138,4 +138,28 @@ pub enum SpectrumError {
         /// "left" or "right".
         side: &'static str,
     },
+    /// A cell asked for, or a chain searched for one, that is not periodic.
+    #[error("the cell does not repeat: {reason}")]
+    CellDoesNotRepeat {
+        /// Which site breaks the pattern, or why no copy fits.
+        reason: String,
+    },
+    /// A chain with no uniform lead to scatter waves from.
+    #[error("no transmission: {reason}")]
+    NoLead {
+        /// Why the chain's ends are not a uniform lead.
+        reason: String,
+    },
+    /// A frequency range that holds no frequency, or lies outside where it is defined.
+    #[error("frequency range [{lower}, {upper}] with {points} point(s): {reason}")]
+    BadRange {
+        /// Its lower end (rad per unit time).
+        lower: f64,
+        /// Its upper end.
+        upper: f64,
+        /// How many frequencies were asked for.
+        points: usize,
+        /// What is wrong with it.
+        reason: String,
+    },
 }

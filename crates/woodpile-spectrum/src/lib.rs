@@ -53,25 +53,31 @@
 //! [`modes::MAX_DENSE_ORDER`] with [`SpectrumError::TooLargeForDense`].
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod bands;
 pub mod chain;
 pub mod condense;
 pub mod damped;
 mod error;
+pub mod host;
 pub mod linearise;
 pub mod localised;
 mod matrices;
 pub mod modes;
+pub mod scene;
 pub mod shape;
+pub mod tables;
 pub mod transmission;
 mod tridiagonal;
 
+pub use analysis::{analyse, Analysis, FrequencyGrid, Request};
 pub use bands::{Bands, Cell, Interval, Wavenumber};
 pub use chain::{ChainSpec, LinearChain, LinearResonator};
 pub use condense::effective_mass;
 pub use damped::{damped_modes, DampedMode};
 pub use error::SpectrumError;
 pub use faer::c64;
+pub use host::{HostCell, Scatterer};
 pub use linearise::{linearise, linearise_precompressed, Linearised};
 pub use localised::{count_below, localised_modes};
 pub use modes::{normal_modes, Mode};

@@ -57,6 +57,16 @@ impl Lead {
         Ok(Lead { mass, stiffness })
     }
 
+    /// Its site mass m.
+    pub fn mass(&self) -> f64 {
+        self.mass
+    }
+
+    /// Its bond stiffness K.
+    pub fn stiffness(&self) -> f64 {
+        self.stiffness
+    }
+
     /// The top of its band, 2 sqrt(K/m).
     pub fn cutoff(&self) -> f64 {
         2.0 * (self.stiffness / self.mass).sqrt()
