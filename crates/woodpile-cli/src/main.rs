@@ -37,6 +37,7 @@ mod progress;
 mod project;
 mod reports;
 mod simulate;
+mod spectrum;
 
 use std::process::ExitCode;
 
@@ -54,6 +55,8 @@ struct Cli {
 enum Command {
     /// Simulate one scene file and print its energy fractions as one JSON object.
     Simulate(simulate::Args),
+    /// The scene's linear picture about its static state: bands, modes, transmission (JSON).
+    Spectrum(spectrum::Args),
     /// Bring pipeline stages up to date: stale or missing ones only, upstream first.
     Run(pipeline_cmd::RunArgs),
     /// Show each stage as fresh, stale or missing, and why.
@@ -125,6 +128,7 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Simulate(args) => simulate::run(&args),
+        Command::Spectrum(args) => spectrum::run(&args),
         Command::Run(args) => pipeline_cmd::run_command(&args),
         Command::Status(args) => pipeline_cmd::status_command(&args),
         Command::Merge(args) => pipeline_cmd::merge_command(&args),

@@ -14,7 +14,7 @@ use std::ops::Range;
 use crate::bands::{Bands, Interval, Wavenumber};
 use crate::chain::LinearChain;
 use crate::damped::{damped_modes, DampedMode};
-use crate::error::SpectrumError;
+use crate::error::{RangeFault, SpectrumError};
 use crate::host::{cell_of, detect_cell, scatterer, HostCell, Scatterer};
 use crate::localised::localised_modes;
 use crate::modes::{normal_modes, Mode, MAX_DENSE_ORDER};
@@ -106,27 +106,24 @@ impl FrequencyGrid {
 
     /// Checks it holds frequencies and lies inside (0, `cutoff`).
     fn check(&self, cutoff: f64) -> Result<(), SpectrumError> {
-        let bad = |reason: String| SpectrumError::BadRange {
-            lower: self.lower,
-            upper: self.upper,
-            points: self.points,
-            reason,
-        };
-        if !(self.lower.is_finite() && self.upper.is_finite()) {
-            return Err(bad("both ends must be finite".into()));
-        }
-        if self.points == 0
+        let fault = if !(self.lower.is_finite() && self.upper.is_finite()) {
+            RangeFault::NotFinite
+        } else if self.points == 0
             || self.lower > self.upper
             || (self.points == 1) != (self.lower == self.upper)
         {
-            return Err(bad("it holds no frequency: need lower < upper and at least 2 points, or lower = upper and 1 point".into()));
-        }
-        if self.lower <= 0.0 || self.upper >= cutoff {
-            return Err(bad(format!(
-                "must lie inside the leads' pass band (0, {cutoff}), where a wave travels to scatter"
-            )));
-        }
-        Ok(())
+            RangeFault::Empty
+        } else if self.lower <= 0.0 || self.upper >= cutoff {
+            RangeFault::OutsideBand { cutoff }
+        } else {
+            return Ok(());
+        };
+        Err(SpectrumError::BadRange {
+            lower: self.lower,
+            upper: self.upper,
+            points: self.points,
+            fault,
+        })
     }
 }
 

@@ -150,8 +150,8 @@ pub enum SpectrumError {
         /// Why the chain's ends are not a uniform lead.
         reason: String,
     },
-    /// A frequency range that holds no frequency, or lies outside where it is defined.
-    #[error("frequency range [{lower}, {upper}] with {points} point(s): {reason}")]
+    /// A frequency range that holds no frequency, or lies outside the leads' pass band.
+    #[error("frequency range [{lower}, {upper}] with {points} point(s): {fault}")]
     BadRange {
         /// Its lower end (rad per unit time).
         lower: f64,
@@ -160,6 +160,25 @@ pub enum SpectrumError {
         /// How many frequencies were asked for.
         points: usize,
         /// What is wrong with it.
-        reason: String,
+        fault: RangeFault,
+    },
+}
+
+/// What is wrong with a frequency range.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum RangeFault {
+    /// An end is NaN or infinite.
+    #[error("both ends must be finite")]
+    NotFinite,
+    /// Lower above upper, no points, or one point over a span.
+    #[error(
+        "it holds no frequency: need lower < upper and at least 2 points, or lower = upper and 1 point"
+    )]
+    Empty,
+    /// Outside (0, cutoff).
+    #[error("must lie inside the leads' pass band (0, {cutoff}), where a wave travels to scatter")]
+    OutsideBand {
+        /// The leads' cutoff (rad per unit time).
+        cutoff: f64,
     },
 }

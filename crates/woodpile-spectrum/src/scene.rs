@@ -14,7 +14,7 @@ use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 
 use crate::analysis::{analyse, Analysis, FrequencyGrid, Request};
-use crate::error::SpectrumError;
+use crate::error::{RangeFault, SpectrumError};
 use crate::linearise::linearise_precompressed;
 
 /// What is asked of a scene's spectrum, in the scene's terms.
@@ -44,6 +44,12 @@ pub enum Asked {
     Cell,
     /// The frequency range.
     Frequencies,
+    /// The probe site of a measured transmission.
+    Probe,
+    /// The run's sampling (`run.sample_every`), for a measured transmission.
+    Sampling,
+    /// The run's length (`run.t_end`), for a measured transmission.
+    Window,
 }
 
 /// A refusal, and the part of the request it is about.
@@ -74,6 +80,9 @@ pub struct SceneSpectrum {
     pub resonators: usize,
     /// Whether the linear chain has dashpots.
     pub damped: bool,
+    /// The transmission measured from the scene's own run, once [`crate::measured::measure`]
+    /// has run it.
+    pub measured: Option<crate::measured::Measured>,
 }
 
 impl SceneSpectrum {
@@ -128,13 +137,34 @@ pub fn scene_spectrum(scene: &Scene, request: &SceneRequest) -> Result<SceneSpec
             })
         }
     };
-    let analysis = analyse(&linear.chain, &Request { cell, frequencies }).map_err(|e| {
-        let asked = match e {
-            SpectrumError::CellDoesNotRepeat { .. } => Asked::Cell,
-            SpectrumError::BadRange { .. } | SpectrumError::NoLead { .. } => Asked::Frequencies,
-            _ => Asked::Scene,
-        };
-        refuse(asked)(e)
+    let in_hz = |omega: f64| omega / (TAU * time_unit);
+    let unit = if si.is_some() {
+        "Hz"
+    } else {
+        "cycles per unit time"
+    };
+    let analysis = analyse(&linear.chain, &Request { cell, frequencies }).map_err(|e| match e {
+        SpectrumError::CellDoesNotRepeat { .. } => refuse(Asked::Cell)(e),
+        SpectrumError::NoLead { .. } => refuse(Asked::Frequencies)(e),
+        // Said in the unit the range was given in.
+        SpectrumError::BadRange {
+            lower,
+            upper,
+            points,
+            fault,
+        } => Refusal {
+            asked: Asked::Frequencies,
+            reason: match fault {
+                RangeFault::OutsideBand { cutoff } => format!(
+                    "[{}, {}] {unit} must lie inside the leads' pass band (0, {}) {unit}, where a wave travels to scatter",
+                    in_hz(lower),
+                    in_hz(upper),
+                    in_hz(cutoff)
+                ),
+                fault => format!("[{}, {}] {unit} with {points} point(s): {fault}", in_hz(lower), in_hz(upper)),
+            },
+        },
+        _ => refuse(Asked::Scene)(e),
     })?;
     let resonators = model.resonators();
     Ok(SceneSpectrum {
@@ -150,6 +180,7 @@ pub fn scene_spectrum(scene: &Scene, request: &SceneRequest) -> Result<SceneSpec
         n_sites: model.n_sites(),
         time_unit,
         si: si.is_some(),
+        measured: None,
     })
 }
 

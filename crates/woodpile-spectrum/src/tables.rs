@@ -14,10 +14,8 @@ use crate::scene::SceneSpectrum;
 pub enum Values {
     /// Real numbers.
     F64(Vec<f64>),
-    /// Integers (indices, paper sites).
+    /// Integers (indices, paper sites, flags as 1 and 0, which a figure can select on).
     I64(Vec<i64>),
-    /// Flags.
-    Bool(Vec<bool>),
 }
 
 /// A named column.
@@ -36,7 +34,8 @@ pub enum Part {
     Bands,
     /// `omega, frequency, q, attenuation`: the host's complex wavenumber per cell.
     Wavenumber,
-    /// `mode, omega, frequency, localised, peak_site, participation, localisation_length`.
+    /// `mode, omega, frequency, localised (1 in a stop band of the host, else 0), peak_site,
+    /// participation, localisation_length`.
     Modes,
     /// `mode, omega, frequency, decay_rate, q_factor`: with dashpots.
     Damped,
@@ -44,11 +43,14 @@ pub enum Part {
     Shapes,
     /// `omega, frequency, transmittance, reflectance, absorbance, phase, log_transmission`.
     Transmission,
+    /// `omega, frequency, linear, measured`: |t|² of the linear picture and of the scene's
+    /// own run ([`crate::measured`]), on the frequencies the run resolves.
+    Measured,
 }
 
 impl Part {
-    /// Every part, in the order they are written.
-    pub const ALL: [Part; 6] = [
+    /// Every part of the linear picture (no run needed), in the order they are written.
+    pub const LINEAR: [Part; 6] = [
         Part::Bands,
         Part::Wavenumber,
         Part::Modes,
@@ -66,18 +68,17 @@ impl Part {
             Part::Damped => "damped",
             Part::Shapes => "shapes",
             Part::Transmission => "transmission",
+            Part::Measured => "measured",
         }
     }
 
     /// The part named `name`.
     pub fn parse(name: &str) -> Result<Part, String> {
-        Part::ALL
-            .into_iter()
-            .find(|p| p.name() == name)
-            .ok_or_else(|| {
-                let names: Vec<&str> = Part::ALL.iter().map(|p| p.name()).collect();
-                format!("`{name}` is not one of {}", names.join(", "))
-            })
+        let all = || Part::LINEAR.into_iter().chain([Part::Measured]);
+        all().find(|p| p.name() == name).ok_or_else(|| {
+            let names: Vec<&str> = all().map(|p| p.name()).collect();
+            format!("`{name}` is not one of {}", names.join(", "))
+        })
     }
 }
 
@@ -121,6 +122,15 @@ pub fn table(s: &SceneSpectrum, part: Part) -> Result<Vec<Column>, String> {
         Part::Damped => damped(s)?,
         Part::Shapes => shapes(s),
         Part::Transmission => transmission(s)?,
+        Part::Measured => {
+            let m = s.measured.as_ref().ok_or("the scene has not been run")?;
+            vec![
+                f64s("omega", m.omega.iter().copied()),
+                f64s("frequency", m.omega.iter().map(|&w| s.frequency(w))),
+                f64s("linear", m.linear.iter().copied()),
+                f64s("measured", m.measured.iter().copied()),
+            ]
+        }
     })
 }
 
@@ -130,10 +140,10 @@ fn modes(s: &SceneSpectrum, modes: &[Mode]) -> Vec<Column> {
         i64s("mode", 0..modes.len() as i64),
         f64s("omega", modes.iter().map(|m| m.omega)),
         f64s("frequency", modes.iter().map(|m| s.frequency(m.omega))),
-        Column {
-            name: "localised",
-            values: Values::Bool(modes.iter().map(|m| m.in_any(windows)).collect()),
-        },
+        i64s(
+            "localised",
+            modes.iter().map(|m| i64::from(m.in_any(windows))),
+        ),
         i64s(
             "peak_site",
             modes.iter().map(|m| s.paper_site(m.localisation.peak_site)),
@@ -219,6 +229,16 @@ pub fn summary(s: &SceneSpectrum) -> Value {
         },
         "modes": modes_summary(s),
         "transmission": transmission_summary(s),
+        "measured": s.measured.as_ref().map(|m| json!({
+            "probe": m.probe,
+            "amplitude": m.amplitude,
+            "points": m.omega.len(),
+            "range": [
+                m.omega.first().map(|&w| s.frequency(w)),
+                m.omega.last().map(|&w| s.frequency(w)),
+            ],
+            "departure": m.departure(),
+        })),
     })
 }
 
@@ -263,11 +283,7 @@ fn transmission_summary(s: &SceneSpectrum) -> Value {
         .min_by(|a, b| a.log_transmission.total_cmp(&b.log_transmission));
     let lead = &t.scatterer.lead;
     json!({
-        "lead": {
-            "mass": lead.mass(),
-            "stiffness": lead.stiffness(),
-            "cutoff": s.frequency(lead.cutoff()),
-        },
+        "lead_cutoff": s.frequency(lead.cutoff()),
         "region": [s.paper_site(t.scatterer.sites.start), s.paper_site(t.scatterer.sites.end - 1)],
         "points": rows.len(),
         "range": [

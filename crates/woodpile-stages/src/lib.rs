@@ -22,6 +22,7 @@ pub mod report;
 pub mod sampling;
 pub mod schema;
 pub mod spacetime;
+pub mod spectrum;
 pub mod stability;
 pub mod sweep;
 pub mod table;
@@ -53,6 +54,9 @@ pub static KINDS: &Registry = &[
     ("design", |f, _| Ok(Arc::new(design::Design::parse(f)?))),
     ("table", |f, _| Ok(Arc::new(table::Table::parse(f)?))),
     ("vary", |f, _| Ok(Arc::new(vary::Vary::parse(f)?))),
+    ("spectrum", |f, _| {
+        Ok(Arc::new(spectrum::Spectrum::parse(f)?))
+    }),
 ];
 
 /// The name of every kind, in pipeline order.
