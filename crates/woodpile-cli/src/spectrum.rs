@@ -70,6 +70,10 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
             Asked::Probe => "--probe: ",
             Asked::Sampling => "run.sample_every: ",
             Asked::Window => "run.t_end: ",
+            Asked::Run => {
+                let e = anyhow!("{}: {}", args.scene.display(), refusal.reason);
+                return Failure::simulation(e);
+            }
         };
         Failure::input(anyhow!("{}: {key}{}", args.scene.display(), refusal.reason))
     };

@@ -50,6 +50,8 @@ pub enum Asked {
     Sampling,
     /// The run's length (`run.t_end`), for a measured transmission.
     Window,
+    /// Not the request: the run of a measured transmission failed.
+    Run,
 }
 
 /// A refusal, and the part of the request it is about.

@@ -191,6 +191,7 @@ fn refusal(fields: &Fields<'_>, r: Refusal) -> PipelineError {
         Asked::Probe => fields.error("probe", r.reason),
         Asked::Sampling => fields.error("scene.run.sample_every", r.reason),
         Asked::Window => fields.error("scene.run.t_end", r.reason),
+        Asked::Run => fields.error("scene", r.reason),
     }
 }
 
