@@ -31,8 +31,8 @@ use woodpile_sim::simulation::simulate;
 
 use crate::analysis::Transmission;
 use crate::chain::LinearChain;
-use crate::transmission::{scatter, Lead};
 use crate::scene::{Asked, Refusal, SceneSpectrum};
+use crate::transmission::{scatter, Lead};
 
 /// Sites of margin left between the fastest echo's arrival at the probe and `t_end`: the
 /// lattice's front is not sharp, and ahead of it the signal is small but not zero.
@@ -174,7 +174,9 @@ impl Delays {
     /// The longest delay within four resolutions of ω: the tapered window's transform at ω
     /// mixes in what rings there.
     fn longest_near(&self, omega: f64) -> f64 {
-        let lo = ((omega - 4.0 * self.resolution) / self.step).floor().max(1.0) as usize;
+        let lo = ((omega - 4.0 * self.resolution) / self.step)
+            .floor()
+            .max(1.0) as usize;
         let hi = ((omega + 4.0 * self.resolution) / self.step).ceil() as usize;
         let slice = &self.delay[(lo - 1).min(self.delay.len())..hi.min(self.delay.len())];
         slice.iter().copied().fold(0.0, f64::max)

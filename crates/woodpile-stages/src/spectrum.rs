@@ -13,6 +13,7 @@
 //! # cell = [0, 1]          # the host cell, paper sites (default: found)
 //! # frequencies = { min = "1 kHz", max = "20 kHz", points = 400 }   # transmission, measured
 //! # probe = 40             # measured only: the probe site past the region
+//! # frequency_unit = "kHz" # a physical scene's `frequency` column in Hz (default), kHz or MHz
 //! [scene]
 //! chain = { n = 50, precompression = 1.0 }
 //! defect = [{ site = 0, eps = 0.5, kappa = 0.3 }]
@@ -47,7 +48,12 @@ pub struct Spectrum {
     pub request: SceneRequest,
     /// For `table = "measured"`: the probe (paper site), or the default.
     pub probe: Option<i64>,
+    /// `frequency_unit` of a physical scene's table: its name and how many Hz it is.
+    pub unit: Option<(String, f64)>,
 }
+
+/// The frequency units a physical scene's table may be given in.
+const UNITS: [(&str, f64); 3] = [("Hz", 1.0), ("kHz", 1e3), ("MHz", 1e6)];
 
 impl Spectrum {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Spectrum> {
@@ -77,12 +83,30 @@ impl Spectrum {
         if probe.is_some() && part != Part::Measured {
             return Err(fields.error("probe", "is read only with table = \"measured\""));
         }
+        let unit = match fields.optional::<String>("frequency_unit")? {
+            None => None,
+            Some(name) => {
+                let Some(&(_, hz)) = UNITS.iter().find(|(n, _)| *n == name) else {
+                    return Err(
+                        fields.error("frequency_unit", "expected \"Hz\", \"kHz\" or \"MHz\"")
+                    );
+                };
+                Some((name, hz))
+            }
+        };
         let sweep = Sweep::parse(fields)?;
+        if unit.is_some() && sweep.scene_at(0)?.physical.is_none() {
+            return Err(fields.error(
+                "frequency_unit",
+                "needs a [physical] scene: a scaled scene's frequencies are cycles per unit time",
+            ));
+        }
         let stage = Spectrum {
             sweep,
             part,
             request: SceneRequest { cell, frequencies },
             probe,
+            unit,
         };
         // Refuse a bad request now (status, dry runs), not when the stage runs: the grid's
         // corners exercise the extremes of every axis.
@@ -117,12 +141,26 @@ impl Spectrum {
                 )
             })?;
             summaries.push(summary(&spectrum));
-            rows.push((self.sweep.values(point), columns));
+            rows.push((self.sweep.values(point), self.in_unit(columns)));
         }
+        let unit = self.unit.as_ref().map(|(name, _)| name.as_str());
         Ok(Output::table(
             self.frame(rows)?,
-            json!({ "table": self.part.name(), "points": summaries }),
+            json!({ "table": self.part.name(), "frequency_unit": unit, "points": summaries }),
         ))
+    }
+
+    /// The `frequency` column in the stage's `frequency_unit`.
+    fn in_unit(&self, mut columns: Vec<Column>) -> Vec<Column> {
+        let Some((_, hz)) = self.unit else {
+            return columns;
+        };
+        for column in columns.iter_mut().filter(|c| c.name == "frequency") {
+            if let Values::F64(values) = &mut column.values {
+                values.iter_mut().for_each(|f| *f /= hz);
+            }
+        }
+        columns
     }
 
     /// The points' tables stacked, each row after its point and axis values when there are

@@ -92,11 +92,22 @@ pub enum Match {
     Text(String),
 }
 
-/// A column of `frame` as strings, nulls kept.
+/// A column of `frame` as strings, nulls kept; an integer column (a band, a point) is written
+/// in decimal, so it can name curves too.
 pub fn str_column(frame: &DataFrame, name: &str) -> Result<Vec<Option<String>>> {
     let column = frame
         .column(name)
         .map_err(|_| PipelineError::stage("table", missing_column(frame, name)))?;
+    let cast;
+    let column = match column.dtype().is_integer() {
+        true => {
+            cast = column
+                .cast(&DataType::String)
+                .map_err(|e| PipelineError::stage("table", format!("column `{name}`: {e}")))?;
+            &cast
+        }
+        false => column,
+    };
     let values = column
         .str()
         .map_err(|e| PipelineError::stage("table", format!("column `{name}`: {e}")))?
