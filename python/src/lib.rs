@@ -10,6 +10,7 @@ mod pool;
 mod scene_input;
 mod series;
 mod simulate;
+mod spectrum;
 mod sweep;
 
 use pyo3::prelude::*;
@@ -39,6 +40,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::simulate_many, m)?)?;
+    m.add_function(wrap_pyfunction!(spectrum::spectrum, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
     m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
     m.add_function(wrap_pyfunction!(table_integrity, m)?)?;

@@ -1,6 +1,7 @@
 """woodpile: granular chains with internal resonator defects, from Python.
 
-Simulate one scene (``simulate``) or a grid of them on every core (``sweep``), and drive the
+Simulate one scene (``simulate``) or a grid of them on every core (``sweep``), compute its
+linear picture (``spectrum``: bands, modes, transmission), and drive the
 figure pipeline of a woodpile project (``Pipeline``; ``new_study`` makes one). Scenes are dicts with the keys of a
 scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile repository.
 
@@ -14,6 +15,7 @@ scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile 
 from ._core import SceneError, SimulationError, __version__, scene_toml
 from ._pipeline import Pipeline, new_study
 from ._simulate import EndReachedWarning, LongRunWarning, SimulationResult, simulate
+from ._spectrum import SpectrumResult, spectrum
 from ._sweep import simulate_many, sweep
 
 __all__ = [
@@ -23,10 +25,12 @@ __all__ = [
     "SceneError",
     "SimulationError",
     "SimulationResult",
+    "SpectrumResult",
     "__version__",
     "new_study",
     "scene_toml",
     "simulate",
     "simulate_many",
+    "spectrum",
     "sweep",
 ]

@@ -28,6 +28,13 @@ def sweep(
 def simulate_many(
     scenes: Sequence[Scene], progress: Optional[Callable[[int, int], None]] = None
 ) -> Dict[str, Any]: ...
+def spectrum(
+    scene: Scene,
+    cell: Optional[Tuple[int, int]] = None,
+    frequencies: Optional[Tuple[Union[float, str], Union[float, str], int]] = None,
+    measure: bool = False,
+    probe: Optional[int] = None,
+) -> Dict[str, Any]: ...
 def scene_toml(scene: Scene) -> str: ...
 
 def table_integrity(data: bytes) -> str:

@@ -33,7 +33,7 @@ sample_every = 0.1
 fn departure(velocity: f64) -> (Measured, f64) {
     let scene = scene(velocity, "method = \"rkn6-contact\"\ndt = 0.02");
     let spectrum = scene_spectrum(&scene, &SceneRequest::default()).unwrap();
-    let measured = measure(&scene, &spectrum, None).unwrap();
+    let measured = measure(&scene, &spectrum, None, &|| false).unwrap();
     let d = measured.departure();
     (measured, d)
 }
@@ -59,12 +59,12 @@ fn a_window_that_lets_an_echo_in_is_refused() {
     let text = "[chain]\nn = 60\nprecompression = 1.0\n[[defect]]\nsite = 0\neps = 0.5\n[impulse]\nsite = -30\nvelocity = 1e-4\n[run]\nt_end = 600.0\nsample_every = 0.1\n";
     let scene = woodpile_scene::parse(text, Path::new("short.toml")).unwrap();
     let spectrum = scene_spectrum(&scene, &SceneRequest::default()).unwrap();
-    let refusal = measure(&scene, &spectrum, None).unwrap_err();
+    let refusal = measure(&scene, &spectrum, None, &|| false).unwrap_err();
     assert_eq!(refusal.asked, Asked::Window);
     let sparse = text.replace("sample_every = 0.1", "sample_every = 2.0");
     let scene = woodpile_scene::parse(&sparse, Path::new("sparse.toml")).unwrap();
-    let refusal = measure(&scene, &spectrum, None).unwrap_err();
+    let refusal = measure(&scene, &spectrum, None, &|| false).unwrap_err();
     assert_eq!(refusal.asked, Asked::Sampling);
-    let refusal = measure(&scene, &spectrum, Some(-5)).unwrap_err();
+    let refusal = measure(&scene, &spectrum, Some(-5), &|| false).unwrap_err();
     assert_eq!(refusal.asked, Asked::Probe);
 }
