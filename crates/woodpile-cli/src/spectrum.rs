@@ -79,7 +79,8 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     };
     let mut spectrum = scene_spectrum(&scene, &request).map_err(refused)?;
     if args.measure {
-        spectrum.measured = Some(measure(&scene, &spectrum, args.probe, &|| false).map_err(refused)?);
+        spectrum.measured =
+            Some(measure(&scene, &spectrum, args.probe, &|| false).map_err(refused)?);
     }
     let report = summary(&spectrum);
     if let Some(out) = &args.out {

@@ -28,12 +28,12 @@ use std::f64::consts::PI;
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::Observer;
 use woodpile_sim::observe::SiteField;
-use woodpile_sim::Model;
 use woodpile_sim::simulation::simulate;
+use woodpile_sim::Model;
 
 use crate::analysis::Transmission;
 use crate::chain::LinearChain;
-use crate::scene::{Asked, Refusal, SceneSpectrum};
+use crate::scene::{Asked, Measured, Refusal, SceneSpectrum};
 use crate::transmission::{scatter, Lead};
 
 /// Sites of margin left between the fastest echo's arrival at the probe and `t_end`: the
@@ -46,33 +46,6 @@ const ECHO_MARGIN_SITES: f64 = 20.0;
 /// of the double defect rod still put |t| 1.2e-3 off; at 0.15 every measured scene keeps
 /// within 1e-3 (docs/spectrum.md).
 const ARRIVED: f64 = 0.15;
-
-/// The transmission measured from a run, on the frequencies that arrived.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Measured {
-    /// The probe, paper numbering.
-    pub probe: i64,
-    /// The impulse's amplitude over the precompression's own velocity scale c0 δ0 (the
-    /// particle velocity of a strain equal to the static one): the linear limit is ≪ 1.
-    pub amplitude: f64,
-    /// ω of each row (model units).
-    pub omega: Vec<f64>,
-    /// |t|² of the linear picture.
-    pub linear: Vec<f64>,
-    /// |t|² measured from the run.
-    pub measured: Vec<f64>,
-}
-
-impl Measured {
-    /// The largest difference of |t| between the run and the linear picture, over the rows.
-    pub fn departure(&self) -> f64 {
-        self.linear
-            .iter()
-            .zip(&self.measured)
-            .map(|(a, b)| (a.sqrt() - b.sqrt()).abs())
-            .fold(0.0, f64::max)
-    }
-}
 
 /// Runs `scene` and measures its transmission on the frequencies of `spectrum`'s transmission
 /// that the run can resolve (see the module documentation); the probe is paper site `probe`,

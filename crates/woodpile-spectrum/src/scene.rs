@@ -84,7 +84,34 @@ pub struct SceneSpectrum {
     pub damped: bool,
     /// The transmission measured from the scene's own run, once [`crate::measured::measure`]
     /// has run it.
-    pub measured: Option<crate::measured::Measured>,
+    pub measured: Option<Measured>,
+}
+
+/// The transmission measured from a run, on the frequencies that arrived.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measured {
+    /// The probe, paper numbering.
+    pub probe: i64,
+    /// The impulse's amplitude over the precompression's own velocity scale c0 δ0 (the
+    /// particle velocity of a strain equal to the static one): the linear limit is ≪ 1.
+    pub amplitude: f64,
+    /// ω of each row (model units).
+    pub omega: Vec<f64>,
+    /// |t|² of the linear picture.
+    pub linear: Vec<f64>,
+    /// |t|² measured from the run.
+    pub measured: Vec<f64>,
+}
+
+impl Measured {
+    /// The largest difference of |t| between the run and the linear picture, over the rows.
+    pub fn departure(&self) -> f64 {
+        self.linear
+            .iter()
+            .zip(&self.measured)
+            .map(|(a, b)| (a.sqrt() - b.sqrt()).abs())
+            .fold(0.0, f64::max)
+    }
 }
 
 impl SceneSpectrum {

@@ -132,7 +132,8 @@ impl Spectrum {
                 |r: Refusal| PipelineError::stage(stage, format!("point {point}: {}", r.reason));
             let mut spectrum = scene_spectrum(&scene, &self.request).map_err(failed)?;
             if self.part == Part::Measured {
-                spectrum.measured = Some(measure(&scene, &spectrum, self.probe, &|| false).map_err(failed)?);
+                spectrum.measured =
+                    Some(measure(&scene, &spectrum, self.probe, &|| false).map_err(failed)?);
             }
             let columns = table(&spectrum, self.part).map_err(|reason| {
                 PipelineError::stage(

@@ -70,6 +70,12 @@ pub fn drive_lanes(
     Some(results.map(|r| r.expect("every lane ends with a result")))
 }
 
+/// Each lane's run under way and, once it has ended, its outcome.
+type LaneRuns<'a, 's> = (
+    &'a mut [Option<Stepping<'s>>; LANES],
+    &'a mut [Option<Result<Stats, SimError>>; LANES],
+);
+
 /// The lanes' shared state and stepper.
 struct LaneBatch<'m> {
     models: [&'m Model; LANES],
@@ -124,10 +130,7 @@ impl<'m> LaneBatch<'m> {
     /// now and then whether to stop ([`Stepping::poll`]).
     fn cover(
         &mut self,
-        (runs, results): (
-            &mut [Option<Stepping<'_>>; LANES],
-            &mut [Option<Result<Stats, SimError>>; LANES],
-        ),
+        (runs, results): LaneRuns<'_, '_>,
         (target, dt): (f64, f64),
         observers: &[&mut dyn Observer; LANES],
     ) {
