@@ -113,8 +113,8 @@ pub(crate) fn sites(chain: Option<&raw::Chain>) -> Result<(i64, i64), Invalid> {
     }
 }
 
-/// `chain.boundary`: `"fixed"` (the default), `"free"`, or `{ left = .., right = .. }`, each
-/// end `"fixed"`, `"free"` or soft, `{ spring = k, damping = c }` (N/m and N·s/m in an SI
+/// `chain.boundary`: `"fixed"` (the default), `"free"`, or `{ left = .., right = .. }` (a side
+/// left out is fixed), each end `"fixed"`, `"free"` or soft, `{ spring = k, damping = c }` (N/m and N·s/m in an SI
 /// scene, converted with its scales).
 pub(crate) fn boundary(chain: Option<&raw::Chain>, si: Option<&Si>) -> Result<Boundary, Invalid> {
     let end = |key: &str, value: &toml::Value| match value {
@@ -134,9 +134,10 @@ pub(crate) fn boundary(chain: Option<&raw::Chain>, si: Option<&Si>) -> Result<Bo
         )),
         Some(toml::Value::Table(ends)) => {
             only_keys("chain.boundary", ends, &["left", "right"], "the ends are left and right")?;
-            let side = |name: &str| {
-                let key = format!("chain.boundary.{name}");
-                end(&key, required(&key, ends.get(name))?)
+            // A side left out keeps the default end, a wall: `{ right = "free" }` frees one.
+            let side = |name: &str| match ends.get(name) {
+                Some(value) => end(&format!("chain.boundary.{name}"), value),
+                None => Ok(End::Fixed),
             };
             Ok(Boundary::ends(side("left")?, side("right")?))
         }

@@ -2,7 +2,7 @@
 //! velocity (the paper's Eq. 2); a striker is a body of its own, index 0 of the simulator,
 //! that starts touching the first site and hits it through its own contact.
 
-use woodpile_sim::model::Boundary;
+use woodpile_sim::model::{Boundary, End};
 use woodpile_sim::rods;
 
 use super::chain::{Layout, Sites};
@@ -59,10 +59,12 @@ pub(crate) fn striker(
             "a scene gives [impulse] or [striker], not both",
         ));
     }
-    if boundary.left_wall() {
+    // A wall would hold the striker back; a soft end's spring and dashpot would act on the
+    // striker itself (index 0 is the left end's body), which is no woodpile's.
+    if !matches!(boundary.left(), End::Free) {
         return Err(invalid(
             "striker",
-            "needs a free left end to strike: set chain.boundary = { left = \"free\", right = \"fixed\" } (or \"free\")",
+            "needs a free left end to strike (a wall or a soft end would act on the striker): set chain.boundary = { left = \"free\", right = \"fixed\" } (or \"free\", or a soft end)",
         ));
     }
     let (mass, contact, velocity) = match si {
