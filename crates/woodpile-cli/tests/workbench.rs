@@ -67,3 +67,77 @@ fn a_one_sided_boundary_keeps_a_wall_on_the_other_side() {
         run("{ left = \"free\", right = \"fixed\" }")
     );
 }
+
+/// The as-built woodpile with a glass-sphere striker, run for `t_end` (TOML value).
+fn woodpile(t_end: &str, sample_every: &str) -> String {
+    format!(
+        r#"[chain]
+sites = [-20, 19]
+boundary = {{ left = "free", right = "free" }}
+[physical]
+material = {{ youngs_modulus = 72e9, poisson_ratio = 0.17, density = 2200.0 }}
+rod = {{ length = 0.020, diameter = 0.005 }}
+[striker]
+velocity = 1.98
+sphere = {{ diameter = 0.010, material = {{ youngs_modulus = 70e9, poisson_ratio = 0.23, density = 2500.0 }} }}
+[run]
+t_end = {t_end}
+sample_every = {sample_every}
+tolerance = 1e-6
+"#
+    )
+}
+
+/// A physical scene's times may carry a unit: the run ends at that time in seconds, and the
+/// same scene written in scaled time gives the same numbers.
+#[test]
+fn times_with_units_are_seconds_in_a_physical_scene() {
+    let out = simulate(&woodpile("\"0.5 ms\"", "\"25 us\""));
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let t_end_s = v["physical"]["t_end_s"].as_f64().unwrap();
+    assert!((t_end_s - 0.5e-3).abs() < 1e-15, "{t_end_s}");
+    // The same run in scaled time: t_end and sample_every over the scene's time scale.
+    let scale = v["physical"]["time_scale_s"].as_f64().unwrap();
+    let scaled = simulate(&woodpile(
+        &format!("{:?}", 0.5e-3 / scale),
+        &format!("{:?}", 25e-6 / scale),
+    ));
+    let w: serde_json::Value = serde_json::from_slice(&scaled.stdout).unwrap();
+    // Equal to rounding: "25 us" is 25 × 1e-6 s, which need not be the double 25e-6.
+    for share in ["R", "T", "E_tr", "S"] {
+        let (a, b) = (v[share].as_f64().unwrap(), w[share].as_f64().unwrap());
+        assert!((a - b).abs() <= 1e-12, "{share}: {a} against {b}");
+    }
+}
+
+#[test]
+fn a_time_with_a_unit_is_refused_where_it_cannot_be_read() {
+    let cases = [
+        (
+            woodpile("\"1.5 kg\"", "1.0"),
+            "key `run.t_end`: `kg` is not a unit of time",
+        ),
+        (
+            woodpile("150.0", "\"2\""),
+            "key `run.sample_every`: `2` has no unit",
+        ),
+        (
+            "[run]\nt_end = \"1 ms\"\n".to_string(),
+            "key `run.t_end`: `1 ms`: a time with a unit needs a [physical] scene",
+        ),
+        (
+            "[run]\nt_end = true\n".to_string(),
+            "a time with a unit such as",
+        ),
+    ];
+    for (scene, expected) in cases {
+        let out = simulate(&scene);
+        assert_eq!(out.status.code(), Some(2), "{expected}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains(expected),
+            "{expected}: {}",
+            stderr(&out)
+        );
+    }
+}

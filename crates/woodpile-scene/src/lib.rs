@@ -15,6 +15,7 @@ pub mod template;
 pub mod threads;
 pub mod units_out;
 
+pub use resolve::time::seconds;
 pub use resolve::{DerivedDefect, Physical, Scene, DEFAULT_RESONATOR_SHARE};
 
 use std::path::{Path, PathBuf};

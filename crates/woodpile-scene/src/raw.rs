@@ -140,11 +140,46 @@ pub(crate) struct Defect {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct Run {
-    pub t_end: Option<f64>,
+    pub t_end: Option<Time>,
     pub method: Option<String>,
     pub tolerance: Option<f64>,
-    pub dt: Option<f64>,
-    pub sample_every: Option<f64>,
+    pub dt: Option<Time>,
+    pub sample_every: Option<Time>,
+}
+
+/// A time: a number in the model's scaled time, or (in a `[physical]` scene) text with a unit,
+/// `"1.5 ms"`.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Time {
+    /// Scaled time, as every scene has always written it.
+    Scaled(f64),
+    /// Seconds with a unit.
+    Text(String),
+}
+
+impl<'de> Deserialize<'de> for Time {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Time, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = Time;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a number (scaled time) or, in a [physical] scene, a time with a unit such as \"1.5 ms\"")
+            }
+            fn visit_f64<E>(self, x: f64) -> Result<Time, E> {
+                Ok(Time::Scaled(x))
+            }
+            fn visit_i64<E>(self, x: i64) -> Result<Time, E> {
+                Ok(Time::Scaled(x as f64))
+            }
+            fn visit_u64<E>(self, x: u64) -> Result<Time, E> {
+                Ok(Time::Scaled(x as f64))
+            }
+            fn visit_str<E>(self, text: &str) -> Result<Time, E> {
+                Ok(Time::Text(text.to_string()))
+            }
+        }
+        deserializer.deserialize_any(Visitor)
+    }
 }
 
 #[derive(Debug, Deserialize)]

@@ -16,6 +16,7 @@ mod defects;
 mod excitation;
 mod physical;
 mod run;
+pub mod time;
 
 use woodpile_sim::energy::Region;
 use woodpile_sim::model::Model;
@@ -113,7 +114,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         striker_sites: usize::from(file.striker.is_some()),
     };
     let built = model(&file, &layout, si.as_ref())?;
-    let settings = run::settings(file.run)?;
+    let settings = run::settings(file.run, si.as_ref())?;
     let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
     let mut region = Region::new(lo as i64, hi as i64, layout.n_sites())
         .map_err(|e| invalid("fractions.region", e.to_string()))?;

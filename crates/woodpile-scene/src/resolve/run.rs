@@ -10,6 +10,8 @@ use woodpile_sim::{OverBudget, StepSetBy};
 
 use super::chain::Layout;
 use super::check::{invalid, positive, Invalid};
+use super::physical::Si;
+use super::time;
 use crate::raw;
 
 const DEFAULT_T_END: f64 = 150.0;
@@ -32,8 +34,8 @@ pub(crate) struct RunSettings {
     pub sample_every_given: bool,
 }
 
-/// The `[run]` table with its defaults.
-pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
+/// The `[run]` table with its defaults; times with a unit are converted with `si`'s scale.
+pub(crate) fn settings(run: Option<raw::Run>, si: Option<&Si>) -> Result<RunSettings, Invalid> {
     let run = run.unwrap_or(raw::Run {
         t_end: None,
         method: None,
@@ -41,7 +43,13 @@ pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
         dt: None,
         sample_every: None,
     });
-    let t_end = positive("run.t_end", run.t_end.unwrap_or(DEFAULT_T_END))?;
+    let time = |key: &str, value: &Option<raw::Time>| {
+        value.as_ref().map(|v| time::scaled(key, v, si)).transpose()
+    };
+    let t_end = positive(
+        "run.t_end",
+        time("run.t_end", &run.t_end)?.unwrap_or(DEFAULT_T_END),
+    )?;
     let name = run.method.as_deref().unwrap_or("auto");
     let method = MethodChoice::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
@@ -66,7 +74,9 @@ pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
             format!("{tolerance:e} is below {MIN_TOLERANCE:e}: fractions summed over a chain in double precision cannot be verified that closely"),
         ));
     }
-    let dt = run.dt.map(|dt| positive("run.dt", dt)).transpose()?;
+    let dt = time("run.dt", &run.dt)?
+        .map(|dt| positive("run.dt", dt))
+        .transpose()?;
     if let Some(dt) = dt {
         match method {
             MethodChoice::Auto => {
@@ -95,7 +105,7 @@ pub(crate) fn settings(run: Option<raw::Run>) -> Result<RunSettings, Invalid> {
     }
     let sample_every = positive(
         "run.sample_every",
-        run.sample_every.unwrap_or(DEFAULT_SAMPLE_EVERY),
+        time("run.sample_every", &run.sample_every)?.unwrap_or(DEFAULT_SAMPLE_EVERY),
     )?;
     Ok(RunSettings {
         t_end,
