@@ -34,6 +34,24 @@ pub(crate) struct RunSettings {
     pub sample_every_given: bool,
 }
 
+/// `run.tolerance`, between what a double can verify and what says anything about a share.
+fn tolerance(given: Option<f64>) -> Result<f64, Invalid> {
+    let tolerance = positive("run.tolerance", given.unwrap_or(DEFAULT_TOLERANCE))?;
+    if tolerance > MAX_TOLERANCE {
+        return Err(invalid(
+            "run.tolerance",
+            format!("{tolerance:e} is above {MAX_TOLERANCE:e}: fractions lie between 0 and 1, so a looser bound says nothing"),
+        ));
+    }
+    if tolerance < MIN_TOLERANCE {
+        return Err(invalid(
+            "run.tolerance",
+            format!("{tolerance:e} is below {MIN_TOLERANCE:e}: fractions summed over a chain in double precision cannot be verified that closely"),
+        ));
+    }
+    Ok(tolerance)
+}
+
 /// The `[run]` table with its defaults; times with a unit are converted with `si`'s scale.
 pub(crate) fn settings(run: Option<raw::Run>, si: Option<&Si>) -> Result<RunSettings, Invalid> {
     let run = run.unwrap_or(raw::Run {
@@ -61,19 +79,7 @@ pub(crate) fn settings(run: Option<raw::Run>, si: Option<&Si>) -> Result<RunSett
             ),
         )
     })?;
-    let tolerance = positive("run.tolerance", run.tolerance.unwrap_or(DEFAULT_TOLERANCE))?;
-    if tolerance > MAX_TOLERANCE {
-        return Err(invalid(
-            "run.tolerance",
-            format!("{tolerance:e} is above {MAX_TOLERANCE:e}: fractions lie between 0 and 1, so a looser bound says nothing"),
-        ));
-    }
-    if tolerance < MIN_TOLERANCE {
-        return Err(invalid(
-            "run.tolerance",
-            format!("{tolerance:e} is below {MIN_TOLERANCE:e}: fractions summed over a chain in double precision cannot be verified that closely"),
-        ));
-    }
+    let tolerance = tolerance(run.tolerance)?;
     let dt = time("run.dt", &run.dt)?
         .map(|dt| positive("run.dt", dt))
         .transpose()?;
