@@ -28,6 +28,7 @@ pub mod force;
 pub mod integrate;
 pub mod model;
 pub mod observe;
+pub mod restitution;
 pub mod rods;
 pub mod simd;
 pub mod simulation;
