@@ -30,6 +30,17 @@ pub(crate) struct DampingTable {
     pub law: Option<String>,
     /// g, on every site.
     pub ground: Option<f64>,
+    /// Instead of `contact`: the restitution an isolated pair of regular sites shows.
+    pub restitution: Option<Restitution>,
+}
+
+/// `restitution = { e = 0.9, velocity = 1.0 }`: the coefficient of restitution of two regular
+/// sites meeting at `velocity` (m/s, or text such as "1 m/s", in a `[physical]` scene).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct Restitution {
+    pub e: Option<f64>,
+    pub velocity: Option<toml::Value>,
 }
 
 #[derive(Debug, Deserialize)]

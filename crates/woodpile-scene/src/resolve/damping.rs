@@ -5,7 +5,9 @@
 use woodpile_sim::model::{Coupling, Resonator};
 use woodpile_sim::{Damping, DashpotLaw};
 
-use super::check::{invalid, non_negative, positive, Invalid};
+use woodpile_sim::restitution::{dashpot_for, Pair};
+
+use super::check::{invalid, non_negative, positive, required, Invalid};
 use super::physical::Si;
 use crate::raw;
 
@@ -42,16 +44,8 @@ pub(crate) fn damping(
         }
     };
     let mut listed = Listed::new();
-    let contact_scale: Scale = match law {
-        DashpotLaw::Linear => |si, c| si.scales.dashpot(c),
-        DashpotLaw::Hertzian => |si, c| si.scales.hertzian_dashpot(c),
-    };
     let dashpot: Scale = |si, c| si.scales.dashpot(c);
-    let contact = converted(
-        ("damping.contact", table.and_then(|t| t.contact)),
-        (si, contact_scale),
-        &mut listed,
-    )?;
+    let contact = contact_dashpot(file, law, si, &mut listed)?;
     let ground = converted(
         ("damping.ground", table.and_then(|t| t.ground)),
         (si, dashpot),
@@ -85,6 +79,103 @@ pub(crate) fn damping(
     let damping = Damping::new(contact, law, ground, per_resonator)
         .map_err(|e| invalid("damping", e.to_string()))?;
     Ok(Some((damping, listed)))
+}
+
+/// γ of every contact: `damping.contact` (converted), or calibrated from
+/// `damping.restitution`, listed in an SI scene both ways.
+fn contact_dashpot(
+    file: &raw::SceneFile,
+    law: DashpotLaw,
+    si: Option<&Si>,
+    listed: &mut Listed,
+) -> Result<f64, Invalid> {
+    let table = file.damping.as_ref();
+    let contact_scale: Scale = match law {
+        DashpotLaw::Linear => |si, c| si.scales.dashpot(c),
+        DashpotLaw::Hertzian => |si, c| si.scales.hertzian_dashpot(c),
+    };
+    Ok(match table.and_then(|t| t.restitution.as_ref()) {
+        None => converted(
+            ("damping.contact", table.and_then(|t| t.contact)),
+            (si, contact_scale),
+            listed,
+        )?,
+        Some(_) if table.and_then(|t| t.contact).is_some() => {
+            return Err(invalid(
+                "damping.restitution",
+                "give damping.contact or damping.restitution, not both",
+            ))
+        }
+        Some(restitution) => {
+            let gamma = calibrated(file, restitution, law, si)?;
+            if let Some(si) = si {
+                listed.push(("damping_contact".into(), gamma));
+                listed.push(("damping_contact_si".into(), gamma / contact_scale(si, 1.0)));
+            }
+            gamma
+        }
+    })
+}
+
+/// γ (model units) of the contact dashpot under which two regular sites meeting at the
+/// restitution's velocity part with its e: the isolated pair's collision solved to the
+/// scene's tolerance ([`woodpile_sim::restitution`]).
+fn calibrated(
+    file: &raw::SceneFile,
+    restitution: &raw::Restitution,
+    law: DashpotLaw,
+    si: Option<&Si>,
+) -> Result<f64, Invalid> {
+    let e = required("damping.restitution.e", restitution.e)?;
+    let velocity = required(
+        "damping.restitution.velocity",
+        restitution.velocity.as_ref(),
+    )?;
+    let velocity = impact_velocity("damping.restitution.velocity", velocity, si)?;
+    let exponent = file.chain.as_ref().and_then(|c| c.exponent).unwrap_or(1.5);
+    // Two regular sites through the regular contact: mass and coefficient 1 in the model's units.
+    let pair = Pair::new(1.0, 1.0, 1.0, exponent, law);
+    let tolerance = file.run.as_ref().and_then(|r| r.tolerance).unwrap_or(1e-8);
+    dashpot_for(&pair, e, velocity, tolerance.clamp(1e-12, 1e-6))
+        .map_err(|err| invalid("damping.restitution", err.to_string()))
+}
+
+/// A velocity in the model's units: a scaled scene's number as it is; a physical scene's in
+/// m/s, a number or text such as "1 m/s" or "20 mm/s", over its velocity scale.
+fn impact_velocity(key: &str, value: &toml::Value, si: Option<&Si>) -> Result<f64, Invalid> {
+    let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
+    let metres_per_second = match (value, si) {
+        (toml::Value::String(text), Some(_)) => velocity_text(key, text)?,
+        (toml::Value::String(text), None) => {
+            return Err(invalid(
+                key,
+                format!("`{text}`: a velocity with a unit needs a [physical] scene; give a number in the model's units"),
+            ))
+        }
+        (v, _) => number(v).ok_or_else(|| invalid(key, "expected a number, or text such as \"1 m/s\""))?,
+    };
+    let v = positive(key, metres_per_second)?;
+    Ok(si.map_or(v, |si| v / si.scales.velocity))
+}
+
+/// `"1 m/s"`, `"20 mm/s"`: metres per second.
+fn velocity_text(key: &str, text: &str) -> Result<f64, Invalid> {
+    let (number, unit) = text.trim().split_once(' ').unwrap_or((text.trim(), ""));
+    let scale = match unit.trim() {
+        "m/s" => 1.0,
+        "mm/s" => 1e-3,
+        "cm/s" => 1e-2,
+        other => {
+            return Err(invalid(
+                key,
+                format!("`{other}` is not a unit of velocity (m/s, cm/s, mm/s)"),
+            ))
+        }
+    };
+    let value: f64 = number
+        .parse()
+        .map_err(|_| invalid(key, format!("`{text}`: `{number}` is not a number")))?;
+    Ok(value * scale)
 }
 
 /// The coefficient at `key` (default 0, checked ≥ 0), in the model's units: an SI scene's
