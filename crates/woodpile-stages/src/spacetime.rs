@@ -21,7 +21,7 @@
 //! numbering), `velocity`. A scene whose simulation fails stops the stage with its reason.
 //!
 //! Instead of a grid, `design = "stage"` (with `inputs = ["stage"]` and `field.sites`) maps
-//! the best design a `design` stage found, from its `results/<stage>.best.toml`.
+//! the best scene a `design` or `optimize` stage found, from its `results/<stage>.best.toml`.
 
 use rayon::prelude::*;
 use serde_json::json;
@@ -267,12 +267,15 @@ impl Kind for SpaceTime {
         let Source::Design(design) = &self.source else {
             return no_inputs(stage);
         };
+        let searches = ["design", "optimize"];
         match stage.inputs.as_slice() {
-            [input] if input == design && inputs.get::<crate::design::Design>(input).is_some() => {
-                Ok(())
-            }
+            [input] if input == design && searches.contains(&inputs.kind_of(input)) => Ok(()),
+            [input] if input == design => wrong_inputs(format!(
+                "`design = \"{design}\"` names a {} stage; a spacetime stage maps the best scene of a design or optimize stage",
+                inputs.kind_of(input)
+            )),
             _ => wrong_inputs(format!(
-                "a spacetime stage of `design = \"{design}\"` reads exactly that design stage"
+                "a spacetime stage of `design = \"{design}\"` maps that stage's best scene, so it must be its one input: inputs = [\"{design}\"]"
             )),
         }
     }

@@ -499,3 +499,29 @@ fn a_design_places_damped_resonators() {
     let e = load_error(&[("trap", &damped.replace("damping = 0.05", "eps = 2.0"))]);
     assert!(e.contains("each_resonator.eps"), "{e}");
 }
+
+/// A spacetime stage maps an optimize stage's best scene as it maps a design stage's, and
+/// says what to write when it is not wired to it.
+#[test]
+fn a_spacetime_stage_maps_an_optimize_stages_best_scene() {
+    let coarse = single_defect_sweep_to(3.0);
+    let optimum =
+        "kind = \"optimize\"\ninputs = [\"at_end\"]\nover = [\"eps\"]\ntolerance = 1e-6\n";
+    let map = "kind = \"spacetime\"\ndesign = \"optimum\"\ninputs = [\"optimum\"]\n[field]\nsites = [-3, 3]\n";
+    let stages = [
+        ("sweep", coarse.as_str()),
+        ("at_end", REDUCE),
+        ("optimum", optimum),
+        ("map", map),
+    ];
+    let p = Project::new(&stages);
+    p.counted(&[]);
+    let out = table::read(&p.output("map")).unwrap();
+    assert!(out.height() > 0);
+    let unwired = map.replace("inputs = [\"optimum\"]\n", "");
+    let e = load_error(&[stages[0], stages[1], stages[2], ("map", &unwired)]);
+    assert!(e.contains("inputs = [\"optimum\"]"), "{e}");
+    let wrong = map.replace("\"optimum\"", "\"at_end\"");
+    let e = load_error(&[stages[0], stages[1], stages[2], ("map", &wrong)]);
+    assert!(e.contains("names a reduce stage"), "{e}");
+}
