@@ -4,6 +4,7 @@
 //! hands results back as NumPy arrays without a copy per sample. The typed, documented API is
 //! the pure-Python `woodpile` package around it.
 
+mod examples;
 mod interrupt;
 mod listed;
 mod pool;
@@ -41,6 +42,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(spectrum::spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(examples::examples, m)?)?;
+    m.add_function(wrap_pyfunction!(examples::example, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
     m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
     m.add_function(wrap_pyfunction!(table_integrity, m)?)?;

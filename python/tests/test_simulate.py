@@ -236,3 +236,15 @@ def test_si_outputs_need_a_physical_scene():
     with pytest.raises(woodpile.SceneError, match="units: expected"):
         woodpile.simulate(STANDARD, units="metric")
     assert woodpile.simulate(STANDARD).units is None
+
+
+def test_the_package_carries_the_example_scenes():
+    """A user without a clone starts from an example: every one runs as a scene."""
+    names = woodpile.examples()
+    assert "single_eps10" in names and "woodpile_striker" in names
+    text = woodpile.example("single_eps10")
+    assert text.startswith("#") and "[[defect]]" in text
+    r = woodpile.simulate(text.replace("t_end = 150.0", "t_end = 20.0"))
+    assert 0 <= r.E_tr <= 1
+    with pytest.raises(woodpile.SceneError, match="single_eps10"):
+        woodpile.example("nope")

@@ -88,3 +88,4 @@ def test_the_run_of_a_small_impulse_measures_the_linear_transmission():
     assert len(m) > 300
     assert np.max(np.abs(np.sqrt(m.linear) - np.sqrt(m.measured))) < 1e-3
     assert r.summary["measured"]["amplitude"] < 1e-3
+

@@ -36,6 +36,10 @@ def spectrum(
     probe: Optional[int] = None,
 ) -> Dict[str, Any]: ...
 def scene_toml(scene: Scene) -> str: ...
+def examples() -> list[str]:
+    """The names of the example scenes the package carries."""
+def example(name: str) -> str:
+    """The TOML text of an example scene: pass it to ``simulate``, or save and edit it."""
 
 def table_integrity(data: bytes) -> str:
     """Whether a table's bytes match their manifest's seal: "intact", "damaged" or "unchecked"."""

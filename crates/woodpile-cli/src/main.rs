@@ -31,6 +31,7 @@ macro_rules! say {
     }};
 }
 mod diff_cmd;
+mod example_cmd;
 mod new_study;
 mod pipeline_cmd;
 mod progress;
@@ -55,6 +56,8 @@ struct Cli {
 enum Command {
     /// Simulate one scene file and print its energy fractions as one JSON object.
     Simulate(simulate::Args),
+    /// Print an example scene (`woodpile example single_eps10 > scene.toml`), or list them.
+    Example(example_cmd::Args),
     /// The scene's linear picture about its static state: bands, modes, transmission (JSON).
     Spectrum(spectrum::Args),
     /// Bring pipeline stages up to date: stale or missing ones only, upstream first.
@@ -128,6 +131,7 @@ fn main() -> ExitCode {
     }
     let result = match cli.command {
         Command::Simulate(args) => simulate::run(&args),
+        Command::Example(args) => example_cmd::run(&args),
         Command::Spectrum(args) => spectrum::run(&args),
         Command::Run(args) => pipeline_cmd::run_command(&args),
         Command::Status(args) => pipeline_cmd::status_command(&args),

@@ -141,3 +141,37 @@ fn a_time_with_a_unit_is_refused_where_it_cannot_be_read() {
         );
     }
 }
+
+/// The binary carries the example scenes: listed, printed, and runnable outside a clone.
+#[test]
+fn the_examples_are_listed_and_printed_without_a_clone() {
+    let woodpile = |args: &[&str], dir: &std::path::Path| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_woodpile"))
+            .args(args)
+            .current_dir(dir)
+            .output()
+            .unwrap()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let list = woodpile(&["example"], dir.path());
+    assert_eq!(list.status.code(), Some(0));
+    let listed = String::from_utf8_lossy(&list.stdout).into_owned();
+    assert!(
+        listed.contains("single_eps10") && listed.contains("woodpile_striker"),
+        "{listed}"
+    );
+    let scene = woodpile(&["example", "single_eps10"], dir.path());
+    let path = dir.path().join("single_eps10.toml");
+    std::fs::write(&path, &scene.stdout).unwrap();
+    let text = String::from_utf8_lossy(&scene.stdout).replace("t_end = 150.0", "t_end = 20.0");
+    std::fs::write(&path, text).unwrap();
+    let run = woodpile(&["simulate", "single_eps10.toml"], dir.path());
+    assert_eq!(run.status.code(), Some(0), "{}", stderr(&run));
+    let missing = woodpile(&["example", "nope"], dir.path());
+    assert_eq!(missing.status.code(), Some(2));
+    assert!(
+        stderr(&missing).contains("the examples are single_eps10"),
+        "{}",
+        stderr(&missing)
+    );
+}

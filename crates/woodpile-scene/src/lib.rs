@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod columns;
+pub mod examples;
 pub mod grid;
 mod raw;
 pub mod report;
