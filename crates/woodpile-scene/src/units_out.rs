@@ -5,9 +5,12 @@
 //! (R, T, E_tr, S, D) have no unit and are never converted.
 
 use serde_json::{json, Value};
-use woodpile_sim::observe::{FractionSeries, SiteField};
+use woodpile_sim::observe::{FractionSeries, SiteField, SpaceTimeField};
 
 use crate::Scene;
+
+/// What a table's `column_units` says of a column in the model's own scaled units.
+pub const SCALED: &str = "scaled";
 
 /// The units asked for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,6 +91,14 @@ impl SiFactors {
             scale(report, key, self.energy_j);
         }
         report["units"] = json!(Units::Si.name());
+    }
+
+    /// A space-time field with its times in s and its velocities in m/s.
+    pub fn space_time(&self, field: &mut SpaceTimeField) {
+        times(&mut field.t, self.time_s);
+        for v in &mut field.velocity {
+            *v = (f64::from(*v) * self.velocity_m_per_s) as f32;
+        }
     }
 
     /// A recorded series with its times in s and, unless it is a kinetic series (whose `E` is a

@@ -18,13 +18,16 @@
 //! ```
 //!
 //! Output: one row per point, sample and site: `point`, the axes, `t`, `site` (paper
-//! numbering), `velocity`. A scene whose simulation fails stops the stage with its reason.
+//! numbering), `velocity`; in the model's scaled units, or with `units = "SI"` (scenes with
+//! `[physical]`) `t` in s and `velocity` in m/s. The manifest's `column_units` says which, and
+//! a figure that labels a scaled axis in µs or m/s is refused. A scene whose simulation fails stops the stage with its reason.
 //!
 //! Instead of a grid, `design = "stage"` (with `inputs = ["stage"]` and `field.sites`) maps
 //! the best scene a `design` or `optimize` stage found, from its `results/<stage>.best.toml`.
 
 use rayon::prelude::*;
 use serde_json::json;
+use woodpile_scene::units_out::{SiFactors, Units, SCALED};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::observe::SpaceTimeField;
@@ -46,6 +49,9 @@ pub struct SpaceTime {
     pub source: Source,
     /// Paper sites kept, inclusive (for a design: checked when its scene is known).
     pub sites: [i64; 2],
+    /// `units = "SI"`: `t` in s and `velocity` in m/s (physical scenes only); else the
+    /// model's scaled units.
+    pub units: Units,
 }
 
 /// Where a spacetime stage's scenes come from.
@@ -84,6 +90,10 @@ fn field_size(scene: &Scene, count: usize, sites: [i64; 2]) -> std::result::Resu
 
 impl SpaceTime {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<SpaceTime> {
+        let units = match fields.optional::<String>("units")? {
+            None => Units::Scaled,
+            Some(name) => Units::parse(&name).map_err(|reason| fields.error("units", reason))?,
+        };
         if let Some(design) = fields.optional::<String>("design")? {
             let table: toml::Table = fields.optional("field")?.unwrap_or_default();
             let mut f = fields.nested("field", table);
@@ -94,6 +104,7 @@ impl SpaceTime {
             return Ok(SpaceTime {
                 source: Source::Design(design),
                 sites,
+                units,
             });
         }
         let sweep = Sweep::parse(fields)?;
@@ -111,9 +122,11 @@ impl SpaceTime {
         let largest = sweep.scene_at(sweep.count() - 1)?;
         field_size(&largest, sweep.count(), sites)
             .map_err(|reason| fields.error("field.sites", reason))?;
+        SiFactors::of(&scene, units).map_err(|reason| fields.error("units", reason))?;
         Ok(SpaceTime {
             source: Source::Grid(sweep),
             sites,
+            units,
         })
     }
 
@@ -137,6 +150,11 @@ impl SpaceTime {
                 let outcome = simulate(&scene.scenario, &mut field).map_err(|e| {
                     PipelineError::stage(stage, format!("point {i}: simulation failed: {e}"))
                 })?;
+                let si = SiFactors::of(&scene, self.units)
+                    .map_err(|reason| PipelineError::stage(stage, format!("units: {reason}")))?;
+                if let Some(si) = si {
+                    si.space_time(&mut field);
+                }
                 Ok((values, field, scene.first_site, outcome.error_estimate))
             })
             .collect::<Result<_>>()?;
@@ -146,16 +164,22 @@ impl SpaceTime {
             .fold(None, |m: Option<f64>, e| Some(m.map_or(e, |m| m.max(e))));
         let (columns, points) = self.columns(&fields, axes);
         let simulated = fields.len();
-        Ok(Output::table(
-            columns.into_frame()?,
-            json!({
-                "points": points,
-                "sites": self.sites,
-                "tolerance": tolerance,
-                "max_error_estimate": max_error_estimate,
-            }),
-        )
-        .with_simulated(simulated))
+        let mut summary = json!({
+            "points": points,
+            "sites": self.sites,
+            "tolerance": tolerance,
+            "max_error_estimate": max_error_estimate,
+        });
+        // What a figure may call its axes: seconds and metres per second, or the model's own.
+        let unit = |si: &'static str| match self.units {
+            Units::Si => si,
+            Units::Scaled => SCALED,
+        };
+        summary["column_units"] = json!({ "t": unit("s"), "velocity": unit("m/s") });
+        if self.units == Units::Si {
+            summary["units"] = json!(Units::Si.name());
+        }
+        Ok(Output::table(columns.into_frame()?, summary).with_simulated(simulated))
     }
 
     /// The scenes to map, each with its axis values, and the axes: the grid's, or a design

@@ -31,6 +31,7 @@ use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::Columns;
 use woodpile_pipeline::Output;
+use woodpile_scene::units_out::SCALED;
 use woodpile_spectrum::measured::{check, measure};
 use woodpile_spectrum::scene::{scene_spectrum, Asked, Frequency, Refusal, SceneRequest};
 use woodpile_spectrum::tables::{summary, table, Column, Part, Values};
@@ -145,9 +146,21 @@ impl Spectrum {
             rows.push((self.sweep.values(point), self.in_unit(columns)));
         }
         let unit = self.unit.as_ref().map(|(name, _)| name.as_str());
+        // What a figure may call the frequency axis: the stage's unit, Hz, or the model's own.
+        let physical = summaries.first().is_some_and(|p| p["units"] == "SI");
+        let column_unit = match (unit, physical) {
+            (Some(name), _) => name,
+            (None, true) => "Hz",
+            (None, false) => SCALED,
+        };
         Ok(Output::table(
             self.frame(rows)?,
-            json!({ "table": self.part.name(), "frequency_unit": unit, "points": summaries }),
+            json!({
+                "table": self.part.name(),
+                "frequency_unit": unit,
+                "column_units": { "frequency": column_unit },
+                "points": summaries,
+            }),
         ))
     }
 

@@ -381,3 +381,59 @@ source = { stage = "fits", column = "A", where = { model = "hopeless" } }
         "{markdown}"
     );
 }
+
+/// A spacetime stage over a physical scene may write SI columns (`units = "SI"`); a figure
+/// then draws `t` in the unit its label names, and a figure that labels the scaled columns of
+/// the same stage in µs is refused.
+#[test]
+fn axes_are_drawn_in_the_units_the_table_has() {
+    let field = |units: &str| {
+        format!(
+            r#"
+kind = "spacetime"
+{units}
+[scene]
+chain = {{ sites = [-10, 9], boundary = "free" }}
+physical = {{ contact = 2.5e9, mass = 1e-3, velocity = 1.0 }}
+impulse = {{ site = -10 }}
+run = {{ t_end = 10.0, method = "rk4", dt = 0.01, sample_every = 1.0 }}
+[field]
+sites = [-10, 9]
+"#
+        )
+    };
+    let figure = r#"
+kind = "render"
+inputs = ["field"]
+title = "rods"
+[heatmap]
+x = "t"
+y = "site"
+z = "velocity"
+x_label = "t (µs)"
+y_label = "rod"
+z_label = "velocity (mm/s)"
+"#;
+    let p = Project::new(&[("field", &field("units = \"SI\"")), ("figure", figure)]);
+    p.counted(&[]);
+    let field_table = table::read(&p.output("field")).unwrap();
+    let t = table::f64_column(&field_table, "t").unwrap();
+    let last = t.iter().flatten().fold(0.0_f64, |a, &b| a.max(b));
+    // 10 units of L/V seconds: tens of microseconds for these rods.
+    assert!(last > 1e-6 && last < 1e-3, "{last}");
+    let plotted = table::read(&p.output("figure")).unwrap();
+    let x = table::f64_column(&plotted, "t").unwrap();
+    let drawn = x.iter().flatten().fold(0.0_f64, |a, &b| a.max(b));
+    assert!(
+        (drawn - last * 1e6).abs() < 1e-9 * drawn,
+        "{drawn} µs against {last} s"
+    );
+    let p = Project::new(&[("field", &field("")), ("figure", figure)]);
+    let e = p.run(&[]).unwrap_err().to_string();
+    assert!(e.contains("names µs") && e.contains("scaled units"), "{e}");
+    let e = load_error(&[(
+        "field",
+        &field("units = \"SI\"").replace("physical = ", "# "),
+    )]);
+    assert!(e.contains("units"), "{e}");
+}

@@ -43,6 +43,11 @@
 //! their ranges, so that panels compare by colour (the paper's Fig. 9), and draws its colour
 //! bar (or category legend) once, beside the panels.
 //!
+//! An axis label may end with its unit in parentheses, `x_label = "t (µs)"`. When the input
+//! says its columns' units (a spacetime stage with `units = "SI"`, a spectrum stage's
+//! `frequency`), the column is drawn in that unit; a label naming a unit the column is not in
+//! (µs on the model's scaled time) is refused.
+//!
 //! Titles (the figure's and fixed panel titles) may quote an input's manifest:
 //! `{stage.params.at}`, `{stage.summary.tolerance}` or `{stage.params.scene.defect.0.eps}` (a
 //! number indexes an array) is replaced by that value, so a title follows the parameters it
@@ -126,6 +131,7 @@ mod plotted;
 mod spec;
 mod style;
 mod title;
+mod units;
 
 pub use spec::{CurveStyle, PanelSpec, Plot, ZRange};
 pub use style::{Labels, StyleSpec};
@@ -253,11 +259,13 @@ impl Render {
         let mut names = Vec::new();
         let mut specs: Vec<&PanelSpec> = Vec::new();
         for spec in &self.panels {
-            let (frame, _) = &inputs[&spec.input];
+            let (frame, manifest) = &inputs[&spec.input];
             spec.check_columns(frame)
                 .map_err(|reason| PipelineError::stage(stage, reason))?;
+            let frame = units::in_label_units(spec, frame, manifest)
+                .map_err(|reason| PipelineError::stage(stage, reason))?;
             let title = spec.title.as_deref().map(quote).transpose()?;
-            let drawn = spec.draw(frame, title).map_err(fail)?;
+            let drawn = spec.draw(&frame, title).map_err(fail)?;
             names.extend(std::iter::repeat_n(spec.columns(), drawn.len()));
             specs.extend(std::iter::repeat_n(spec, drawn.len()));
             panels.extend(drawn);
