@@ -8,6 +8,7 @@ use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use woodpile_points::rows::{columns, sweep, Cell, Column, Row};
+use woodpile_scene::units_out::SiFactors;
 use woodpile_scene::Scene;
 use woodpile_sim::simulation::{simulate, simulate_batch, Outcome};
 
@@ -102,10 +103,12 @@ pub(crate) fn simulate_group(
 }
 
 /// The rows of `simulate_many`: one per scene, in input order; `S` on every row when any
-/// scene has a striker, and `D` when any declares damping, as a sweep's table has them.
+/// scene has a striker, and `D` when any declares damping, as a sweep's table has them. With
+/// `si` (one per scene), `dt` is in s and the energies in J.
 pub(crate) fn outcome_rows<'a>(
     outcomes: &'a [Result<Outcome, String>],
     scenes: &[Scene],
+    si: &[Option<SiFactors>],
 ) -> Vec<OutcomeRow<'a>> {
     let striker = scenes.iter().any(|s| s.scenario.region.has_striker());
     let dissipation = scenes.iter().any(|s| s.scenario.model.is_dissipative());
@@ -117,6 +120,7 @@ pub(crate) fn outcome_rows<'a>(
             outcome,
             striker,
             dissipation,
+            si: si.get(point).copied().flatten(),
         })
         .collect()
 }
@@ -127,12 +131,15 @@ pub(crate) struct OutcomeRow<'a> {
     outcome: &'a Result<Outcome, String>,
     striker: bool,
     dissipation: bool,
+    /// SI factors, when the row is asked in SI units.
+    si: Option<SiFactors>,
 }
 
 impl Row for OutcomeRow<'_> {
     fn cells(&self) -> Vec<(&str, Cell)> {
         let ok = self.outcome.as_ref().ok();
         let share = |pick: fn(&Outcome) -> f64| Cell::from(ok.map(pick));
+        let (time, energy) = self.si.map_or((1.0, 1.0), |f| (f.time_s, f.energy_j));
         let mut cells = vec![
             (sweep::POINT, Cell::from(self.point as i64)),
             (sweep::REFLECTED, share(|o| o.fractions.reflected)),
@@ -146,12 +153,12 @@ impl Row for OutcomeRow<'_> {
             cells.push((sweep::DISSIPATED, share(|o| o.fractions.dissipated)));
         }
         cells.extend([
-            ("E_initial", share(|o| o.e_initial)),
-            ("E_final", share(|o| o.e_final)),
+            ("E_initial", ok.map(|o| o.e_initial * energy).into()),
+            ("E_final", ok.map(|o| o.e_final * energy).into()),
             ("error_estimate", ok.and_then(|o| o.error_estimate).into()),
             (
                 "dt",
-                ok.and_then(|o| o.plan.dt().map(|_| o.stats.max_step))
+                ok.and_then(|o| o.plan.dt().map(|_| o.stats.max_step * time))
                     .into(),
             ),
             ("steps", ok.map(|o| o.stats.steps as i64).into()),

@@ -19,6 +19,7 @@ use woodpile_scene::grid::{
     PLANNED_BYTES_PER_SITE,
 };
 use woodpile_scene::template::Template;
+use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::simulation::batch_size;
 
@@ -334,12 +335,15 @@ fn points_done(
 /// order, as `_sweep` returns its points (four neighbours at a time in lanes where they can). A scene that fails to simulate is a row with its
 /// reason; one that is invalid is a `SceneError` naming its index.
 #[pyfunction]
-#[pyo3(signature = (scenes, progress = None))]
+#[pyo3(signature = (scenes, progress = None, units = "scaled"))]
 pub(crate) fn simulate_many<'py>(
     py: Python<'py>,
     scenes: &Bound<'py, PyAny>,
     progress: Option<Py<PyAny>>,
+    units: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let units =
+        Units::parse(units).map_err(|reason| SceneError::new_err(format!("units: {reason}")))?;
     let mut list = Vec::new();
     // The scenes planned so far hold their chains: stop as soon as they alone are too many,
     // before the next is planned (the whole list is checked below).
@@ -358,6 +362,14 @@ pub(crate) fn simulate_many<'py>(
     }
     woodpile_scene::grid::check_list_memory(&list)
         .map_err(|reason| SceneError::new_err(format!("scenes: {reason}")))?;
+    let si = list
+        .iter()
+        .enumerate()
+        .map(|(index, scene)| {
+            SiFactors::of(scene, units)
+                .map_err(|reason| SceneError::new_err(format!("scenes[{index}]: units: {reason}")))
+        })
+        .collect::<PyResult<Vec<_>>>()?;
     let done = AtomicUsize::new(0);
     let poll = |py: Python<'_>| points_done(py, progress.as_ref(), &done, list.len());
     let (outcomes, signal) = interruptible_keeping(py, &poll, |cancel| {
@@ -378,5 +390,5 @@ pub(crate) fn simulate_many<'py>(
         return Err(signal);
     }
     let outcomes = outcomes.map_err(PyValueError::new_err)?;
-    table_dict(py, &outcome_rows(&outcomes, &list))
+    table_dict(py, &outcome_rows(&outcomes, &list, &si))
 }

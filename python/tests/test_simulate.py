@@ -248,3 +248,16 @@ def test_the_package_carries_the_example_scenes():
     assert 0 <= r.E_tr <= 1
     with pytest.raises(woodpile.SceneError, match="single_eps10"):
         woodpile.example("nope")
+
+
+def test_simulate_many_gives_si_units_per_scene():
+    """`units="SI"`: each scene's dt in s and energies in J, as `simulate` gives them."""
+    text = woodpile.example("woodpile_experiment")
+    scenes = [text, text.replace("velocity = 1.98", "velocity = 1.2")]
+    frame = woodpile.simulate_many(scenes, progress=False, units="SI")
+    for i, scene in enumerate(scenes):
+        one = woodpile.simulate(scene, units="SI")
+        assert frame.E_initial[i] == one.E_initial and frame.E_final[i] == one.E_final
+        assert frame.R[i] == one.R
+    with pytest.raises(woodpile.SceneError, match=r"scenes\[0\]: units"):
+        woodpile.simulate_many([{"chain": {"n": 10}, "impulse": {"site": -5}}], progress=False, units="SI")

@@ -26,7 +26,9 @@ def sweep(
     progress: Optional[Callable[[int, int], None]] = None,
 ) -> Dict[str, Any]: ...
 def simulate_many(
-    scenes: Sequence[Scene], progress: Optional[Callable[[int, int], None]] = None
+    scenes: Sequence[Scene],
+    progress: Optional[Callable[[int, int], None]] = None,
+    units: str = "scaled",
 ) -> Dict[str, Any]: ...
 def spectrum(
     scene: Scene,

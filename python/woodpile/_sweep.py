@@ -82,7 +82,9 @@ def sweep(
         bar.close()
 
 
-def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -> pd.DataFrame:
+def simulate_many(
+    scenes: Sequence[Scene], *, progress: Optional[bool] = None, units: str = "scaled"
+) -> pd.DataFrame:
     """Simulate any list of scenes on all cores, with the GIL released: the points an
     optimiser picks rather than a grid (SciPy's ``differential_evolution`` with
     ``vectorized=True`` hands over a population at once).
@@ -90,6 +92,9 @@ def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -
     Args:
         scenes: dicts with the keys of a scene file, TOML strings or paths, in any mix.
         progress: a progress line on stderr, as ``sweep``'s.
+        units: ``"scaled"`` (the default) or ``"SI"``: ``dt`` in s and ``E_initial``,
+            ``E_final`` in J, each scene with its own scales (every scene must then have a
+            ``[physical]`` table). The shares have no unit.
 
     Returns:
         A DataFrame with one row per scene, in input order: ``point`` (the scene's index),
@@ -101,7 +106,8 @@ def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -
         ``failure``; each number is what ``simulate`` gives for that scene, bit for bit.
 
     Raises:
-        SceneError: a scene is invalid (the message names its index, ``scenes[i]``).
+        SceneError: a scene is invalid, or has no scales for ``units="SI"`` (the message names
+            its index, ``scenes[i]``).
         TypeError: ``scenes`` is one scene (a string, path or dict) rather than a list, or
             ``progress`` is not True, False or None.
         KeyboardInterrupt: Ctrl-C stops the runs within about a second.
@@ -113,7 +119,7 @@ def simulate_many(scenes: Sequence[Scene], *, progress: Optional[bool] = None) -
         )
     bar = Progress("simulate_many", progress)
     try:
-        return _frame(_core.simulate_many(list(scenes), bar.points))
+        return _frame(_core.simulate_many(list(scenes), bar.points, units))
     finally:
         bar.close()
 
