@@ -10,6 +10,7 @@ use pyo3::types::{PyDict, PyList};
 use woodpile_points::rows::{columns, sweep, Cell, Column, Row};
 use woodpile_scene::units_out::SiFactors;
 use woodpile_scene::Scene;
+use woodpile_sim::observe::SiteField;
 use woodpile_sim::simulation::{simulate, simulate_batch, Outcome};
 
 use crate::interrupt::{internal_message, Watch};
@@ -45,61 +46,84 @@ pub(crate) fn table_dict<'py, R: Row>(py: Python<'py>, rows: &[R]) -> PyResult<B
     Ok(out)
 }
 
+/// One listed scene's run: its outcome (or why it failed) and, when fields were asked for, the
+/// field it recorded.
+pub(crate) type Listed = (Result<Outcome, String>, Option<SiteField>);
+
+/// What one scene's run records: nothing, or every site's field.
+fn recorder(scene: &Scene, fields: bool) -> Option<SiteField> {
+    let n = scene.scenario.model.n_sites();
+    fields.then(|| SiteField::new(&scene.scenario.model, 0, n - 1))
+}
+
 /// `scene` simulated as `simulate` runs it (stopped once `cancel` is raised), keeping only what
 /// the table reads: a run's final state is a chain's worth of floats, which thousands of scenes
 /// of a long chain would hold at once. A panic in the core is this scene's failure.
-pub(crate) fn simulate_one(scene: &Scene, cancel: &AtomicBool) -> Result<Outcome, String> {
+pub(crate) fn simulate_one(scene: &Scene, cancel: &AtomicBool, fields: bool) -> Listed {
     if cancel.load(Ordering::Relaxed) {
-        return Err("cancelled".into());
+        return (Err("cancelled".into()), None);
     }
     let stop = || cancel.load(Ordering::Relaxed);
     let run = || {
         let mut watched = Watch {
-            inner: (),
+            inner: recorder(scene, fields),
             stop: &stop,
             clock: None,
         };
-        let mut outcome = simulate(&scene.scenario, &mut watched).map_err(|e| e.to_string())?;
-        outcome.final_state = Vec::new();
-        Ok(outcome)
+        let outcome = simulate(&scene.scenario, &mut watched).map(|mut outcome| {
+            outcome.final_state = Vec::new();
+            outcome
+        });
+        match outcome {
+            Ok(outcome) => (Ok(outcome), watched.inner),
+            Err(e) => (Err(e.to_string()), None),
+        }
     };
     std::panic::catch_unwind(AssertUnwindSafe(run))
-        .unwrap_or_else(|panic| Err(internal_message(&panic)))
+        .unwrap_or_else(|panic| (Err(internal_message(&panic)), None))
 }
 
 /// [`simulate_one`] of each of `scenes`, neighbours together: four consecutive scenes that
 /// share a chain and a first step run `auto`'s first pair in lanes
 /// (`woodpile_sim::simulation::simulate_batch`), with the same results. A panic makes each
 /// scene again alone, so that it is the failure of its own scene only.
-pub(crate) fn simulate_group(
-    scenes: &[&Scene],
-    cancel: &AtomicBool,
-) -> Vec<Result<Outcome, String>> {
+pub(crate) fn simulate_group(scenes: &[&Scene], cancel: &AtomicBool, fields: bool) -> Vec<Listed> {
     let stop = || cancel.load(Ordering::Relaxed);
     let run = || {
         let scenarios: Vec<_> = scenes.iter().map(|s| &s.scenario).collect();
         let mut watches: Vec<_> = scenes
             .iter()
-            .map(|_| Watch {
-                inner: (),
+            .map(|scene| Watch {
+                inner: recorder(scene, fields),
                 stop: &stop,
                 clock: None,
             })
             .collect();
-        simulate_batch(&scenarios, &mut watches)
+        let outcomes = simulate_batch(&scenarios, &mut watches);
+        outcomes
             .into_iter()
-            .map(|outcome| {
-                let mut outcome = outcome.map_err(|e| e.to_string())?;
-                outcome.final_state = Vec::new();
-                Ok(outcome)
+            .zip(watches)
+            .map(|(outcome, watched)| match outcome {
+                Ok(mut outcome) => {
+                    outcome.final_state = Vec::new();
+                    (Ok(outcome), watched.inner)
+                }
+                Err(e) => (Err(e.to_string()), None),
             })
             .collect()
     };
     if stop() {
-        return scenes.iter().map(|_| Err("cancelled".into())).collect();
+        return scenes
+            .iter()
+            .map(|_| (Err("cancelled".into()), None))
+            .collect();
     }
-    std::panic::catch_unwind(AssertUnwindSafe(run))
-        .unwrap_or_else(|_| scenes.iter().map(|s| simulate_one(s, cancel)).collect())
+    std::panic::catch_unwind(AssertUnwindSafe(run)).unwrap_or_else(|_| {
+        scenes
+            .iter()
+            .map(|s| simulate_one(s, cancel, fields))
+            .collect()
+    })
 }
 
 /// The rows of `simulate_many`: one per scene, in input order; `S` on every row when any

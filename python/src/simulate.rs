@@ -170,7 +170,7 @@ fn internal_sites(scene: &Scene, (lo, hi): (i64, i64)) -> PyResult<(usize, usize
         .map_err(|reason| SceneError::new_err(format!("field_sites ({lo}, {hi}): {reason}")))
 }
 
-fn add_field(
+pub(crate) fn add_field(
     py: Python<'_>,
     out: &Bound<'_, PyDict>,
     scene: &Scene,

@@ -335,12 +335,13 @@ fn points_done(
 /// order, as `_sweep` returns its points (four neighbours at a time in lanes where they can). A scene that fails to simulate is a row with its
 /// reason; one that is invalid is a `SceneError` naming its index.
 #[pyfunction]
-#[pyo3(signature = (scenes, progress = None, units = "scaled"))]
+#[pyo3(signature = (scenes, progress = None, units = "scaled", fields = false))]
 pub(crate) fn simulate_many<'py>(
     py: Python<'py>,
     scenes: &Bound<'py, PyAny>,
     progress: Option<Py<PyAny>>,
     units: &str,
+    fields: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let units =
         Units::parse(units).map_err(|reason| SceneError::new_err(format!("units: {reason}")))?;
@@ -370,6 +371,9 @@ pub(crate) fn simulate_many<'py>(
                 .map_err(|reason| SceneError::new_err(format!("scenes[{index}]: units: {reason}")))
         })
         .collect::<PyResult<Vec<_>>>()?;
+    if fields {
+        check_fields(&list)?;
+    }
     let done = AtomicUsize::new(0);
     let poll = |py: Python<'_>| points_done(py, progress.as_ref(), &done, list.len());
     let (outcomes, signal) = interruptible_keeping(py, &poll, |cancel| {
@@ -379,7 +383,7 @@ pub(crate) fn simulate_many<'py>(
             list.par_chunks(batch_size(list.len()))
                 .flat_map_iter(|group| {
                     let group: Vec<&Scene> = group.iter().collect();
-                    let outcomes = crate::listed::simulate_group(&group, cancel);
+                    let outcomes = crate::listed::simulate_group(&group, cancel, fields);
                     done.fetch_add(group.len(), Ordering::Relaxed);
                     outcomes
                 })
@@ -389,6 +393,48 @@ pub(crate) fn simulate_many<'py>(
     if let Some(signal) = signal {
         return Err(signal);
     }
-    let outcomes = outcomes.map_err(PyValueError::new_err)?;
-    table_dict(py, &outcome_rows(&outcomes, &list, &si))
+    let listed = outcomes.map_err(PyValueError::new_err)?;
+    let (outcomes, recorded): (Vec<_>, Vec<_>) = listed.into_iter().unzip();
+    let table = table_dict(py, &outcome_rows(&outcomes, &list, &si))?;
+    if fields {
+        let each = pyo3::types::PyList::empty(py);
+        for ((scene, field), si) in list.iter().zip(recorded).zip(&si) {
+            match field {
+                None => each.append(py.None())?,
+                Some(mut field) => {
+                    if let Some(si) = si {
+                        si.field(&mut field);
+                    }
+                    let arrays = PyDict::new(py);
+                    crate::simulate::add_field(py, &arrays, scene, field)?;
+                    each.append(arrays)?;
+                }
+            }
+        }
+        table.set_item("fields", each)?;
+    }
+    Ok(table)
+}
+
+/// Most field values (samples × sites, summed over the scenes) `simulate_many(fields=True)`
+/// keeps: each is four doubles, so 2.5·10^7 take 800 MB.
+const MAX_LISTED_FIELD_VALUES: f64 = 2.5e7;
+
+/// Refuses fields too large to hold: each scene's own bound, then all of them together.
+fn check_fields(list: &[Scene]) -> PyResult<()> {
+    let mut total = 0.0;
+    for (index, scene) in list.iter().enumerate() {
+        let s = &scene.scenario;
+        let n = s.model.n_sites();
+        woodpile_sim::observe::SiteField::check_size(s, n)
+            .map_err(|reason| SceneError::new_err(format!("scenes[{index}]: fields: {reason}")))?;
+        let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) as f64 + 1.0;
+        total += samples * n as f64;
+    }
+    if total > MAX_LISTED_FIELD_VALUES {
+        return Err(SceneError::new_err(format!(
+            "fields: the scenes' fields would hold {total:.3e} values, more than the {MAX_LISTED_FIELD_VALUES:e} simulate_many keeps; ask for fewer scenes at once, or sample less often"
+        )));
+    }
+    Ok(())
 }

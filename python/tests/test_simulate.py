@@ -261,3 +261,27 @@ def test_simulate_many_gives_si_units_per_scene():
         assert frame.R[i] == one.R
     with pytest.raises(woodpile.SceneError, match=r"scenes\[0\]: units"):
         woodpile.simulate_many([{"chain": {"n": 10}, "impulse": {"site": -5}}], progress=False, units="SI")
+
+
+def test_simulate_many_returns_each_scenes_field():
+    """`fields=True`: each scene's field, bit for bit the one `simulate` records."""
+    scenes = [
+        {"chain": {"n": 20}, "impulse": {"site": -5}, "defect": [{"site": 0, "eps": eps}], "run": {"t_end": 15.0}}
+        for eps in (1.0, 2.0, 3.0)
+    ]
+    frame = woodpile.simulate_many(scenes, progress=False, fields=True)
+    for i, scene in enumerate(scenes):
+        one = woodpile.simulate(scene, fields=True)
+        field = frame.field[i]
+        assert np.array_equal(field["t"], one.t)
+        assert np.array_equal(field["velocity"], one.velocity)
+        assert np.array_equal(field["sites"], one.sites)
+    assert "field" not in woodpile.simulate_many(scenes[:1], progress=False).columns
+    with pytest.raises(TypeError, match="fields"):
+        woodpile.simulate_many(scenes, progress=False, fields=1)
+
+
+def test_simulate_many_refuses_fields_that_would_not_fit_before_running():
+    big = {"chain": {"n": 2000}, "impulse": {"site": -5}, "run": {"t_end": 150.0, "sample_every": 0.05}}
+    with pytest.raises(woodpile.SceneError, match="fields"):
+        woodpile.simulate_many([big] * 8, progress=False, fields=True)

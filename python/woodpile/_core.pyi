@@ -29,6 +29,7 @@ def simulate_many(
     scenes: Sequence[Scene],
     progress: Optional[Callable[[int, int], None]] = None,
     units: str = "scaled",
+    fields: bool = False,
 ) -> Dict[str, Any]: ...
 def spectrum(
     scene: Scene,

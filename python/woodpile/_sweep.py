@@ -83,7 +83,11 @@ def sweep(
 
 
 def simulate_many(
-    scenes: Sequence[Scene], *, progress: Optional[bool] = None, units: str = "scaled"
+    scenes: Sequence[Scene],
+    *,
+    progress: Optional[bool] = None,
+    units: str = "scaled",
+    fields: bool = False,
 ) -> pd.DataFrame:
     """Simulate any list of scenes on all cores, with the GIL released: the points an
     optimiser picks rather than a grid (SciPy's ``differential_evolution`` with
@@ -95,6 +99,12 @@ def simulate_many(
         units: ``"scaled"`` (the default) or ``"SI"``: ``dt`` in s and ``E_initial``,
             ``E_final`` in J, each scene with its own scales (every scene must then have a
             ``[physical]`` table). The shares have no unit.
+        fields: also record every site's field at every sample of each scene, for fits in
+            your own code: a column ``field`` holds, per scene, a dict with ``t``, ``sites``,
+            ``velocity``, ``displacement``, ``energy``, ``kinetic`` (float64 arrays of shape
+            (time, site)) and the resonators' ``resonator_sites``, ``resonator_displacement``
+            and ``resonator_velocity``, as ``simulate(..., fields=True)`` has them (None for a
+            scene whose run failed). In SI with ``units="SI"``.
 
     Returns:
         A DataFrame with one row per scene, in input order: ``point`` (the scene's index),
@@ -107,7 +117,7 @@ def simulate_many(
 
     Raises:
         SceneError: a scene is invalid, or has no scales for ``units="SI"`` (the message names
-            its index, ``scenes[i]``).
+            its index, ``scenes[i]``), or the fields asked for would not fit in memory.
         TypeError: ``scenes`` is one scene (a string, path or dict) rather than a list, or
             ``progress`` is not True, False or None.
         KeyboardInterrupt: Ctrl-C stops the runs within about a second.
@@ -117,11 +127,18 @@ def simulate_many(
             "simulate_many: scenes must be a list of scenes (dicts, TOML strings or paths), "
             f"not one {type(scenes).__name__}; for one scene, pass [scene] or call simulate"
         )
+    if not isinstance(fields, bool):
+        raise TypeError(f"fields must be True or False, not {type(fields).__name__}")
     bar = Progress("simulate_many", progress)
     try:
-        return _frame(_core.simulate_many(list(scenes), bar.points, units))
+        raw = _core.simulate_many(list(scenes), bar.points, units, fields)
     finally:
         bar.close()
+    recorded = raw.pop("fields", None)
+    frame = _frame(raw)
+    if recorded is not None:
+        frame["field"] = pd.Series(recorded, dtype=object)
+    return frame
 
 
 @contextlib.contextmanager

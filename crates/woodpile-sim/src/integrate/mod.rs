@@ -120,6 +120,23 @@ impl Observer for () {
     fn reset(&mut self) {}
 }
 
+/// An observer that may not be there: a run that records only when asked.
+impl<A: Observer> Observer for Option<A> {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        if let Some(inner) = self {
+            inner.observe(model, t, y);
+        }
+    }
+    fn reset(&mut self) {
+        if let Some(inner) = self {
+            inner.reset();
+        }
+    }
+    fn cancelled(&self) -> bool {
+        self.as_ref().is_some_and(Observer::cancelled)
+    }
+}
+
 impl<A: Observer, B: Observer> Observer for (A, B) {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
         self.0.observe(model, t, y);
