@@ -231,6 +231,9 @@ pub fn scene_json(scene: &Scene) -> Value {
             "exponent": law.exponent(),
             "precompression": law.precompression(),
         });
+        if law.gravity() > 0.0 {
+            canonical["contacts"]["gravity"] = json!(law.gravity());
+        }
     }
     if s.region.has_striker() {
         canonical["striker"] = json!(true);

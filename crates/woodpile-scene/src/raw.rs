@@ -58,6 +58,8 @@ pub(crate) struct Chain {
     pub precompression: Option<f64>,
     /// The coefficient a of the two wall contacts.
     pub wall_contact: Option<f64>,
+    /// g: the chain stands upright, its first site on top.
+    pub gravity: Option<f64>,
 }
 
 /// Site properties over a range of paper sites.

@@ -63,6 +63,8 @@ pub struct ContactLaw {
     exponent: f64,
     power: Power,
     precompression: f64,
+    /// g, when the static forces are the weights above each contact (0 otherwise).
+    gravity: f64,
     /// a_b for bonds 0..=S.
     coefficient: Vec<f64>,
     /// δ_b for bonds 0..=S (0 without precompression).
@@ -98,12 +100,66 @@ impl ContactLaw {
                 value: precompression,
             });
         }
+        let loads = vec![precompression; coefficients.len()];
+        Ok(ContactLaw::loaded(
+            coefficients,
+            exponent,
+            &loads,
+            precompression,
+            0.0,
+        ))
+    }
+
+    /// The contacts of a vertical chain in gravity `g` (the first site on top): bond b carries
+    /// `weights_above[b]`, the weight g·m of every body above it, so the rest state (u = 0) is
+    /// an exact equilibrium and each contact subtracts its own static force, as under a
+    /// precompression. Where a contact opens, the static force it subtracts is the weight it no
+    /// longer carries: the motion about the rest state is the motion in gravity, exactly.
+    pub fn under_gravity(
+        coefficients: Vec<f64>,
+        exponent: f64,
+        weights_above: &[f64],
+        gravity: f64,
+    ) -> Result<ContactLaw, ModelError> {
+        let law = ContactLaw::new(coefficients, exponent, 0.0)?;
+        if !(gravity.is_finite() && gravity > 0.0) {
+            return Err(ModelError::NotPositive {
+                what: "gravity".into(),
+                value: gravity,
+            });
+        }
+        if weights_above.len() != law.coefficient.len()
+            || weights_above.iter().any(|w| !(w.is_finite() && *w >= 0.0))
+        {
+            return Err(ModelError::Negative {
+                what: "the weight above a contact".into(),
+                value: weights_above.iter().copied().fold(f64::NAN, f64::min),
+            });
+        }
+        Ok(ContactLaw::loaded(
+            law.coefficient,
+            exponent,
+            weights_above,
+            0.0,
+            gravity,
+        ))
+    }
+
+    /// The law whose bond b carries the static force `loads[b]` (checked by the callers).
+    fn loaded(
+        coefficients: Vec<f64>,
+        exponent: f64,
+        loads: &[f64],
+        precompression: f64,
+        gravity: f64,
+    ) -> ContactLaw {
         let power = Power::of(exponent);
         let static_overlap: Vec<f64> = coefficients
             .iter()
-            .map(|&a| match precompression {
+            .zip(loads)
+            .map(|(&a, &load)| match load {
                 0.0 => 0.0,
-                f0 => (f0 / a).powf(1.0 / exponent),
+                f => (f / a).powf(1.0 / exponent),
             })
             .collect();
         let static_force = coefficients
@@ -111,14 +167,15 @@ impl ContactLaw {
             .zip(&static_overlap)
             .map(|(&a, &delta)| a * power.at(delta))
             .collect();
-        Ok(ContactLaw {
+        ContactLaw {
             exponent,
             power,
             precompression,
+            gravity,
             coefficient: coefficients,
             static_overlap,
             static_force,
-        })
+        }
     }
 
     /// Number of bonds, walls included (sites + 1).
@@ -134,6 +191,11 @@ impl ContactLaw {
     /// The static force F0 (0 without precompression).
     pub fn precompression(&self) -> f64 {
         self.precompression
+    }
+
+    /// g of a chain in gravity (0 for none): its contacts carry the weights above them.
+    pub fn gravity(&self) -> f64 {
+        self.gravity
     }
 
     /// a_b.

@@ -8,6 +8,7 @@ use super::check::{
     invalid, non_negative, number, number_text, only_keys, positive, positive_pattern, required,
     Invalid,
 };
+use super::gravity;
 use super::physical::Si;
 use crate::raw;
 
@@ -268,17 +269,19 @@ fn fits(key: &str, len: usize, room: usize, what: &str) -> Result<(), Invalid> {
 /// (then the chain is the paper's and keeps its bits). Walls carry `chain.wall_contact`.
 pub(crate) fn contact_law(
     chain: Option<&raw::Chain>,
-    boundary: Boundary,
-    has_striker: bool,
+    (boundary, has_striker): (Boundary, bool),
     si: Option<&Si>,
     sites: &mut Sites,
+    carried: &[f64],
 ) -> Result<Option<ContactLaw>, Invalid> {
+    let gravity = gravity::gravity(chain, boundary, si)?;
     let (exponent, precompression, wall_contact) = chain.map_or((None, None, None), |c| {
         (c.exponent, c.precompression, c.wall_contact)
     });
     let declared = exponent.is_some()
         || precompression.is_some()
         || wall_contact.is_some()
+        || gravity.is_some()
         || sites.contacts_set;
     if !declared {
         return Ok(None);
@@ -327,7 +330,12 @@ pub(crate) fn contact_law(
         sites.set_contact(0, a);
         sites.set_contact(last, a);
     }
-    ContactLaw::new(sites.contacts.clone(), exponent, precompression)
-        .map(Some)
-        .map_err(|e| invalid("chain", e.to_string()))
+    let law = match gravity {
+        None => ContactLaw::new(sites.contacts.clone(), exponent, precompression),
+        Some(g) => {
+            let above = gravity::weights_above(carried, g);
+            ContactLaw::under_gravity(sites.contacts.clone(), exponent, &above, g)
+        }
+    };
+    law.map(Some).map_err(|e| invalid("chain", e.to_string()))
 }

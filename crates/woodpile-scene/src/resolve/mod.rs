@@ -14,6 +14,7 @@ mod check;
 mod damping;
 mod defects;
 mod excitation;
+mod gravity;
 mod physical;
 mod run;
 pub mod time;
@@ -190,13 +191,21 @@ fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Resu
             excitation::striker(striker, file.impulse.is_some(), boundary, si, &mut sites)?
         }
     };
+    // What each site carries down the chain: its own mass and its resonators'.
+    let mut carried = sites.masses.clone();
+    for r in &resonators {
+        carried[r.site] += r.eps;
+    }
     let law = chain::contact_law(
         chain_table,
-        boundary,
-        file.striker.is_some(),
+        (boundary, file.striker.is_some()),
         si,
         &mut sites,
+        &carried,
     )?;
+    if law.as_ref().is_some_and(|l| l.gravity() > 0.0) {
+        gravity::check_resonators(&resonators)?;
+    }
     let striker = file
         .striker
         .as_ref()
@@ -276,6 +285,9 @@ fn physical_values(
         .filter(|l| l.precompression() > 0.0)
     {
         values.push(("precompression".into(), law.precompression()));
+    }
+    if let Some(law) = scenario.model.contacts().filter(|l| l.gravity() > 0.0) {
+        values.push(("gravity".into(), law.gravity()));
     }
     Physical {
         scales: si.scales,

@@ -160,3 +160,27 @@ fn tables_have_equal_columns_in_paper_sites() {
     };
     assert_eq!((sites[0], sites[60]), (-30, 30));
 }
+
+/// A chain in gravity has a linear regime too: each contact's stiffness is
+/// K(z) = (3/2) a δ(z)^{1/2} with δ(z) the overlap under the weight above it, so the sound
+/// speed sqrt(K/m) grows with depth.
+#[test]
+fn a_chain_in_gravity_stiffens_with_depth() {
+    let s = scene(
+        "[chain]\nsites = [0, 29]\nboundary = { left = \"free\", right = \"fixed\" }\ngravity = 0.01\n[impulse]\nsite = 0\n",
+    );
+    let linear = crate::linearise_precompressed(&s.scenario.model, 0.0).unwrap();
+    let chain = &linear.chain;
+    assert_eq!(chain.stiffness(0), 0.0, "the top is free");
+    for bond in 1..=30 {
+        let delta = (0.01 * bond as f64).powf(2.0 / 3.0);
+        let expected = 1.5 * delta.sqrt();
+        let got = chain.stiffness(bond);
+        assert!(
+            (got - expected).abs() <= 1e-14 * expected,
+            "bond {bond}: {got}"
+        );
+    }
+    let spectrum = scene_spectrum(&s, &SceneRequest::default()).unwrap();
+    assert!(spectrum.analysis.modes.complete);
+}
