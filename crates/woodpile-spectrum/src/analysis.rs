@@ -27,6 +27,9 @@ pub const BAND_WAVENUMBERS: usize = 201;
 pub const WAVENUMBER_FREQUENCIES: usize = 401;
 /// How far above the top band the complex wavenumber is sampled.
 pub const WAVENUMBER_SPAN: f64 = 1.25;
+/// Why a graded chain has no transmission.
+const GRADED: &str = "a chain in gravity is graded (its contacts stiffen with depth), so it has no uniform lead to scatter from; its modes are every mode of the chain";
+
 /// Frequencies in the default transmission grid.
 pub const DEFAULT_POINTS: usize = 400;
 
@@ -38,6 +41,11 @@ pub struct Request {
     /// The transmission's frequencies: `[lower, upper]` (ω) and how many; `None` for
     /// [`DEFAULT_POINTS`] spread evenly inside the leads' band.
     pub frequencies: Option<FrequencyGrid>,
+    /// The number messages give site 0 (a scene's paper numbering).
+    pub first_site: i64,
+    /// Whether the chain is graded (in gravity, its contacts stiffen with depth): it then has
+    /// no uniform lead to scatter from, and no host whose stop bands make a mode localised.
+    pub graded: bool,
 }
 
 /// `points` frequencies evenly spaced over [lower, upper] (ω), ends included.
@@ -130,8 +138,8 @@ impl FrequencyGrid {
 /// The linear picture of `chain` (see the module documentation).
 pub fn analyse(chain: &LinearChain, request: &Request) -> Result<Analysis, SpectrumError> {
     let host = match &request.cell {
-        Some(sites) => cell_of(chain, sites.clone())?,
-        None => detect_cell(chain)?,
+        Some(sites) => cell_of(chain, sites.clone(), request.first_site)?,
+        None => detect_cell(chain, request.first_site)?,
     };
     let pass_bands = host.cell.pass_bands()?;
     let top = pass_bands.last().map_or(0.0, |band| band.upper);
@@ -141,8 +149,14 @@ pub fn analyse(chain: &LinearChain, request: &Request) -> Result<Analysis, Spect
             Ok((omega, host.cell.wavenumber(omega)?))
         })
         .collect::<Result<_, SpectrumError>>()?;
-    let windows = host.cell.stop_bands(chain.frequency_bound())?;
-    let transmission = transmission(chain, request.frequencies)?;
+    let windows = match request.graded {
+        true => Vec::new(),
+        false => host.cell.stop_bands(chain.frequency_bound())?,
+    };
+    let transmission = match request.graded {
+        true => Ok(Err(GRADED.to_string())),
+        false => transmission(chain, request.frequencies, request.first_site),
+    }?;
     Ok(Analysis {
         bands: host.cell.bands(BAND_WAVENUMBERS)?,
         gaps: host.cell.gaps()?,
@@ -178,8 +192,9 @@ fn modes(chain: &LinearChain, windows: &[Interval]) -> Result<Modes, SpectrumErr
 fn transmission(
     chain: &LinearChain,
     grid: Option<FrequencyGrid>,
+    first_site: i64,
 ) -> Result<Result<Transmission, String>, SpectrumError> {
-    let scatterer = match scatterer(chain) {
+    let scatterer = match scatterer(chain, first_site) {
         Ok(s) => s,
         Err(SpectrumError::NoLead { reason }) => {
             if grid.is_some() {

@@ -58,7 +58,8 @@ pub enum SpectrumError {
     /// vacuum there and has no linear spectrum.
     #[error(
         "contact {bond} has no static overlap (δ0 = {overlap}): no static load, so the chain is \
-         a sonic vacuum with no linear spectrum; a precompression or gravity is needed"
+         a sonic vacuum with no linear spectrum; give chain.precompression (walls at both \
+         ends) or chain.gravity (a free top, a supported bottom)"
     )]
     NoStaticLoad {
         /// The bond (0 = left wall, b joins sites b−1 and b).

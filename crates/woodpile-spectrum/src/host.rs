@@ -42,23 +42,29 @@ pub struct Scatterer {
 }
 
 /// The cell `sites` of `chain`, checked to repeat over the whole chain; the error names the
-/// first site that breaks the pattern.
-pub fn cell_of(chain: &LinearChain, sites: Range<usize>) -> Result<HostCell, SpectrumError> {
+/// first site that breaks the pattern, numbered from `first` (a scene's paper numbering).
+pub fn cell_of(
+    chain: &LinearChain,
+    sites: Range<usize>,
+    first: i64,
+) -> Result<HostCell, SpectrumError> {
+    let paper = |site: usize| first + site as i64;
     let period = sites.len();
     let n = chain.n_sites();
     if period == 0 || sites.end > n || n < sites.start + 2 * period {
         return Err(SpectrumError::CellDoesNotRepeat {
             reason: format!(
                 "a cell of {period} site(s) from site {} needs two copies in the chain's {n} sites",
-                sites.start
+                paper(sites.start)
             ),
         });
     }
     if let Some(site) = first_break(chain, period) {
         return Err(SpectrumError::CellDoesNotRepeat {
             reason: format!(
-                "site {site} differs from site {}, one period before",
-                site - period
+                "site {} differs from site {}, one period before",
+                paper(site),
+                paper(site - period)
             ),
         });
     }
@@ -71,12 +77,12 @@ pub fn cell_of(chain: &LinearChain, sites: Range<usize>) -> Result<HostCell, Spe
 
 /// The shortest cell the whole chain repeats (at least twice), or the lead's one-site cell when
 /// it repeats none.
-pub fn detect_cell(chain: &LinearChain) -> Result<HostCell, SpectrumError> {
+pub fn detect_cell(chain: &LinearChain, first: i64) -> Result<HostCell, SpectrumError> {
     let n = chain.n_sites();
     if let Some(period) = (1..=n / 2).find(|&p| first_break(chain, p).is_none()) {
-        return cell_of(chain, 0..period);
+        return cell_of(chain, 0..period, first);
     }
-    let lead = lead_of(chain)?;
+    let lead = lead_of(chain, first)?;
     Ok(HostCell {
         sites: 0..1,
         periodic: false,
@@ -84,9 +90,10 @@ pub fn detect_cell(chain: &LinearChain) -> Result<HostCell, SpectrumError> {
     })
 }
 
-/// The lead and the region of `chain` (see the module documentation).
-pub fn scatterer(chain: &LinearChain) -> Result<Scatterer, SpectrumError> {
-    let lead = lead_of(chain)?;
+/// The lead and the region of `chain` (see the module documentation); messages number sites
+/// from `first`.
+pub fn scatterer(chain: &LinearChain, first: i64) -> Result<Scatterer, SpectrumError> {
+    let lead = lead_of(chain, first)?;
     let n = chain.n_sites();
     let differs = |site: usize| {
         chain.mass(site) != lead.mass()
@@ -97,9 +104,9 @@ pub fn scatterer(chain: &LinearChain) -> Result<Scatterer, SpectrumError> {
                     && (chain.stiffness(b) != lead.stiffness() || chain.bond_damping(b) != 0.0)
             })
     };
-    let first = (0..n).find(|&s| differs(s));
-    let last = (0..n).rev().find(|&s| differs(s));
-    let sites = match (first, last) {
+    let top = (0..n).find(|&s| differs(s));
+    let bottom = (0..n).rev().find(|&s| differs(s));
+    let sites = match (top, bottom) {
         (Some(a), Some(b)) => a..b + 1,
         // A uniform chain: one of its own sites, which scatters nothing.
         _ => 1..2,
@@ -108,8 +115,8 @@ pub fn scatterer(chain: &LinearChain) -> Result<Scatterer, SpectrumError> {
         return Err(SpectrumError::NoLead {
             reason: format!(
                 "sites {}..={} differ from the lead and reach the chain's end: keep a lead site at each end",
-                sites.start,
-                sites.end - 1
+                first + sites.start as i64,
+                first + sites.end as i64 - 1
             ),
         });
     }
@@ -120,8 +127,8 @@ pub fn scatterer(chain: &LinearChain) -> Result<Scatterer, SpectrumError> {
     })
 }
 
-/// The lead the chain starts with: site 0's mass and bond 1's stiffness.
-fn lead_of(chain: &LinearChain) -> Result<Lead, SpectrumError> {
+/// The lead the chain starts with: its first site's mass and the bond after it.
+fn lead_of(chain: &LinearChain, first: i64) -> Result<Lead, SpectrumError> {
     let no_lead = |reason: &str| SpectrumError::NoLead {
         reason: reason.to_string(),
     };
@@ -129,9 +136,9 @@ fn lead_of(chain: &LinearChain) -> Result<Lead, SpectrumError> {
         return Err(no_lead("a chain of fewer than 3 sites has no lead"));
     }
     if !chain.resonators_on(0).is_empty() {
-        return Err(no_lead(
-            "site 0 carries a resonator, so the chain starts with no uniform lead",
-        ));
+        return Err(no_lead(&format!(
+            "its first site, {first}, carries a resonator, so the chain starts with no uniform lead"
+        )));
     }
     if (0..chain.n_sites()).any(|s| chain.ground_damping(s) != 0.0) {
         return Err(no_lead(

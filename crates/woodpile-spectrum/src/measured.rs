@@ -83,7 +83,7 @@ pub fn measure(
             asked: Asked::Window,
             reason: format!(
                 "{}: no frequency of the transmission arrives at the probe early enough to be resolved; lengthen the run (and the chain)",
-                s.t_end
+                spectrum.time_text(s.t_end)
             ),
         });
     }
@@ -264,12 +264,16 @@ fn check_window(
     cutoff: f64,
     [impulse, probe]: [usize; 2],
 ) -> Result<(), Refusal> {
+    let time = |t: f64| spectrum.time_text(t);
     if sample_every * cutoff > PI / 2.0 {
         return Err(Refusal {
             asked: Asked::Sampling,
             reason: format!(
-                "{sample_every} samples the lead's band (up to ω = {cutoff}) less than twice per Nyquist interval; at most {} is needed",
-                PI / (2.0 * cutoff)
+                "{} is too coarse: the transform needs four samples per period of the lead's highest frequency ({:.4} {}); sample every {} or less",
+                time(sample_every),
+                spectrum.frequency(cutoff),
+                spectrum.frequency_unit(),
+                time(PI / (2.0 * cutoff))
             ),
         });
     }
@@ -280,8 +284,9 @@ fn check_window(
         return Err(Refusal {
             asked: Asked::Window,
             reason: format!(
-                "{t_end} lets an echo from a wall reach the probe (the lead carries sound at {c0} sites per unit time); at most {} for this chain, or lengthen it",
-                echo / c0
+                "{} lets an echo from a wall reach the probe: end the run by {}, or lengthen the chain, or move the impulse and the probe away from the walls",
+                time(t_end),
+                time(echo / c0)
             ),
         });
     }

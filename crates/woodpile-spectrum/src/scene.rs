@@ -82,6 +82,9 @@ pub struct SceneSpectrum {
     pub resonators: usize,
     /// Whether the linear chain has dashpots.
     pub damped: bool,
+    /// Whether the chain is graded (in gravity): it has no host cell, no lead, and no mode
+    /// counts as localised.
+    pub graded: bool,
     /// The transmission measured from the scene's own run, once [`crate::measured::measure`]
     /// has run it.
     pub measured: Option<Measured>,
@@ -123,6 +126,14 @@ impl SceneSpectrum {
     /// A rate in model units (per unit time) → per the scene's time unit.
     pub fn rate(&self, rate: f64) -> f64 {
         rate / self.time_unit
+    }
+
+    /// A time of the model as the scene writes it: seconds for a physical scene.
+    pub fn time_text(&self, t: f64) -> String {
+        match self.si {
+            true => format!("{:.4e} s", t * self.time_unit),
+            false => format!("{t:.4}"),
+        }
     }
 
     /// The paper number of internal site `site`.
@@ -172,7 +183,14 @@ pub fn scene_spectrum(scene: &Scene, request: &SceneRequest) -> Result<SceneSpec
     } else {
         "cycles per unit time"
     };
-    let analysis = analyse(&linear.chain, &Request { cell, frequencies }).map_err(|e| match e {
+    let graded = model.contacts().is_some_and(|law| law.gravity() > 0.0);
+    let request = Request {
+        cell,
+        frequencies,
+        first_site: scene.first_site,
+        graded,
+    };
+    let analysis = analyse(&linear.chain, &request).map_err(|e| match e {
         SpectrumError::CellDoesNotRepeat { .. } => refuse(Asked::Cell)(e),
         SpectrumError::NoLead { .. } => refuse(Asked::Frequencies)(e),
         // Said in the unit the range was given in.
@@ -199,6 +217,7 @@ pub fn scene_spectrum(scene: &Scene, request: &SceneRequest) -> Result<SceneSpec
     Ok(SceneSpectrum {
         resonators: linear.chain.resonators().len(),
         damped: linear.chain.is_damped(),
+        graded,
         detached: linear
             .detached
             .iter()

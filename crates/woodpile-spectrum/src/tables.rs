@@ -9,6 +9,10 @@ use crate::bands::Interval;
 use crate::modes::Mode;
 use crate::scene::SceneSpectrum;
 
+/// Why a chain in gravity has no bands.
+const GRADED_CELL: &str =
+    "a chain in gravity is graded (its contacts stiffen with depth): it repeats no cell, so it has no bands";
+
 /// One column's values.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Values {
@@ -99,6 +103,9 @@ fn i64s(name: &'static str, values: impl IntoIterator<Item = i64>) -> Column {
 /// The columns of `part`, or why the scene has no such table (no leads, no dashpots).
 pub fn table(s: &SceneSpectrum, part: Part) -> Result<Vec<Column>, String> {
     let a = &s.analysis;
+    if s.graded && matches!(part, Part::Bands | Part::Wavenumber) {
+        return Err(GRADED_CELL.into());
+    }
     Ok(match part {
         Part::Bands => {
             let rows = a.bands.q.iter().zip(&a.bands.omega);
@@ -221,11 +228,14 @@ pub fn summary(s: &SceneSpectrum) -> Value {
             "detached_resonators": s.detached,
             "damped": s.damped,
         },
-        "cell": {
-            "sites": [s.paper_site(cell.start), s.paper_site(cell.end - 1)],
-            "periodic": a.host.periodic,
-            "pass_bands": intervals(&a.pass_bands),
-            "gaps": intervals(&a.gaps),
+        "cell": match s.graded {
+            true => json!({ "skipped": GRADED_CELL }),
+            false => json!({
+                "sites": [s.paper_site(cell.start), s.paper_site(cell.end - 1)],
+                "periodic": a.host.periodic,
+                "pass_bands": intervals(&a.pass_bands),
+                "gaps": intervals(&a.gaps),
+            }),
         },
         "modes": modes_summary(s),
         "transmission": transmission_summary(s),

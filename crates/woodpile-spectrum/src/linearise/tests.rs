@@ -54,7 +54,7 @@ fn a_sonic_vacuum_is_refused_with_its_reason() {
     );
     let message = error.to_string();
     assert!(message.contains("no static load"));
-    assert!(message.contains("precompression or gravity"));
+    assert!(message.contains("chain.precompression") && message.contains("chain.gravity"));
     let single = Model::new(1, Boundary::Fixed, vec![]).unwrap();
     assert!(matches!(
         linearise(&single, &[0.0, 0.0], 0.0),

@@ -181,6 +181,19 @@ fn a_chain_in_gravity_stiffens_with_depth() {
             "bond {bond}: {got}"
         );
     }
+    // Graded, it has no bands, no lead and no host whose stop bands localise a mode: said so,
+    // rather than measured against its top site.
     let spectrum = scene_spectrum(&s, &SceneRequest::default()).unwrap();
     assert!(spectrum.analysis.modes.complete);
+    let json = summary(&spectrum);
+    assert!(json["cell"]["skipped"]
+        .as_str()
+        .unwrap()
+        .contains("gravity"));
+    assert!(json["transmission"]["skipped"]
+        .as_str()
+        .unwrap()
+        .contains("gravity"));
+    assert_eq!(json["modes"]["localised"], serde_json::json!([]));
+    assert!(table(&spectrum, Part::Bands).is_err());
 }
