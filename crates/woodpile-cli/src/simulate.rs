@@ -204,11 +204,22 @@ fn manifest(what: &str, file: &Path, scene: &Scene, report: &Value, extra: Value
     if let Value::Object(map) = &mut summary {
         map.remove("wall_s");
     }
+    scene_table_manifest(file, format!("simulate {what}"), params, summary)
+}
+
+/// The manifest of a table a command writes from the scene `file`: named after the file, keyed
+/// by the code and `params`, with `summary`.
+pub(crate) fn scene_table_manifest(
+    file: &Path,
+    kind: String,
+    params: Value,
+    summary: Value,
+) -> Manifest {
     Manifest {
         stage: file
             .file_stem()
             .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned()),
-        kind: format!("simulate {what}"),
+        kind,
         key: Key::of(&json!({"code": code_version(), "params": params}))
             .as_str()
             .to_string(),

@@ -7,15 +7,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::anyhow;
 use serde_json::json;
-use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table;
-use woodpile_points::canonical::{code_version, scene_json, Key};
+use woodpile_points::canonical::scene_json;
 use woodpile_spectrum::measured::measure;
 use woodpile_spectrum::scene::{
     scene_spectrum, Asked, Frequency, Refusal, SceneRequest, SceneSpectrum,
 };
 use woodpile_spectrum::tables::{summary, table, Part};
 
+use crate::simulate::scene_table_manifest;
 use crate::Failure;
 
 /// Arguments of `woodpile spectrum`.
@@ -135,21 +135,8 @@ fn write_tables(
         };
         let frame = woodpile_stages::spectrum::frame_of(columns).map_err(Failure::simulation)?;
         let params = json!({"scene": scene_json(scene), "table": part.name()});
-        let manifest = Manifest {
-            stage: file
-                .file_stem()
-                .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned()),
-            kind: format!("spectrum {}", part.name()),
-            key: Key::of(&json!({"code": code_version(), "params": params}))
-                .as_str()
-                .to_string(),
-            code_version: code_version(),
-            params,
-            inputs: Default::default(),
-            summary: report.clone(),
-            files: Default::default(),
-            checksum: None,
-        };
+        let kind = format!("spectrum {}", part.name());
+        let manifest = scene_table_manifest(file, kind, params, report.clone());
         table::write(&path, frame, &manifest).map_err(Failure::input)?;
     }
     Ok(())

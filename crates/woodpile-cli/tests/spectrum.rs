@@ -70,7 +70,11 @@ fn refusals_exit_2_naming_the_flag() {
             &["--from", "0.1", "--to", "1.0"],
             "--from/--to/--points: [0.1, 1]",
         ),
-        (ONE_DEFECT, &["--measure"], "run.sample_every: 1 samples"),
+        (
+            ONE_DEFECT,
+            &["--measure"],
+            "run.sample_every: 1.0000 is too coarse",
+        ),
     ];
     for (scene, args, expected) in cases {
         let out = spectrum(dir.path(), scene, args);

@@ -103,21 +103,13 @@ impl Pair {
     /// equals its spring force there: the scale the search starts from.
     fn gamma_scale(&self, v: f64) -> f64 {
         let c = self.elastic_overlap(v);
-        let g = match self.law {
-            DashpotLaw::Linear => 1.0,
-            DashpotLaw::Hertzian => c.sqrt(),
-        };
-        self.coefficient * c.powf(self.exponent) / (g * v)
+        self.coefficient * c.powf(self.exponent) / self.law.force(1.0, c, v)
     }
 
     /// The contact force at overlap `c` closing at `rate`, before the clip at zero.
     fn unclipped_force(&self, gamma: f64, c: f64, rate: f64) -> f64 {
         let c = c.max(0.0);
-        let g = match self.law {
-            DashpotLaw::Linear => 1.0,
-            DashpotLaw::Hertzian => c.sqrt(),
-        };
-        self.coefficient * c.powf(self.exponent) + gamma * g * rate
+        self.coefficient * c.powf(self.exponent) + self.law.force(gamma, c, rate)
     }
 }
 

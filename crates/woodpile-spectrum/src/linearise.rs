@@ -20,7 +20,7 @@
 //! wall contact with δ_b = 0 is open, a free end; a chain none of whose contacts is loaded is
 //! refused too.
 
-use woodpile_sim::{DashpotLaw, End, Model};
+use woodpile_sim::{End, Model};
 
 use crate::chain::{length, non_negative, ChainSpec, LinearChain, LinearResonator};
 use crate::error::SpectrumError;
@@ -91,10 +91,10 @@ fn bonds(model: &Model, overlaps: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Spectr
             Some(law) => law.stiffness(bond, delta),
             None => 1.5 * delta.sqrt(),
         };
-        let damping = model.damping().map_or(0.0, |d| match d.law {
-            DashpotLaw::Linear => d.contact,
-            DashpotLaw::Hertzian => d.contact * delta.sqrt(),
-        });
+        // The dashpot's force per unit closing rate at the static overlap.
+        let damping = model
+            .damping()
+            .map_or(0.0, |d| d.law.force(d.contact, delta, 1.0));
         match delta > 0.0 {
             true => (stiffness, damping),
             false => (0.0, 0.0),

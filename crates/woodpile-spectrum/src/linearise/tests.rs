@@ -2,6 +2,7 @@
 //! resonators, dashpots and soft ends carried over.
 
 use super::*;
+use woodpile_sim::DashpotLaw;
 use woodpile_sim::{Boundary, ContactLaw, Coupling, Damping, Resonator};
 
 fn close(got: f64, expected: f64) -> bool {
