@@ -403,6 +403,41 @@ pub fn chain_audit_scene(rng: &mut Lcg) -> Scenario {
     }
 }
 
+/// One scene of the audit of gravity (`auto_audit --gravity`): a linear audit scene
+/// ([`linear_audit_scene`]) stood upright, top (left) end free and bottom (right) end fixed,
+/// in gravity g from 1e-4 to 0.3 (a weight per site from far below to about half of a
+/// unit-velocity solitary wave's peak contact force), every contact carrying the weight above
+/// it; half the time a dimer of masses 1 and up to 3 with alternating contact coefficients.
+pub fn gravity_audit_scene(rng: &mut Lcg) -> Scenario {
+    let base = linear_audit_scene(rng);
+    let g = rng.log_uniform(1e-4, 0.3);
+    let dimer = rng.uniform() < 0.5;
+    let (heavy, contact) = (rng.log_uniform(1.0, 3.0), rng.log_uniform(0.5, 2.0));
+    let n_sites = base.model.n_sites();
+    let site_masses: Vec<f64> = (0..n_sites)
+        .map(|i| if dimer && i % 2 == 1 { heavy } else { 1.0 })
+        .collect();
+    let coefficients: Vec<f64> = (0..=n_sites)
+        .map(|b| if dimer && b % 2 == 1 { contact } else { 1.0 })
+        .collect();
+    let resonators = base.model.resonators().to_vec();
+    let mut carried = site_masses.clone();
+    for r in &resonators {
+        carried[r.site] += r.eps;
+    }
+    let mut above = vec![0.0];
+    for m in &carried {
+        above.push(above[above.len() - 1] + g * m);
+    }
+    let law = crate::ContactLaw::under_gravity(coefficients, 1.5, &above, g)
+        .expect("a valid survey contact law");
+    let boundary = Boundary::ends(crate::End::Free, crate::End::Fixed);
+    let model = Model::with_masses(n_sites, boundary, resonators, Some(site_masses))
+        .and_then(|m| m.with_contacts(law))
+        .expect("a valid survey model");
+    Scenario { model, ..base }
+}
+
 /// One scene of the audit of dissipation (`auto_audit --damped`): an audit scene, or half the
 /// time one of the experiment's chain ([`chain_audit_scene`]), given every kind of damping a
 /// scene can declare: a contact dashpot (γ from 1e-4 to 0.3, linear or Hertzian law, equally

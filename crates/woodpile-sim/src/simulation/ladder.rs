@@ -402,7 +402,7 @@ struct Strictness {
     /// The largest error estimate accepted ([`accepted_estimate`]).
     accept: f64,
     /// Accept only from a third run on, so that the asymptotic-regime check has three runs to
-    /// judge (a ramped coupling and a nonlinear resonator).
+    /// judge (a ramped coupling and a nonlinear resonator; a chain in gravity).
     needs_three_runs: bool,
     /// The pair about to be accepted must also agree with a run at 1.5 dt, off its ladder (a
     /// nonlinear resonator).
@@ -412,9 +412,13 @@ struct Strictness {
 impl Strictness {
     fn of(model: &Model, tol: f64) -> Strictness {
         let (nonlinear, ramped) = resonator_kinds(model);
+        // A chain in gravity is graded (its contacts stiffen with depth): a first pair can
+        // agree far better than it is accurate (`auto_audit --gravity`), so its regime is
+        // judged on three runs, as a ramped nonlinear chain's is.
+        let graded = model.contacts().is_some_and(|law| law.gravity() > 0.0);
         Strictness {
             accept: accepted_estimate(model, tol),
-            needs_three_runs: nonlinear && ramped,
+            needs_three_runs: (nonlinear && ramped) || graded,
             off_ladder_run: nonlinear,
         }
     }
