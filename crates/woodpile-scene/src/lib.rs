@@ -9,6 +9,7 @@
 pub mod columns;
 pub mod examples;
 pub mod grid;
+pub mod quantity;
 mod raw;
 pub mod report;
 mod resolve;

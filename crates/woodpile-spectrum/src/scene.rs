@@ -257,25 +257,7 @@ fn hertz(f: &Frequency, si: bool) -> Result<f64, Refusal> {
             "`{text}`: a frequency with a unit needs a [physical] scene; give a number in cycles per unit time"
         )));
     }
-    let split = text
-        .find(|c: char| c.is_ascii_alphabetic() && c != 'e' && c != 'E')
-        .unwrap_or(text.len());
-    let (number, unit) = text.split_at(split);
-    let scale = match unit.trim() {
-        "Hz" => 1.0,
-        "kHz" => 1e3,
-        "MHz" => 1e6,
-        other => {
-            return Err(refuse(format!(
-                "`{text}`: unit `{other}` is not Hz, kHz or MHz"
-            )))
-        }
-    };
-    let value: f64 = number
-        .trim()
-        .parse()
-        .map_err(|_| refuse(format!("`{text}`: `{}` is not a number", number.trim())))?;
-    Ok(value * scale)
+    woodpile_scene::quantity::parse(text, "frequency").map_err(refuse)
 }
 
 #[cfg(test)]

@@ -145,7 +145,9 @@ fn calibrated(
 fn impact_velocity(key: &str, value: &toml::Value, si: Option<&Si>) -> Result<f64, Invalid> {
     let number = |v: &toml::Value| v.as_float().or_else(|| v.as_integer().map(|i| i as f64));
     let metres_per_second = match (value, si) {
-        (toml::Value::String(text), Some(_)) => velocity_text(key, text)?,
+        (toml::Value::String(text), Some(_)) => {
+            crate::quantity::parse(text, "velocity").map_err(|reason| invalid(key, reason))?
+        }
         (toml::Value::String(text), None) => {
             return Err(invalid(
                 key,
@@ -156,26 +158,6 @@ fn impact_velocity(key: &str, value: &toml::Value, si: Option<&Si>) -> Result<f6
     };
     let v = positive(key, metres_per_second)?;
     Ok(si.map_or(v, |si| v / si.scales.velocity))
-}
-
-/// `"1 m/s"`, `"20 mm/s"`: metres per second.
-fn velocity_text(key: &str, text: &str) -> Result<f64, Invalid> {
-    let (number, unit) = text.trim().split_once(' ').unwrap_or((text.trim(), ""));
-    let scale = match unit.trim() {
-        "m/s" => 1.0,
-        "mm/s" => 1e-3,
-        "cm/s" => 1e-2,
-        other => {
-            return Err(invalid(
-                key,
-                format!("`{other}` is not a unit of velocity (m/s, cm/s, mm/s)"),
-            ))
-        }
-    };
-    let value: f64 = number
-        .parse()
-        .map_err(|_| invalid(key, format!("`{text}`: `{number}` is not a number")))?;
-    Ok(value * scale)
 }
 
 /// The coefficient at `key` (default 0, checked ≥ 0), in the model's units: an SI scene's

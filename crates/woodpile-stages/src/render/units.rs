@@ -9,36 +9,15 @@ use serde_json::Value;
 use woodpile_pipeline::error::Result;
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::f64_column;
+use woodpile_scene::quantity::{self, Unit};
 use woodpile_scene::units_out::SCALED;
 
 use super::spec::{PanelSpec, Plot};
 
-/// Units a label may name: the name, what it measures, and its size in the SI unit.
-const UNITS: [(&str, &str, f64); 17] = [
-    ("s", "time", 1.0),
-    ("ms", "time", 1e-3),
-    ("µs", "time", 1e-6),
-    ("us", "time", 1e-6),
-    ("ns", "time", 1e-9),
-    ("m", "length", 1.0),
-    ("mm", "length", 1e-3),
-    ("µm", "length", 1e-6),
-    ("m/s", "velocity", 1.0),
-    ("mm/s", "velocity", 1e-3),
-    ("J", "energy", 1.0),
-    ("mJ", "energy", 1e-3),
-    ("µJ", "energy", 1e-6),
-    ("nJ", "energy", 1e-9),
-    ("Hz", "frequency", 1.0),
-    ("kHz", "frequency", 1e3),
-    ("MHz", "frequency", 1e6),
-];
-
-/// The unit named at the end of `label`, in parentheses, if it is one of [`UNITS`].
-fn label_unit(label: &str) -> Option<(&'static str, &'static str, f64)> {
+/// The unit named at the end of `label`, in parentheses, if woodpile knows it.
+fn label_unit(label: &str) -> Option<Unit> {
     let inner = label.trim_end().strip_suffix(')')?;
-    let unit = inner[inner.rfind('(')? + 1..].trim();
-    UNITS.into_iter().find(|(name, _, _)| *name == unit)
+    quantity::named(inner[inner.rfind('(')? + 1..].trim())
 }
 
 /// By how much to multiply `column` so that it is in `label`'s unit: `None` when the label
@@ -49,7 +28,12 @@ fn factor(
     input: &str,
     manifest: &Manifest,
 ) -> std::result::Result<Option<f64>, String> {
-    let Some((unit, measures, size)) = label_unit(label) else {
+    let Some(Unit {
+        name: unit,
+        measures,
+        size,
+    }) = label_unit(label)
+    else {
         return Ok(None);
     };
     let Some(declared) = manifest.summary["column_units"]
@@ -63,8 +47,8 @@ fn factor(
             "the label \"{label}\" names {unit}, but column `{column}` of `{input}` is in the model's scaled units: give `{input}` units = \"SI\", or label the axis in scaled units"
         ));
     }
-    match UNITS.iter().find(|(name, _, _)| *name == declared) {
-        Some(&(_, what, base)) if what == measures => Ok(Some(base / size)),
+    match quantity::named(declared) {
+        Some(column) if column.measures == measures => Ok(Some(column.size / size)),
         _ => Err(format!(
             "the label \"{label}\" names {unit} ({measures}), but column `{column}` of `{input}` is in {declared}"
         )),
@@ -132,8 +116,8 @@ mod tests {
 
     #[test]
     fn units_are_read_from_the_end_of_a_label() {
-        assert_eq!(label_unit("t (µs)").map(|u| u.0), Some("µs"));
-        assert_eq!(label_unit("frequency (kHz)").map(|u| u.2), Some(1e3));
+        assert_eq!(label_unit("t (µs)").map(|u| u.name), Some("µs"));
+        assert_eq!(label_unit("frequency (kHz)").map(|u| u.size), Some(1e3));
         assert_eq!(label_unit("t (1 unit = 9.08 µs)"), None);
         assert_eq!(label_unit("log₁₀ wall time (ms) of runs"), None);
         assert_eq!(label_unit("velocity"), None);
