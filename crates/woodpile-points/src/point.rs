@@ -3,11 +3,10 @@
 
 use serde_json::json;
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::Observer;
-use woodpile_sim::integrate::StepControl;
+use woodpile_sim::integrate::{StepControl, Stoppable};
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::simulation::{simulate_batch, Outcome, Scenario};
-use woodpile_sim::{Model, SimError};
+use woodpile_sim::SimError;
 
 use crate::canonical::{code_version, scene_json, Key};
 
@@ -110,7 +109,10 @@ pub fn simulate_points_until(
         match kind.recorder(&scene.scenario) {
             Ok(series) => {
                 runnable.push(k);
-                recorders.push(Stoppable { series, stop });
+                recorders.push(Stoppable {
+                    inner: series,
+                    stop,
+                });
             }
             Err(reason) => results[k] = Some(Err(reason)),
         }
@@ -122,28 +124,10 @@ pub fn simulate_points_until(
         results[k] = match outcome {
             Err(SimError::Cancelled { .. }) => None,
             Err(e) => Some(Err(e.to_string())),
-            Ok(out) => Some(Ok(PointData::of(s, &out, watched.series))),
+            Ok(out) => Some(Ok(PointData::of(s, &out, watched.inner))),
         };
     }
     results
-}
-
-/// A fraction recorder that also stops its run once `stop()` says so.
-struct Stoppable<'a> {
-    series: FractionSeries,
-    stop: &'a dyn Fn() -> bool,
-}
-
-impl Observer for Stoppable<'_> {
-    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
-        self.series.observe(model, t, y);
-    }
-    fn reset(&mut self) {
-        self.series.reset();
-    }
-    fn cancelled(&self) -> bool {
-        (self.stop)()
-    }
 }
 
 impl PointData {

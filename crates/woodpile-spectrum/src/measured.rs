@@ -26,10 +26,9 @@
 use std::f64::consts::PI;
 
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::Observer;
+use woodpile_sim::integrate::Stoppable;
 use woodpile_sim::observe::SiteField;
 use woodpile_sim::simulation::simulate;
-use woodpile_sim::Model;
 
 use crate::analysis::Transmission;
 use crate::chain::LinearChain;
@@ -61,15 +60,15 @@ pub fn measure(
     let setup = setup(scene, spectrum, probe)?;
     let s = &scene.scenario;
     let (lead, t) = (&setup.transmission.scatterer.lead, setup.transmission);
-    let mut probed = Probed {
-        field: SiteField::new(&s.model, setup.probe, setup.probe),
+    let mut probed = Stoppable {
+        inner: SiteField::new(&s.model, setup.probe, setup.probe),
         stop,
     };
     simulate(s, &mut probed).map_err(|e| Refusal {
         asked: Asked::Run,
         reason: format!("the run failed: {e}"),
     })?;
-    let field = probed.field;
+    let field = probed.inner;
     let c0 = (lead.stiffness() / lead.mass()).sqrt();
     let distance = (setup.probe - s.impulse_site) as f64;
     let delays = Delays::over(lead, &t.scatterer.region, distance, s.t_end);
@@ -162,24 +161,6 @@ impl Delays {
         let hi = ((omega + 4.0 * self.resolution) / self.step).ceil() as usize;
         let slice = &self.delay[(lo - 1).min(self.delay.len())..hi.min(self.delay.len())];
         slice.iter().copied().fold(0.0, f64::max)
-    }
-}
-
-/// The probe's record, and whether the caller still wants it.
-struct Probed<'a> {
-    field: SiteField,
-    stop: &'a dyn Fn() -> bool,
-}
-
-impl Observer for Probed<'_> {
-    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
-        self.field.observe(model, t, y);
-    }
-    fn reset(&mut self) {
-        self.field.reset();
-    }
-    fn cancelled(&self) -> bool {
-        (self.stop)()
     }
 }
 

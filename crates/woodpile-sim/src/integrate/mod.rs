@@ -120,6 +120,27 @@ impl Observer for () {
     fn reset(&mut self) {}
 }
 
+/// An observer its caller may stop: `inner` records, and the run is cancelled once `stop`
+/// says so (Ctrl-C in Python, a sweep being stopped).
+pub struct Stoppable<'a, O> {
+    /// What records the run.
+    pub inner: O,
+    /// Asked at every sample whether the run is still wanted.
+    pub stop: &'a dyn Fn() -> bool,
+}
+
+impl<O: Observer> Observer for Stoppable<'_, O> {
+    fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
+        self.inner.observe(model, t, y);
+    }
+    fn reset(&mut self) {
+        self.inner.reset();
+    }
+    fn cancelled(&self) -> bool {
+        (self.stop)() || self.inner.cancelled()
+    }
+}
+
 /// An observer that may not be there: a run that records only when asked.
 impl<A: Observer> Observer for Option<A> {
     fn observe(&mut self, model: &Model, t: f64, y: &[f64]) {
