@@ -110,15 +110,16 @@ impl ContactLaw {
         ))
     }
 
-    /// The contacts of a vertical chain in gravity `g` (the first site on top): bond b carries
-    /// `weights_above[b]`, the weight g·m of every body above it, so the rest state (u = 0) is
+    /// The contacts of a vertical chain in gravity `g` (the first site on top), whose site n
+    /// carries the mass `carried[n]` (its own and its resonators'): bond b carries the weight
+    /// g·Σ_{n<b} carried\[n\] of every body above it, so the rest state (u = 0) is
     /// an exact equilibrium and each contact subtracts its own static force, as under a
     /// precompression. Where a contact opens, the static force it subtracts is the weight it no
     /// longer carries: the motion about the rest state is the motion in gravity, exactly.
     pub fn under_gravity(
         coefficients: Vec<f64>,
         exponent: f64,
-        weights_above: &[f64],
+        carried: &[f64],
         gravity: f64,
     ) -> Result<ContactLaw, ModelError> {
         let law = ContactLaw::new(coefficients, exponent, 0.0)?;
@@ -128,18 +129,25 @@ impl ContactLaw {
                 value: gravity,
             });
         }
-        if weights_above.len() != law.coefficient.len()
-            || weights_above.iter().any(|w| !(w.is_finite() && *w >= 0.0))
+        if carried.len() + 1 != law.coefficient.len()
+            || carried.iter().any(|m| !(m.is_finite() && *m >= 0.0))
         {
             return Err(ModelError::Negative {
-                what: "the weight above a contact".into(),
-                value: weights_above.iter().copied().fold(f64::NAN, f64::min),
+                what: "the mass a site carries".into(),
+                value: carried.iter().copied().fold(f64::NAN, f64::min),
             });
+        }
+        let mut weights_above = Vec::with_capacity(carried.len() + 1);
+        let mut total = 0.0;
+        weights_above.push(0.0);
+        for m in carried {
+            total += m;
+            weights_above.push(gravity * total);
         }
         Ok(ContactLaw::loaded(
             law.coefficient,
             exponent,
-            weights_above,
+            &weights_above,
             0.0,
             gravity,
         ))

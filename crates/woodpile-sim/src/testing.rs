@@ -425,11 +425,7 @@ pub fn gravity_audit_scene(rng: &mut Lcg) -> Scenario {
     for r in &resonators {
         carried[r.site] += r.eps;
     }
-    let mut above = vec![0.0];
-    for m in &carried {
-        above.push(above[above.len() - 1] + g * m);
-    }
-    let law = crate::ContactLaw::under_gravity(coefficients, 1.5, &above, g)
+    let law = crate::ContactLaw::under_gravity(coefficients, 1.5, &carried, g)
         .expect("a valid survey contact law");
     let boundary = Boundary::ends(crate::End::Free, crate::End::Fixed);
     let model = Model::with_masses(n_sites, boundary, resonators, Some(site_masses))

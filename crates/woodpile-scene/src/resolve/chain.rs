@@ -332,10 +332,7 @@ pub(crate) fn contact_law(
     }
     let law = match gravity {
         None => ContactLaw::new(sites.contacts.clone(), exponent, precompression),
-        Some(g) => {
-            let above = gravity::weights_above(carried, g);
-            ContactLaw::under_gravity(sites.contacts.clone(), exponent, &above, g)
-        }
+        Some(g) => ContactLaw::under_gravity(sites.contacts.clone(), exponent, carried, g),
     };
     law.map(Some).map_err(|e| invalid("chain", e.to_string()))
 }

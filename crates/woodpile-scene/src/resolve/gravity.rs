@@ -52,19 +52,6 @@ pub(crate) fn gravity(
     })))
 }
 
-/// The weight above each bond 0..=S: g times the mass of every site (and what it carries)
-/// before it. `masses[n]` is site n's own mass with its resonators'.
-pub(crate) fn weights_above(masses: &[f64], g: f64) -> Vec<f64> {
-    let mut above = Vec::with_capacity(masses.len() + 1);
-    let mut total = 0.0;
-    above.push(0.0);
-    for m in masses {
-        total += m;
-        above.push(g * total);
-    }
-    above
-}
-
 /// Refuses resonators whose rest state gravity would move: a nonlinear coupling (its static
 /// stretch has no linear part to stand on) or a ramp (its rest state changes as it runs).
 pub(crate) fn check_resonators(resonators: &[Resonator]) -> Result<(), Invalid> {
