@@ -11,8 +11,12 @@ use std::fmt;
 
 use serde_json::{json, Map, Value};
 use woodpile_scene::Scene;
-use woodpile_sim::integrate::MethodChoice;
-use woodpile_sim::{Boundary, End};
+use woodpile_sim::contact::LawParts;
+use woodpile_sim::energy::RegionParts;
+use woodpile_sim::integrate::{Accuracy, MethodChoice};
+use woodpile_sim::model::ModelParts;
+use woodpile_sim::simulation::Scenario;
+use woodpile_sim::{Boundary, Coupling, Damping, End, Resonator};
 
 /// The version every cache key includes. Bump [`NUMERICS_REVISION`] whenever a change can alter
 /// a computed number without changing a stage file: every cached result then goes stale.
@@ -176,77 +180,138 @@ mod change_tests {
 
 /// The resolved scene as canonical JSON: everything that determines the simulated numbers and
 /// nothing else (no file names, no spelling of defaults).
+///
+/// Every type on the way is taken apart with no `..` (the model's through
+/// [`woodpile_sim::model::parts`]), so a field added anywhere in a resolved scene fails to
+/// compile here until it is hashed or named as not changing a number. The chain's later keys
+/// join the JSON only when a scene declares them, so that every earlier scene keeps its key
+/// (and its cached point); `tests/key_coverage.rs` changes every documented key in turn.
 pub fn scene_json(scene: &Scene) -> Value {
-    let s = &scene.scenario;
-    let model = &s.model;
-    let masses: Vec<f64> = (0..model.n_sites()).map(|i| model.site_mass(i)).collect();
-    let unit_masses = masses.iter().all(|&m| m == 1.0);
-    let resonators: Vec<Value> = model
-        .resonators()
-        .iter()
-        .map(|r| {
-            let coupling = match r.coupling {
-                woodpile_sim::Coupling::Constant(k) => json!(k),
-                woodpile_sim::Coupling::Ramp { k1, k2, t0, tau } => {
-                    json!({"k1": k1, "k2": k2, "t0": t0, "tau": tau})
-                }
-            };
-            json!({"site": r.site, "eps": r.eps, "kappa": coupling, "p": r.p})
-        })
-        .collect();
-    let method = match s.method {
+    let Scene {
+        scenario,
+        // The paper numbering and the SI scales only name and convert what the run computes.
+        first_site: _,
+        last_site: _,
+        region_paper: _,
+        physical: _,
+    } = scene;
+    let Scenario {
+        model,
+        impulse_site,
+        impulse_velocity,
+        t_end,
+        region,
+        method,
+        accuracy,
+        sample_every,
+    } = scenario;
+    let ModelParts {
+        n_sites,
+        boundary,
+        resonators,
+        site_masses,
+        contacts,
+        damping,
+    } = model.parts();
+    let RegionParts { lo, hi, striker } = region.parts();
+    let Accuracy {
+        tolerance,
+        tolerance_explicit,
+        dt,
+    } = accuracy;
+    let unit_masses = site_masses.is_none_or(|m| m.iter().all(|&m| m == 1.0));
+    let mut canonical = json!({
+        "sites": n_sites,
+        "boundary": boundary_json(boundary),
+        "masses": if unit_masses { Value::Null } else { json!(site_masses) },
+        "resonators": resonators.iter().map(resonator_json).collect::<Vec<_>>(),
+        "impulse": {"site": impulse_site, "velocity": impulse_velocity},
+        "t_end": t_end,
+        "region": [lo, hi],
+        "method": method_name(*method),
+        "tolerance": tolerance,
+        "tolerance_explicit": tolerance_explicit,
+        "dt": dt,
+        "sample_every": sample_every,
+    });
+    if let Some(law) = contacts {
+        canonical["contacts"] = law_json(law);
+    }
+    if striker {
+        canonical["striker"] = json!(true);
+    }
+    if let Some(damping) = damping {
+        canonical["damping"] = damping_json(damping);
+    }
+    canonical
+}
+
+fn method_name(method: MethodChoice) -> &'static str {
+    match method {
         MethodChoice::Auto => "auto",
         MethodChoice::Named(m) => m.name(),
+    }
+}
+
+fn resonator_json(resonator: &Resonator) -> Value {
+    let Resonator {
+        site,
+        eps,
+        coupling,
+        p,
+    } = resonator;
+    let kappa = match *coupling {
+        Coupling::Constant(k) => json!(k),
+        Coupling::Ramp { k1, k2, t0, tau } => json!({"k1": k1, "k2": k2, "t0": t0, "tau": tau}),
     };
+    json!({"site": site, "eps": eps, "kappa": kappa, "p": p})
+}
+
+fn boundary_json(boundary: Boundary) -> Value {
     let end = |end: End| match end {
         End::Fixed => json!("fixed"),
         End::Free => json!("free"),
         End::Soft { spring, damping } => json!({"spring": spring, "damping": damping}),
     };
-    let boundary = match model.boundary() {
+    match boundary {
         Boundary::Fixed => json!("fixed"),
         Boundary::Free => json!("free"),
         Boundary::Ends { left, right } => json!({"left": end(left), "right": end(right)}),
-    };
-    let mut canonical = json!({
-        "sites": model.n_sites(),
-        "boundary": boundary,
-        "masses": if unit_masses { Value::Null } else { json!(masses) },
-        "resonators": resonators,
-        "impulse": {"site": s.impulse_site, "velocity": s.impulse_velocity},
-        "t_end": s.t_end,
-        "region": [s.region.lo(), s.region.hi()],
-        "method": method,
-        "tolerance": s.accuracy.tolerance,
-        "tolerance_explicit": s.accuracy.tolerance_explicit,
-        "dt": s.accuracy.dt,
-        "sample_every": s.sample_every,
+    }
+}
+
+fn law_json(law: LawParts<'_>) -> Value {
+    let LawParts {
+        coefficients,
+        exponent,
+        precompression,
+        gravity,
+    } = law;
+    let mut contacts = json!({
+        "coefficients": coefficients,
+        "exponent": exponent,
+        "precompression": precompression,
     });
-    // The chain's new keys join the key only when a scene declares them, so that every
-    // earlier scene keeps its key (and its cached point).
-    if let Some(law) = model.contacts() {
-        let coefficients: Vec<f64> = (0..law.n_bonds()).map(|b| law.coefficient(b)).collect();
-        canonical["contacts"] = json!({
-            "coefficients": coefficients,
-            "exponent": law.exponent(),
-            "precompression": law.precompression(),
-        });
-        if law.gravity() > 0.0 {
-            canonical["contacts"]["gravity"] = json!(law.gravity());
-        }
+    // Gravity joined the key after the contacts did: a chain without it keeps its key.
+    if gravity > 0.0 {
+        contacts["gravity"] = json!(gravity);
     }
-    if s.region.has_striker() {
-        canonical["striker"] = json!(true);
-    }
-    if let Some(d) = model.damping() {
-        canonical["damping"] = json!({
-            "contact": d.contact,
-            "law": d.law.name(),
-            "ground": d.ground,
-            "resonators": d.resonator,
-        });
-    }
-    canonical
+    contacts
+}
+
+fn damping_json(damping: &Damping) -> Value {
+    let Damping {
+        contact,
+        law,
+        ground,
+        resonator,
+    } = damping;
+    json!({
+        "contact": contact,
+        "law": law.name(),
+        "ground": ground,
+        "resonators": resonator,
+    })
 }
 
 #[cfg(test)]

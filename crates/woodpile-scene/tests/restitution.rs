@@ -1,6 +1,8 @@
 //! `damping.restitution`: the contact dashpot calibrated so that two regular sites meeting at
 //! the given velocity part with the given e. Checked by simulating that very collision.
 
+#![allow(clippy::unwrap_used)]
+
 mod common;
 
 use std::path::Path;

@@ -73,7 +73,43 @@ pub struct ContactLaw {
     static_force: Vec<f64>,
 }
 
+/// The defining parts of a [`ContactLaw`].
+#[derive(Debug, Clone, Copy)]
+pub struct LawParts<'a> {
+    /// a_b for every bond, walls included.
+    pub coefficients: &'a [f64],
+    /// The exponent α.
+    pub exponent: f64,
+    /// The static force F0 the walls hold.
+    pub precompression: f64,
+    /// g, when the chain stands in gravity (0 otherwise).
+    pub gravity: f64,
+}
+
 impl ContactLaw {
+    /// The parts this law was built from, taken apart with no `..` (see
+    /// [`crate::model::parts`]).
+    pub fn parts(&self) -> LawParts<'_> {
+        let ContactLaw {
+            exponent,
+            precompression,
+            gravity,
+            coefficient,
+            // Derived from `exponent`.
+            power: _,
+            // Derived: the rest state under the precompression or gravity's weights, from the
+            // coefficients, the exponent and the masses each contact carries.
+            static_overlap: _,
+            static_force: _,
+        } = self;
+        LawParts {
+            coefficients: coefficient,
+            exponent: *exponent,
+            precompression: *precompression,
+            gravity: *gravity,
+        }
+    }
+
     /// The contacts of a chain of `coefficients.len() - 1` sites: `coefficients[b]` is a_b in
     /// the bond numbering of the module documentation (walls included, whether or not the ends
     /// are walls), `exponent` is α and `precompression` the static force F0 (0 for none).

@@ -25,6 +25,17 @@ pub struct Region {
     striker_sites: usize,
 }
 
+/// The defining parts of a [`Region`] ([`Region::parts`]).
+#[derive(Debug, Clone, Copy)]
+pub struct RegionParts {
+    /// Its first site (internal index).
+    pub lo: usize,
+    /// Its last site.
+    pub hi: usize,
+    /// Whether site 0 is a striker, whose energy is the share S.
+    pub striker: bool,
+}
+
 impl Region {
     /// A region of sites `lo..=hi` in a chain of `n_sites`.
     pub fn new(lo: i64, hi: i64, n_sites: usize) -> Result<Self, ModelError> {
@@ -52,6 +63,21 @@ impl Region {
             striker_sites: 1,
             ..self
         })
+    }
+
+    /// The parts this region was built from, taken apart with no `..` (see
+    /// [`crate::model::parts`]).
+    pub fn parts(&self) -> RegionParts {
+        let Region {
+            lo,
+            hi,
+            striker_sites,
+        } = *self;
+        RegionParts {
+            lo,
+            hi,
+            striker: striker_sites == 1,
+        }
     }
 
     /// Whether site 0 is a striker.

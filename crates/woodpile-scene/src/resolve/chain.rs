@@ -265,8 +265,8 @@ fn fits(key: &str, len: usize, room: usize, what: &str) -> Result<(), Invalid> {
     }
 }
 
-/// The contact law a scene declares, or `None` when it declares none of the chain's new keys
-/// (then the chain is the paper's and keeps its bits). Walls carry `chain.wall_contact`.
+/// The contact law a scene declares, or `None` when its keys leave the paper's law (then the
+/// chain is the paper's and keeps its bits). Walls carry `chain.wall_contact`.
 pub(crate) fn contact_law(
     chain: Option<&raw::Chain>,
     (boundary, has_striker): (Boundary, bool),
@@ -329,6 +329,15 @@ pub(crate) fn contact_law(
         let last = sites.contacts.len() - 1;
         sites.set_contact(0, a);
         sites.set_contact(last, a);
+    }
+    // Keys spelling out the paper's law (α = 3/2, unit coefficients, no static force) build
+    // the paper's chain: its code path, its bits and its cache key, however they are written.
+    let papers = exponent == 1.5
+        && precompression == 0.0
+        && gravity.is_none()
+        && sites.contacts.iter().all(|&a| a == 1.0);
+    if papers {
+        return Ok(None);
     }
     let law = match gravity {
         None => ContactLaw::new(sites.contacts.clone(), exponent, precompression),

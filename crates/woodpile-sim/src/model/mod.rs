@@ -13,10 +13,12 @@
 //! `n_dof = S + R` and `y.len() = 2 n_dof`. Contacts push, never pull (`[x]_+ = max(x, 0)`).
 
 mod boundary;
+pub mod parts;
 mod resonator;
 mod window;
 
 pub use boundary::{Boundary, End};
+pub use parts::ModelParts;
 pub use resonator::{Coupling, Resonator};
 pub use window::Window;
 
