@@ -4,7 +4,7 @@
 //! ω² = κ (1/m + 1/ε), and light resonators make ω large. An ordinary Nyström step resolves
 //! that vibration only while ω h is small: DPRKN6 grows its amplitude by 4e-6 a step at ω h = 1,
 //! so `auto` capped ω h at 0.5, and on F7's light resonators the coarse run of its first pair
-//! missed by 18 times what a heavy resonator's did (docs/performance.md). Here the pair's spring
+//! missed by 18 times what a heavy resonator's did (measured in commit bcb51da's work). Here the pair's spring
 //! is integrated exactly and only the rest of the force, g (the contacts), by the tableau.
 //!
 //! Each pair's spring is a linear term −Ω² q of rank one: on the pair's coordinates (u, v)
