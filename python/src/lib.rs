@@ -48,6 +48,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
     m.add_function(wrap_pyfunction!(table_integrity, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The shares' names in the order every table lists them, for the Python side to iterate.
+    let shares = woodpile_sim::Share::ALL.map(woodpile_sim::Share::name);
+    m.add("SHARES", pyo3::types::PyTuple::new(py, shares)?)?;
     Ok(())
 }
 

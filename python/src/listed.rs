@@ -12,6 +12,7 @@ use woodpile_scene::units_out::SiFactors;
 use woodpile_scene::Scene;
 use woodpile_sim::observe::SiteField;
 use woodpile_sim::simulation::{simulate, simulate_batch, Outcome};
+use woodpile_sim::ShareSet;
 
 use crate::interrupt::{internal_message, Watch};
 
@@ -134,16 +135,17 @@ pub(crate) fn outcome_rows<'a>(
     scenes: &[Scene],
     si: &[Option<SiFactors>],
 ) -> Vec<OutcomeRow<'a>> {
-    let striker = scenes.iter().any(|s| s.scenario.region.has_striker());
-    let dissipation = scenes.iter().any(|s| s.scenario.model.is_dissipative());
+    let shares = scenes
+        .iter()
+        .map(|s| ShareSet::of(&s.scenario.model, &s.scenario.region))
+        .fold(ShareSet::default(), ShareSet::union);
     outcomes
         .iter()
         .enumerate()
         .map(|(point, outcome)| OutcomeRow {
             point,
             outcome,
-            striker,
-            dissipation,
+            shares,
             si: si.get(point).copied().flatten(),
         })
         .collect()
@@ -153,8 +155,8 @@ pub(crate) fn outcome_rows<'a>(
 pub(crate) struct OutcomeRow<'a> {
     point: usize,
     outcome: &'a Result<Outcome, String>,
-    striker: bool,
-    dissipation: bool,
+    /// The shares every row carries: those of any scene.
+    shares: ShareSet,
     /// SI factors, when the row is asked in SI units.
     si: Option<SiFactors>,
 }
@@ -162,19 +164,10 @@ pub(crate) struct OutcomeRow<'a> {
 impl Row for OutcomeRow<'_> {
     fn cells(&self) -> Vec<(&str, Cell)> {
         let ok = self.outcome.as_ref().ok();
-        let share = |pick: fn(&Outcome) -> f64| Cell::from(ok.map(pick));
         let (time, energy) = self.si.map_or((1.0, 1.0), |f| (f.time_s, f.energy_j));
-        let mut cells = vec![
-            (sweep::POINT, Cell::from(self.point as i64)),
-            (sweep::REFLECTED, share(|o| o.fractions.reflected)),
-            (sweep::TRANSMITTED, share(|o| o.fractions.transmitted)),
-            (sweep::TRAPPED, share(|o| o.fractions.trapped)),
-        ];
-        if self.striker {
-            cells.push((sweep::STRIKER, share(|o| o.fractions.striker)));
-        }
-        if self.dissipation {
-            cells.push((sweep::DISSIPATED, share(|o| o.fractions.dissipated)));
+        let mut cells = vec![(sweep::POINT, Cell::from(self.point as i64))];
+        for kind in self.shares.iter() {
+            cells.push((kind.name(), Cell::from(ok.map(|o| kind.of(&o.fractions)))));
         }
         cells.extend([
             ("E_initial", ok.map(|o| o.e_initial * energy).into()),

@@ -12,7 +12,7 @@ use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::simulation::{simulate as run, Outcome, Scenario};
-use woodpile_sim::SimError;
+use woodpile_sim::{ShareSet, SimError};
 
 use crate::interrupt::{on_this_thread, Clock, Watch};
 use crate::scene_input::{label_text, Source};
@@ -57,7 +57,7 @@ pub(crate) fn simulate<'py>(
     };
     let s = &scene.scenario;
     if let Some((first, last)) = sites {
-        SiteField::check_size(s, last - first + 1)
+        woodpile_sim::simulation::check_field_size(s, last - first + 1)
             .map_err(|reason| SceneError::new_err(format!("{label}: field: {reason}")))?;
     }
     if let Some(note) = cost_note(&scene) {
@@ -146,18 +146,16 @@ fn warn_long_run(py: Python<'_>, message: &str) -> PyResult<()> {
 fn series_columns<'py>(
     py: Python<'py>,
     scene: &Scene,
-    series: FractionSeries,
+    mut series: FractionSeries,
 ) -> PyResult<Bound<'py, PyDict>> {
     let columns = PyDict::new(py);
-    columns.set_item("t", series.t.into_pyarray(py))?;
-    columns.set_item("R", series.reflected.into_pyarray(py))?;
-    columns.set_item("T", series.transmitted.into_pyarray(py))?;
-    columns.set_item("E_tr", series.trapped.into_pyarray(py))?;
-    if scene.scenario.region.has_striker() {
-        columns.set_item("S", series.striker.into_pyarray(py))?;
-    }
-    if scene.scenario.model.is_dissipative() {
-        columns.set_item("D", series.dissipated.into_pyarray(py))?;
+    columns.set_item("t", std::mem::take(&mut series.t).into_pyarray(py))?;
+    let scenario = &scene.scenario;
+    for share in ShareSet::of(&scenario.model, &scenario.region).iter() {
+        columns.set_item(
+            share.name(),
+            share.take_series(&mut series).into_pyarray(py),
+        )?;
     }
     columns.set_item("E", series.energy.into_pyarray(py))?;
     Ok(columns)

@@ -22,6 +22,7 @@ use woodpile_scene::template::Template;
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::simulation::batch_size;
+use woodpile_sim::ShareSet;
 
 use crate::interrupt::{internal_message, interruptible_keeping};
 use crate::listed::{outcome_rows, table_dict};
@@ -72,8 +73,10 @@ pub(crate) fn sweep<'py>(
     };
     let shape = SweepShape {
         axes: &grid.axes,
-        with_striker: first.scenario.region.has_striker(),
-        with_dissipation: grid.template.declares_dissipation(),
+        shares: ShareSet {
+            striker: first.scenario.region.has_striker(),
+            dissipative: grid.template.declares_dissipation(),
+        },
     };
     run.table(py, count, shape, progress.as_ref())
 }
@@ -426,7 +429,7 @@ fn check_fields(list: &[Scene]) -> PyResult<()> {
     for (index, scene) in list.iter().enumerate() {
         let s = &scene.scenario;
         let n = s.model.n_sites();
-        woodpile_sim::observe::SiteField::check_size(s, n)
+        woodpile_sim::simulation::check_field_size(s, n)
             .map_err(|reason| SceneError::new_err(format!("scenes[{index}]: fields: {reason}")))?;
         let samples = woodpile_sim::integrate::intervals(s.t_end, s.sample_every) as f64 + 1.0;
         total += samples * n as f64;

@@ -285,3 +285,32 @@ def test_simulate_many_refuses_fields_that_would_not_fit_before_running():
     big = {"chain": {"n": 2000}, "impulse": {"site": -5}, "run": {"t_end": 150.0, "sample_every": 0.05}}
     with pytest.raises(woodpile.SceneError, match="fields"):
         woodpile.simulate_many([big] * 8, progress=False, fields=True)
+
+
+def test_every_output_lists_the_same_shares_in_one_order():
+    """The shares are named once (`woodpile._core.SHARES`): `simulate`'s attributes and
+    series, `simulate_many`'s and `sweep`'s columns and the type stubs all follow it."""
+    from woodpile import _core
+    from woodpile._simulate import SimulationResult
+
+    assert _core.SHARES == ("R", "T", "E_tr", "S", "D")
+    assert set(_core.SHARES) <= set(SimulationResult.__annotations__)
+    stubs = (Path(woodpile.__file__).parent / "_core.pyi").read_text()
+    assert "SHARES:" in stubs
+    struck = {
+        "chain": {"n": 20, "boundary": {"left": "free"}},
+        "striker": {"mass": 2.0},
+        "defect": [{"site": 0, "eps": 2.0}],
+        "damping": {"ground": 0.001},
+        "run": {"t_end": 10.0, "tolerance": 1e-6},
+    }
+    result = woodpile.simulate(struck)
+    assert [c for c in result.series.columns if c in _core.SHARES] == list(_core.SHARES)
+    assert result.S is not None and result.D is not None
+    many = woodpile.simulate_many([struck, struck])
+    assert [c for c in many.columns if c in _core.SHARES] == list(_core.SHARES)
+    swept = woodpile.sweep(struck | {"defect": [{"site": 0, "eps": "$eps"}]}, {"eps": [1.0, 2.0]})
+    assert [c for c in swept.columns if c in _core.SHARES] == list(_core.SHARES)
+    plain = woodpile.simulate(STANDARD)
+    assert [c for c in plain.series.columns if c in _core.SHARES] == ["R", "T", "E_tr"]
+    assert plain.S is None and plain.D is None

@@ -6,6 +6,8 @@ from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Unio
 Scene = Union[Dict[str, Any], str, "os.PathLike[str]"]
 
 __version__: str
+#: The energy shares in the order every table lists them: ("R", "T", "E_tr", "S", "D").
+SHARES: Tuple[str, str, str, str, str]
 
 class SceneError(ValueError): ...
 class SimulationError(RuntimeError): ...

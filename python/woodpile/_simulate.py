@@ -93,8 +93,9 @@ class SimulationResult:
             setattr(self, key, value)
         self.physical = self._report.get("physical")
         self.units = self._report.get("units")
-        self.S = self._report.get("S")
-        self.D = self._report.get("D")
+        # A share the scene does not have (S without a striker, D without losses) is None.
+        for share in _core.SHARES:
+            setattr(self, share, self._report.get(share))
         self._series_columns: Dict[str, np.ndarray] = raw["series"]
         self._series: Optional[pd.DataFrame] = None
         self.t = raw.get("t", self._series_columns["t"])
@@ -112,9 +113,8 @@ class SimulationResult:
         """R, T, E_tr and E at every ``run.sample_every`` (columns t, R, T, E_tr, (S,) (D,)
         E): the arrays the simulation returned, made a DataFrame on first access."""
         if self._series is None:
-            columns = self._series_columns
-            names = ("t", "R", "T", "E_tr", "S", "D", "E")
-            self._series = pd.DataFrame({name: columns[name] for name in names if name in columns})
+            # The native module lists t, the scene's shares in their order, then E.
+            self._series = pd.DataFrame(self._series_columns)
         return self._series
 
     def as_dict(self) -> Dict[str, Any]:

@@ -15,7 +15,7 @@ use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::observe::{FractionSeries, SiteField};
 use woodpile_sim::simulation::simulate;
-use woodpile_sim::SimError;
+use woodpile_sim::{ShareSet, SimError};
 
 use crate::Failure;
 
@@ -60,7 +60,7 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
     let si = SiFactors::of(&scene, units)
         .map_err(|reason| Failure::input(anyhow!("--si: {}: {reason}", args.scene.display())))?;
     if args.field.is_some() {
-        SiteField::check_size(s, sites.1 - sites.0 + 1)
+        woodpile_sim::simulation::check_field_size(s, sites.1 - sites.0 + 1)
             .map_err(|reason| Failure::input(anyhow!("--field: {reason}")))?;
     }
     let mut observers = (
@@ -241,16 +241,10 @@ fn write_series(
 ) -> Result<(), Failure> {
     let some = |v: &[f64]| v.iter().map(|x| Some(*x)).collect::<Vec<_>>();
     let mut columns = Columns::new();
-    columns
-        .f64("t", some(&series.t))
-        .f64("R", some(&series.reflected))
-        .f64("T", some(&series.transmitted))
-        .f64("E_tr", some(&series.trapped));
-    if scene.scenario.region.has_striker() {
-        columns.f64("S", some(&series.striker));
-    }
-    if scene.scenario.model.is_dissipative() {
-        columns.f64("D", some(&series.dissipated));
+    columns.f64("t", some(&series.t));
+    let scenario = &scene.scenario;
+    for share in ShareSet::of(&scenario.model, &scenario.region).iter() {
+        columns.f64(share.name(), some(share.in_series(series)));
     }
     columns.f64("E", some(&series.energy));
     let frame = columns.into_frame().map_err(Failure::simulation)?;

@@ -6,7 +6,7 @@ use woodpile_scene::Scene;
 use woodpile_sim::integrate::{StepControl, Stoppable};
 use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::simulation::{simulate_batch, Outcome, Scenario};
-use woodpile_sim::SimError;
+use woodpile_sim::{Share, SimError};
 
 use crate::canonical::{code_version, scene_json, Key};
 
@@ -49,6 +49,20 @@ pub struct PointData {
     pub striker: Option<Vec<f64>>,
     /// D(t), the dissipated share: only for a dissipative scene, for the same reason.
     pub dissipated: Option<Vec<f64>>,
+}
+
+impl PointData {
+    /// `share` at sample `sample`; `None` for S at a point with no striker. A point whose
+    /// values dissipate nothing has no D series, and shows D = 0: it lost nothing.
+    pub fn share_at(&self, share: Share, sample: usize) -> Option<f64> {
+        match share {
+            Share::Reflected => Some(self.reflected[sample]),
+            Share::Transmitted => Some(self.transmitted[sample]),
+            Share::Trapped => Some(self.trapped[sample]),
+            Share::Striker => self.striker.as_ref().map(|s| s[sample]),
+            Share::Dissipated => Some(self.dissipated.as_ref().map_or(0.0, |d| d[sample])),
+        }
+    }
 }
 
 /// Which energy a sweep's fractions split.

@@ -7,6 +7,7 @@
 //! code.
 
 use woodpile_scene::grid::{Axis, AxisValue};
+use woodpile_sim::ShareSet;
 
 use crate::canonical::Key;
 use crate::point::{PointData, PointResult};
@@ -143,10 +144,9 @@ pub use woodpile_scene::columns as sweep;
 pub struct SweepShape<'a> {
     /// The grid's axes, in order.
     pub axes: &'a [Axis],
-    /// Whether its scenes have a striker: the table then has `S`.
-    pub with_striker: bool,
-    /// Whether its scene declares dissipation: the table then has `D` on every row.
-    pub with_dissipation: bool,
+    /// Its shares: `S` when its scenes have a striker, `D` on every row when its scene
+    /// declares dissipation.
+    pub shares: ShareSet,
 }
 
 /// One point of a sweep, as its rows need it.
@@ -200,20 +200,10 @@ impl Row for SweepRow<'_> {
         }
         let ok = self.point.result.as_ref().ok();
         let at = |series: fn(&PointData) -> &Vec<f64>| ok.map(|p| series(p)[self.sample]);
-        cells.extend([
-            (sweep::TIME, at(|p| &p.t).into()),
-            (sweep::REFLECTED, at(|p| &p.reflected).into()),
-            (sweep::TRANSMITTED, at(|p| &p.transmitted).into()),
-            (sweep::TRAPPED, at(|p| &p.trapped).into()),
-        ]);
-        if self.shape.with_striker {
-            let share = ok.and_then(|p| p.striker.as_ref().map(|s| s[self.sample]));
-            cells.push((sweep::STRIKER, share.into()));
-        }
-        if self.shape.with_dissipation {
-            // A point whose values dissipate nothing has no D series: it lost nothing.
-            let lost = ok.map(|p| p.dissipated.as_ref().map_or(0.0, |d| d[self.sample]));
-            cells.push((sweep::DISSIPATED, lost.into()));
+        cells.push((sweep::TIME, at(|p| &p.t).into()));
+        for share in self.shape.shares.iter() {
+            let value = ok.and_then(|p| p.share_at(share, self.sample));
+            cells.push((share.name(), value.into()));
         }
         cells.extend([
             (sweep::ENERGY, at(|p| &p.energy).into()),

@@ -2,21 +2,24 @@
 //! reason for a point that failed), after the point's axis values under the axes' names. Named
 //! here, beside the grid, so that no axis can take a column's name
 //! ([`crate::grid::RESERVED`]), and written by `woodpile_points::rows` and Python's module.
+//! The shares' names are [`Share`]'s.
+
+use woodpile_sim::Share;
 
 /// The point's index in the grid.
 pub const POINT: &str = "point";
 /// The sample time.
 pub const TIME: &str = "t";
 /// The reflected share R.
-pub const REFLECTED: &str = "R";
+pub const REFLECTED: &str = Share::Reflected.name();
 /// The transmitted share T.
-pub const TRANSMITTED: &str = "T";
+pub const TRANSMITTED: &str = Share::Transmitted.name();
 /// The trapped share E_tr.
-pub const TRAPPED: &str = "E_tr";
+pub const TRAPPED: &str = Share::Trapped.name();
 /// The striker's share S (only in sweeps whose scenes have a `[striker]`).
-pub const STRIKER: &str = "S";
+pub const STRIKER: &str = Share::Striker.name();
 /// The dissipated share D (sweeps of scenes with damping).
-pub const DISSIPATED: &str = "D";
+pub const DISSIPATED: &str = Share::Dissipated.name();
 /// The total energy (or, for a kinetic series, the kinetic share of the impact energy).
 pub const ENERGY: &str = "E";
 /// The method of the reported run.

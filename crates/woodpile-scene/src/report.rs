@@ -5,6 +5,7 @@
 use serde_json::{json, Value};
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::simulation::{budget, Outcome};
+use woodpile_sim::{Share, ShareSet};
 
 use crate::Scene;
 
@@ -15,9 +16,6 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
     // A dissipative chain's energy_drift is its ledger's, |E(t) + D(t) − E(0)| / E(0).
     let dissipative = scenario.model.is_dissipative();
     let mut report = json!({
-        "R": unsigned_zero(f.reflected),
-        "T": unsigned_zero(f.transmitted),
-        "E_tr": unsigned_zero(f.trapped),
         "E_initial": out.e_initial,
         "E_final": out.e_final,
         "method": out.plan.method.name(),
@@ -49,11 +47,10 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
         "end_reached_at": out.stats.end_reached_at,
         "version": env!("CARGO_PKG_VERSION"),
     });
-    if scenario.region.has_striker() {
-        report["S"] = json!(unsigned_zero(f.striker));
-    }
-    if dissipative {
-        report["D"] = json!(unsigned_zero(f.dissipated));
+    // The shares (R, T, E_tr, and S and D where the scene has them); serde_json's map keeps
+    // its keys sorted, so where they are added does not move them.
+    for share in ShareSet::of(&scenario.model, &scenario.region).iter() {
+        report[share.name()] = json!(unsigned_zero(share.of(&f)));
     }
     if let Some(p) = &scene.physical {
         report["physical"] = json!({
@@ -118,22 +115,19 @@ fn duration(seconds: f64) -> String {
 /// the tolerance. `woodpile simulate` prints it under `unverified` with exit 3, and Python's
 /// `SimulationError.result` holds it.
 pub fn unverified_report(scene: &Scene, finest: &woodpile_sim::Unverified) -> Value {
-    let [reflected, transmitted, trapped, striker, dissipated] = finest.shares;
     let scenario = &scene.scenario;
     let mut report = json!({
-        "R": reflected,
-        "T": transmitted,
-        "E_tr": trapped,
         "dt": finest.dt,
         "error_estimate": finest.estimate.is_finite().then_some(finest.estimate),
         "tolerance": scenario.accuracy.tolerance,
         "verified": false,
     });
-    if scenario.region.has_striker() {
-        report["S"] = json!(striker);
-    }
-    if scenario.model.is_dissipative() {
-        report["D"] = json!(dissipated);
+    // `Unverified::shares` holds the shares in `Share::ALL`'s order.
+    let reported = ShareSet::of(&scenario.model, &scenario.region);
+    for (share, value) in Share::ALL.into_iter().zip(finest.shares) {
+        if reported.has(share) {
+            report[share.name()] = json!(value);
+        }
     }
     report
 }

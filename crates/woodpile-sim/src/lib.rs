@@ -14,6 +14,7 @@
 //! - [`integrate`]: the steppers (RK4, Störmer–Verlet, symplectic compositions, DOP853) and the
 //!   single driver that owns the time loop, sampling and failure detection.
 //! - [`observe`]: sampled time series of the fractions and the space-time velocity field.
+//! - [`share`]: the shares (R, T, E_tr, S, D) named once, and which a scene reports.
 //! - [`simulation`]: "simulate a scene, return its fractions" as one function.
 //! - [`simulation::budget`]: what a run will cost, so an endless one is refused before it starts.
 //! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
@@ -30,6 +31,7 @@ pub mod model;
 pub mod observe;
 pub mod restitution;
 pub mod rods;
+pub mod share;
 pub mod simd;
 pub mod simulation;
 #[cfg(any(test, feature = "testing"))]
@@ -40,3 +42,4 @@ pub use contact::ContactLaw;
 pub use damping::{Damping, DashpotLaw};
 pub use error::{ModelError, OverBudget, Refusal, SimError, StepSetBy, Unverified};
 pub use model::{Boundary, Coupling, End, Model, Resonator};
+pub use share::{Share, ShareSet};

@@ -10,9 +10,8 @@
 //!   field for analysis, `woodpile simulate --field`, Python's `fields`).
 
 use crate::energy::{energy_density, kinetic_density, Fractions, Region};
-use crate::integrate::{intervals, Observer};
+use crate::integrate::Observer;
 use crate::model::Model;
-use crate::simulation::Scenario;
 
 /// Which energy a [`FractionSeries`] splits.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -240,21 +239,6 @@ impl SiteField {
     /// Number of sites kept per sample.
     pub fn width(&self) -> usize {
         self.last - self.first + 1
-    }
-
-    /// Refuses, before the run, a field of more than [`MAX_FIELD_VALUES`] values per array:
-    /// `width` sites at every sample of `scenario`. The reason names the sizes.
-    pub fn check_size(scenario: &Scenario, width: usize) -> Result<(), String> {
-        // The resonator arrays are as wide as the chain has resonators.
-        let width = width.max(scenario.model.resonators().len());
-        let samples = intervals(scenario.t_end, scenario.sample_every) + 1;
-        let values = samples.saturating_mul(width as u64);
-        if values > MAX_FIELD_VALUES {
-            return Err(format!(
-                "a field {width} columns wide (sites or resonators) at {samples} samples is {values} values per array, more than the {MAX_FIELD_VALUES} it may have; keep fewer sites or sample less often"
-            ));
-        }
-        Ok(())
     }
 }
 

@@ -36,6 +36,7 @@ use serde_json::{json, Value};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::simulation::batch_size;
+use woodpile_sim::ShareSet;
 
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
@@ -58,10 +59,9 @@ pub struct Sweep {
     pub series: Shares,
     template: Template,
     file: PathBuf,
-    /// Whether its scenes have a striker: the table then has the striker's share `S`.
-    with_striker: bool,
-    /// Whether its scene declares dissipation: the table then has the dissipated share `D`.
-    with_dissipation: bool,
+    /// The shares its table has: `S` when its scenes have a striker, `D` when its scene
+    /// declares dissipation (on every row, a point that loses nothing showing 0).
+    shares: ShareSet,
 }
 
 impl Sweep {
@@ -95,19 +95,21 @@ impl Sweep {
                 reason,
                 source: None,
             })?;
-        let with_dissipation = template.declares_dissipation();
+        let dissipative = template.declares_dissipation();
         let sweep = Sweep {
             axes,
             series,
             template,
             file: file.to_path_buf(),
-            with_striker: false,
-            with_dissipation,
+            shares: ShareSet {
+                striker: false,
+                dissipative,
+            },
         };
         // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
         // the grid exercise the extremes of every axis. A placeholder cannot add or remove a
         // table, so the first scene says whether every scene has a striker.
-        let with_striker = sweep.scene_at(0)?.scenario.region.has_striker();
+        let striker = sweep.scene_at(0)?.scenario.region.has_striker();
         let last = sweep.scene_at(sweep.count() - 1)?;
         woodpile_scene::grid::check_sweep_memory(sweep.count(), &last).map_err(|reason| {
             PipelineError::Definition {
@@ -118,7 +120,10 @@ impl Sweep {
             }
         })?;
         Ok(Sweep {
-            with_striker,
+            shares: ShareSet {
+                striker,
+                dissipative,
+            },
             ..sweep
         })
     }
@@ -237,8 +242,7 @@ impl Sweep {
     fn shape(&self) -> SweepShape<'_> {
         SweepShape {
             axes: &self.axes,
-            with_striker: self.with_striker,
-            with_dissipation: self.with_dissipation,
+            shares: self.shares,
         }
     }
 }

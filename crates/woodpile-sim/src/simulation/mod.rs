@@ -18,8 +18,10 @@ pub use lanes::{batch_size, simulate_batch};
 
 use crate::energy::{Fractions, Region};
 use crate::error::SimError;
-use crate::integrate::{Accuracy, CancelOnly, MethodChoice, Observer, Plan, Stats};
+use crate::integrate::{intervals, Accuracy, CancelOnly, MethodChoice, Observer, Plan, Stats};
 use crate::model::Model;
+use crate::observe::MAX_FIELD_VALUES;
+use crate::share::Share;
 
 /// Halvings `auto` tries before giving up.
 const MAX_HALVINGS: u32 = 6;
@@ -94,13 +96,7 @@ pub fn simulate<O: Observer + ?Sized>(
 pub fn check_shares(scenario: &Scenario, out: Outcome) -> Result<Outcome, SimError> {
     let allowance = share_allowance(scenario, &out.plan);
     let f = &out.fractions;
-    let shares = [
-        ("R", f.reflected),
-        ("T", f.transmitted),
-        ("E_tr", f.trapped),
-        ("S", f.striker),
-        ("D", f.dissipated),
-    ];
+    let shares = Share::ALL.map(|share| (share.name(), share.of(f)));
     let why = if let Some((name, x)) = shares.iter().find(|(_, x)| !x.is_finite()) {
         Some(format!("{name} is {x} (E(0) = {:e})", out.e_initial))
     } else if let Some((name, x)) = shares
@@ -254,4 +250,19 @@ fn outcome_of(
         error_estimate: None,
         final_state: y,
     }
+}
+
+/// Refuses, before the run, a field of more than [`MAX_FIELD_VALUES`] values per array:
+/// `width` sites at every sample of `scenario`. The reason names the sizes.
+pub fn check_field_size(scenario: &Scenario, width: usize) -> Result<(), String> {
+    // The resonator arrays are as wide as the chain has resonators.
+    let width = width.max(scenario.model.resonators().len());
+    let samples = intervals(scenario.t_end, scenario.sample_every) + 1;
+    let values = samples.saturating_mul(width as u64);
+    if values > MAX_FIELD_VALUES {
+        return Err(format!(
+            "a field {width} columns wide (sites or resonators) at {samples} samples is {values} values per array, more than the {MAX_FIELD_VALUES} it may have; keep fewer sites or sample less often"
+        ));
+    }
+    Ok(())
 }
