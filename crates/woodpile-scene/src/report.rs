@@ -83,9 +83,15 @@ pub fn wall_note(scene: &Scene, out: &Outcome) -> Option<String> {
 /// said before it starts, with what it will cost if the tolerance needs every halving.
 pub fn cost_note(scene: &Scene) -> Option<String> {
     let f = budget::forecast(&scene.scenario)?;
-    (f.first_rung_s > budget::LONG_RUN_S).then(|| {
+    let long = f.first_rung_s > budget::LONG_RUN_S
+        || (f.halvings_likely && f.whole_ladder_s > budget::LONG_RUN_S);
+    let likely = match f.halvings_likely {
+        true => " (likely: a contact dashpot's onset costs rk4-contact its order)",
+        false => "",
+    };
+    long.then(|| {
         format!(
-            "auto's first rung is two runs of about {:.2e} and {:.2e} steps over {} sites and resonators (step {:.2e}): roughly {} at the rate measured on woodpile's development machine, and up to {} if the tolerance needs every halving; a looser tolerance or a shorter t_end is faster",
+            "auto's first rung is two runs of about {:.2e} and {:.2e} steps over {} sites and resonators (step {:.2e}): roughly {} at the rate measured on woodpile's development machine, and up to {} if the tolerance needs every halving{likely}; a looser tolerance or a shorter t_end is faster",
             f.steps,
             f.steps / 2.0,
             f.sites,
@@ -101,9 +107,10 @@ fn unsigned_zero(share: f64) -> f64 {
     share + 0.0
 }
 
-/// `12 s`, `7 min`, `3.2 h`.
+/// `0.4 s`, `12 s`, `7 min`, `3.2 h`.
 fn duration(seconds: f64) -> String {
     match seconds {
+        s if s < 10.0 => format!("{s:.1} s"),
         s if s < 120.0 => format!("{s:.0} s"),
         s if s < 7200.0 => format!("{:.0} min", s / 60.0),
         s => format!("{:.1} h", s / 3600.0),

@@ -180,3 +180,24 @@ fn long_runs_are_forecast_before_they_start() {
     // adds fine runs of 2, 4, ..., 64 times its steps: (0.5 + 127) / 1.5 = 85 first rungs.
     assert!((f.whole_ladder_s / f.first_rung_s - 85.0).abs() < 1e-9);
 }
+
+/// A stiff contact dashpot is announced (issue 55, B6): its onset costs `auto` most of its
+/// halvings and a damped step costs about four undamped ones, so the forecast counts the
+/// whole ladder at the damped rate. The same chain without it says nothing.
+#[test]
+fn a_stiff_contact_dashpot_is_forecast_long() {
+    let scene = |damping: &str| {
+        let text = format!(
+            "[chain]\nn = 30\n[impulse]\nsite = -10\n[[defect]]\nsite = 0\neps = 2.0\n{damping}[run]\nt_end = 30.0\n"
+        );
+        woodpile_scene::parse(&text, std::path::Path::new("dashpot.toml")).unwrap()
+    };
+    let damped = scene("[damping]\ncontact = 1000.0\n");
+    let note = woodpile_scene::report::cost_note(&damped).expect("a note");
+    assert!(note.contains("contact dashpot"), "{note}");
+    assert_eq!(woodpile_scene::report::cost_note(&scene("")), None);
+    // Ground damping is smooth: the forecast keeps the first rung as its measure.
+    let ground =
+        woodpile_sim::simulation::budget::forecast(&scene("[damping]\nground = 0.001\n").scenario);
+    assert!(!ground.unwrap().halvings_likely);
+}

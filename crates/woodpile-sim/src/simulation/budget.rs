@@ -19,6 +19,12 @@ use crate::SimError;
 /// made with it are upper bounds, within a factor of a few of any recent machine.
 pub const SECONDS_PER_SITE_STEP: f64 = 9e-9;
 
+/// Seconds one step of one site costs `auto` on a chain whose forces depend on velocities
+/// (`rk4-contact` over the damped force: four evaluations a step, each with its dashpots), as
+/// measured like [`SECONDS_PER_SITE_STEP`]: 4.1e-8 on the standard scene with a linear contact
+/// dashpot of 0.05, 3.6e-8 on a 61-site chain with one of 1000.
+pub const DAMPED_SECONDS_PER_SITE_STEP: f64 = 4e-8;
+
 /// `auto`'s first-rung runs cost less than this, in the forecast, without a word: longer ones
 /// are announced before they start.
 pub const LONG_RUN_S: f64 = 10.0;
@@ -37,6 +43,10 @@ pub struct Forecast {
     /// Seconds of the whole ladder, should every halving be needed (each rung costs twice the
     /// one before).
     pub whole_ladder_s: f64,
+    /// Whether the halvings are likely: a contact dashpot switches on with its contact, a
+    /// kink `rk4-contact` steps through at a reduced order, and `auto` then needs most rungs
+    /// (the 61-site chain above needed all six at 1e-8).
+    pub halvings_likely: bool,
 }
 
 /// `auto`'s forecast for `scenario` (`None` for a named method: it runs once, as asked).
@@ -48,7 +58,12 @@ pub fn forecast(scenario: &Scenario) -> Option<Forecast> {
     let dt = auto_first_step(scenario, &plan);
     let steps = (scenario.t_end / dt).max(intervals(scenario.t_end, scenario.sample_every) as f64);
     let sites = scenario.model.n_dof();
-    let rung = 1.5 * steps * sites as f64 * SECONDS_PER_SITE_STEP;
+    let model = &scenario.model;
+    let per_site_step = match model.is_dissipative() {
+        true => DAMPED_SECONDS_PER_SITE_STEP,
+        false => SECONDS_PER_SITE_STEP,
+    };
+    let rung = 1.5 * steps * sites as f64 * per_site_step;
     let rungs = f64::from(super::MAX_HALVINGS + 1);
     Some(Forecast {
         dt,
@@ -58,6 +73,7 @@ pub fn forecast(scenario: &Scenario) -> Option<Forecast> {
         // The coarse run once, then fine runs at dt, dt/2, ...: 0.5 + (2^rungs - 1) first-rung
         // fine runs of the first rung's 1.5.
         whole_ladder_s: rung / 1.5 * (0.5 + 2f64.powf(rungs) - 1.0),
+        halvings_likely: model.damping().is_some_and(|d| d.contact > 0.0),
     })
 }
 
