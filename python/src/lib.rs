@@ -4,6 +4,7 @@
 //! hands results back as NumPy arrays without a copy per sample. The typed, documented API is
 //! the pure-Python `woodpile` package around it.
 
+mod calibrate;
 mod examples;
 mod interrupt;
 mod listed;
@@ -42,6 +43,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(spectrum::spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(examples::examples, m)?)?;
     m.add_function(wrap_pyfunction!(examples::example, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;

@@ -1,7 +1,8 @@
 """woodpile: granular chains with internal resonator defects, from Python.
 
 Simulate one scene (``simulate``) or a grid of them on every core (``sweep``), compute its
-linear picture (``spectrum``: bands, modes, transmission), and drive the
+linear picture (``spectrum``: bands, modes, transmission), fit a scene to a measured
+trace (``calibrate``), and drive the
 figure pipeline of a woodpile project (``Pipeline``; ``new_study`` makes one). Scenes are dicts with the keys of a
 scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile repository.
 
@@ -14,6 +15,7 @@ scene file, TOML strings, or paths; the format is docs/scene.md of the woodpile 
 >>> woodpile.sweep({"defect": [{"site": 0, "eps": "$eps"}]}, {"eps": [0.5, 1, 2, 5]})
 """
 
+from ._calibrate import CalibrationResult, calibrate
 from ._core import SceneError, SimulationError, __version__, example, examples, scene_toml
 from ._pipeline import Pipeline, new_study
 from ._simulate import EndReachedWarning, LongRunWarning, SimulationResult, simulate
@@ -21,6 +23,7 @@ from ._spectrum import SpectrumResult, spectrum
 from ._sweep import simulate_many, sweep
 
 __all__ = [
+    "CalibrationResult",
     "EndReachedWarning",
     "LongRunWarning",
     "Pipeline",
@@ -29,6 +32,7 @@ __all__ = [
     "SimulationResult",
     "SpectrumResult",
     "__version__",
+    "calibrate",
     "example",
     "examples",
     "new_study",

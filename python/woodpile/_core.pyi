@@ -40,6 +40,14 @@ def spectrum(
     measure: bool = False,
     probe: Optional[int] = None,
 ) -> Dict[str, Any]: ...
+def calibrate(
+    scene: Scene,
+    t: Sequence[float],
+    rod: Sequence[int],
+    velocity: Sequence[float],
+    sigma: Optional[Sequence[float]],
+    parameters: Sequence[Tuple[str, float, float, Optional[float]]],
+) -> Dict[str, Any]: ...
 def scene_toml(scene: Scene) -> str: ...
 def examples() -> list[str]:
     """The names of the example scenes the package carries."""
