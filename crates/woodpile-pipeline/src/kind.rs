@@ -176,6 +176,9 @@ pub struct Context<'a> {
     pub stage: &'a Stage,
     /// Every stage upstream of it (reached through [`Context::upstream`]).
     pub(crate) upstream: Vec<&'a Stage>,
+    /// The project's root, which data files a stage names (`trace = "data/x.csv"`) are
+    /// relative to.
+    pub root: &'a Path,
     /// The results tree.
     pub results: &'a Path,
     /// Where figures go.

@@ -386,9 +386,11 @@ fn execute(
         .into_iter()
         .filter(|s| s.name != stage.name)
         .collect();
+    let root = crate::pipeline::project_root(pipeline.dir());
     let output = stage.spec.run(&Context {
         stage,
         upstream,
+        root: &root,
         results,
         figures: &options.figures,
         store,

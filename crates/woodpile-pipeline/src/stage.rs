@@ -51,6 +51,7 @@ impl Stage {
     ) -> Result<Stage> {
         let mut table = parse_table(text, file)?;
         include_scene_file(&mut table, file, root)?;
+        include_data_digest(&mut table, file, root)?;
         defaults.lay_under(&mut table);
         Stage::from_table(table, file, kinds)
     }
@@ -236,6 +237,36 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
     })?;
     merge(&mut scene, overrides);
     table.insert("scene".into(), toml::Value::Table(scene));
+    Ok(())
+}
+
+/// The keys under which a stage may name a data file of the project (a measured trace).
+pub const DATA_KEYS: [&str; 1] = ["trace"];
+
+/// A data file by reference, `trace = "data/trace.csv"`: kept as `{ file, blake3 }`, the
+/// path and the blake3 digest of its bytes, so that the stage's key changes when the file
+/// does (as a scene file's content does). The kind reads the file and checks the digest.
+fn include_data_digest(table: &mut toml::Table, file: &Path, root: &Path) -> Result<()> {
+    for key in DATA_KEYS {
+        let reference = match table.get(key) {
+            Some(toml::Value::String(path)) => path.clone(),
+            Some(toml::Value::Table(t)) => match t.get("file") {
+                Some(toml::Value::String(path)) => path.clone(),
+                _ => return Err(definition(file, key, "expected the path of a data file")),
+            },
+            Some(_) => return Err(definition(file, key, "expected the path of a data file")),
+            None => continue,
+        };
+        let path = woodpile_points::layout::contained(root, &reference)
+            .map_err(|reason| definition(file, key, &reason))?;
+        let bytes = std::fs::read(&path)
+            .map_err(|e| definition(file, key, &format!("{}: cannot read: {e}", path.display())))?;
+        let mut data = toml::Table::new();
+        data.insert("file".into(), toml::Value::String(reference));
+        let digest = blake3::hash(&bytes).to_hex().to_string();
+        data.insert("blake3".into(), toml::Value::String(digest));
+        table.insert(key.into(), toml::Value::Table(data));
+    }
     Ok(())
 }
 

@@ -12,6 +12,7 @@ use std::sync::Arc;
 use woodpile_pipeline::kind::Registry;
 
 pub mod approximate;
+pub mod calibrate;
 pub mod design;
 pub mod fit;
 pub mod optimize;
@@ -56,6 +57,9 @@ pub static KINDS: &Registry = &[
     ("vary", |f, _| Ok(Arc::new(vary::Vary::parse(f)?))),
     ("spectrum", |f, _| {
         Ok(Arc::new(spectrum::Spectrum::parse(f)?))
+    }),
+    ("calibrate", |f, _| {
+        Ok(Arc::new(calibrate::Calibrate::parse(f)?))
     }),
 ];
 
