@@ -23,6 +23,7 @@ use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row};
 use woodpile_pipeline::Output;
+use woodpile_sim::{Share, ShareSet};
 
 /// A parsed reduce stage.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,8 +110,8 @@ impl Reduce {
 struct Reduced<'a> {
     axes: &'a [Axis],
     pick: &'a Pick,
-    /// Whether the input has the striker's share S and the dissipated share D.
-    shares: [bool; 2],
+    /// The input's shares (S and D where it has them).
+    shares: ShareSet,
 }
 
 impl Row for Reduced<'_> {
@@ -129,19 +130,9 @@ impl Row for Reduced<'_> {
             })
             .collect();
         let at = |f: fn(&Sample) -> f64| p.row.as_ref().map(f);
-        cells.extend([
-            (sweep::TIME, at(|r| r.t).into()),
-            (Fraction::Reflected.column(), at(|r| r.r).into()),
-            (Fraction::Transmitted.column(), at(|r| r.tr).into()),
-            (Fraction::Trapped.column(), at(|r| r.e_tr).into()),
-        ]);
-        for (present, (column, share)) in self.shares.into_iter().zip([
-            (sweep::STRIKER, p.row.and_then(|r| r.s)),
-            (sweep::DISSIPATED, p.row.and_then(|r| r.d)),
-        ]) {
-            if present {
-                cells.push((column, share.into()));
-            }
+        cells.push((sweep::TIME, at(|r| r.t).into()));
+        for share in self.shares.iter() {
+            cells.push((share.name(), p.row.and_then(|r| r.share(share)).into()));
         }
         cells.extend([
             (sweep::ENERGY, at(|r| r.e).into()),
@@ -170,6 +161,19 @@ struct Sample {
     d: Option<f64>,
     e: f64,
     error_estimate: Option<f64>,
+}
+
+impl Sample {
+    /// `share`'s value (`None` for S or D where the sweep has none).
+    fn share(&self, share: Share) -> Option<f64> {
+        match share {
+            Share::Reflected => Some(self.r),
+            Share::Transmitted => Some(self.tr),
+            Share::Trapped => Some(self.e_tr),
+            Share::Striker => self.s,
+            Share::Dissipated => self.d,
+        }
+    }
 }
 
 /// The chosen row of a point (or of a group, after maximisation).
@@ -219,8 +223,12 @@ impl SweepRows {
     }
 
     /// Whether the table has S and D.
-    fn shares(&self) -> [bool; 2] {
-        [self.s.is_some(), self.d.is_some()]
+    /// The shares the table has: S and D where their columns are.
+    fn shares(&self) -> ShareSet {
+        ShareSet {
+            striker: self.s.is_some(),
+            dissipative: self.d.is_some(),
+        }
     }
 
     fn row(&self, i: usize) -> Option<Sample> {
