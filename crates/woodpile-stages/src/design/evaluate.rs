@@ -8,8 +8,32 @@ use woodpile_pipeline::events::Events;
 use woodpile_points::{point_key, Key, PointResult, PointStore, Shares};
 use woodpile_sim::integrate::lanes::LANES;
 
+use super::space::round_sig;
 use super::{Design, Evaluated, Layout, Search};
 use crate::schema::Fraction;
+
+/// `layout` with each rod's eps and kappa as its scene derived them (a layout of eps and
+/// kappa as it is).
+fn with_derived(layout: &Layout, scene: &Scene) -> Layout {
+    let Some(physical) = &scene.physical else {
+        return layout.clone();
+    };
+    let resonators = layout
+        .resonators
+        .iter()
+        .map(
+            |r| match (r.length, physical.defects.iter().find(|d| d.site == r.site)) {
+                (Some(_), Some(derived)) => super::Resonator {
+                    eps: round_sig(derived.eps),
+                    kappa: round_sig(derived.kappa),
+                    ..*r
+                },
+                _ => *r,
+            },
+        )
+        .collect();
+    Layout { resonators }
+}
 
 impl Design {
     /// The scene table of `layout` (with `run.tolerance` replaced when given).
@@ -21,9 +45,18 @@ impl Design {
             .map(|r| {
                 let mut d = toml::Table::new();
                 d.insert("site".into(), toml::Value::Integer(r.site));
-                d.insert("eps".into(), toml::Value::Float(r.eps));
-                d.insert("kappa".into(), toml::Value::Float(r.kappa));
-                d.insert("p".into(), toml::Value::Integer(r.p));
+                match r.length {
+                    Some(length) => {
+                        let mut rod = toml::Table::new();
+                        rod.insert("length".into(), toml::Value::Float(length));
+                        d.insert("rod".into(), toml::Value::Table(rod));
+                    }
+                    None => {
+                        d.insert("eps".into(), toml::Value::Float(r.eps));
+                        d.insert("kappa".into(), toml::Value::Float(r.kappa));
+                        d.insert("p".into(), toml::Value::Integer(r.p));
+                    }
+                }
                 d.extend(self.each_resonator.clone());
                 toml::Value::Table(d)
             })
@@ -109,7 +142,7 @@ impl Design {
             &scenes.iter().collect::<Vec<_>>()[..],
         );
         let fetched = store.get_or_simulate_all(points, Shares::Energy)?;
-        let mut simulated = keys.into_iter().zip(fetched);
+        let mut simulated = keys.into_iter().zip(fetched).zip(&scenes);
         let evaluated = layouts.iter().map(|layout| {
             if let Some(reason) = over_bound(layout) {
                 return Evaluated {
@@ -121,12 +154,12 @@ impl Design {
                     simulated: false,
                 };
             }
-            let (key, fetched) = simulated.next().expect("a result per feasible layout");
+            let ((key, fetched), scene) = simulated.next().expect("a result per feasible layout");
             events.point_done();
             let score = self.score(&fetched.result);
             Evaluated {
                 search,
-                layout: layout.clone(),
+                layout: with_derived(layout, scene),
                 result: fetched.result,
                 score,
                 key: key.to_string(),

@@ -92,13 +92,13 @@ impl Design {
 /// keys the design sets itself.
 fn parse_each_resonator(fields: &mut Fields<'_>) -> Result<toml::Table> {
     let each: toml::Table = fields.optional("each_resonator")?.unwrap_or_default();
-    match ["site", "eps", "kappa", "p"]
+    match ["site", "eps", "kappa", "p", "rod"]
         .into_iter()
         .find(|k| each.contains_key(*k))
     {
         Some(placed) => Err(fields.error(
             &format!("each_resonator.{placed}"),
-            "the design sets each resonator's site, eps, kappa and p",
+            "the design sets each resonator's site, eps, kappa and p (or its rod)",
         )),
         None => Ok(each),
     }
@@ -140,6 +140,10 @@ fn parse_space(mut f: Fields<'_>) -> Result<Space> {
     if (sites.count() as i64) < lo {
         return Err(f.error("sites", "fewer sites than the fewest resonators"));
     }
+    let length = parse_lengths(&mut f)?;
+    if length.is_some() {
+        return rod_space(f, sites, (lo as usize, hi as usize), length);
+    }
     let eps = parse_values(&mut f, "eps")?;
     let kappa = parse_values(&mut f, "kappa")?;
     let p: Vec<i64> = match f.optional::<toml::Value>("p")? {
@@ -162,7 +166,82 @@ fn parse_space(mut f: Fields<'_>) -> Result<Space> {
         kappa,
         p,
         max_total_eps,
+        length: None,
     })
+}
+
+/// A space of defect rods (`length`): eps, kappa and p follow from each rod, so they may not
+/// be given, nor a bound on the added eps.
+fn rod_space(
+    mut f: Fields<'_>,
+    sites: Sites,
+    resonators: (usize, usize),
+    length: Option<Values>,
+) -> Result<Space> {
+    for key in ["eps", "kappa", "p", "max_total_eps"] {
+        if f.take(key).is_some() {
+            return Err(f.error(
+                key,
+                "a space of rod lengths derives each rod's eps and kappa from its bending mode (p = 1): leave it out",
+            ));
+        }
+    }
+    f.finish()?;
+    Ok(Space {
+        resonators,
+        sites,
+        eps: Values::List(Vec::new()),
+        kappa: Values::List(Vec::new()),
+        p: vec![1],
+        max_total_eps: None,
+        length,
+    })
+}
+
+/// `length`: the defect rods' lengths, `{ min = "20 mm", max = "80 mm", log = false }` or a
+/// list of the lengths a lab has (`["20 mm", "40 mm"]`); a bare number is metres.
+fn parse_lengths(f: &mut Fields<'_>) -> Result<Option<Values>> {
+    let metres = |f: &Fields<'_>, key: &str, v: &toml::Value| -> Result<f64> {
+        let x = match v {
+            toml::Value::String(text) => woodpile_scene::quantity::parse(text, "length")
+                .map_err(|reason| f.error(key, reason))?,
+            toml::Value::Float(x) => *x,
+            toml::Value::Integer(i) => *i as f64,
+            _ => return Err(f.error(key, "expected a length, \"40 mm\" or metres")),
+        };
+        match x.is_finite() && x > 0.0 {
+            true => Ok(x),
+            false => Err(f.error(key, "expected a positive length")),
+        }
+    };
+    match f.take("length") {
+        None => Ok(None),
+        Some(toml::Value::Array(items)) if !items.is_empty() => {
+            let list = items
+                .iter()
+                .map(|v| metres(f, "length", v))
+                .collect::<Result<Vec<f64>>>()?;
+            Ok(Some(Values::List(list)))
+        }
+        Some(toml::Value::Table(table)) => {
+            let mut r = f.nested("length", table);
+            let (Some(min), Some(max)) = (r.take("min"), r.take("max")) else {
+                return Err(r.error("min", "expected { min, max } lengths"));
+            };
+            let (min, max) = (metres(&r, "min", &min)?, metres(&r, "max", &max)?);
+            let log = match r.take("log") {
+                None => false,
+                Some(toml::Value::Boolean(b)) => b,
+                Some(_) => return Err(r.error("log", "expected true or false")),
+            };
+            if min > max {
+                return Err(r.error("min", "expected min <= max"));
+            }
+            r.finish()?;
+            Ok(Some(Values::Range(Range { min, max, log })))
+        }
+        Some(_) => Err(f.error("length", "expected { min, max } or a list of lengths")),
+    }
 }
 
 /// `sites`: `[first, last]`, a list of three or more sites, `{ among = [...] }` or

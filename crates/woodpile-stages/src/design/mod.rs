@@ -29,6 +29,15 @@
 //! max_total_eps = 200.0               # optional: a bound on the added mass, sum of eps
 //! ```
 //!
+//! In a `[physical]` scene the design cuts defect rods instead: `[space] length = { min =
+//! "20 mm", max = "80 mm" }` (or a list of the lengths at hand, `["20 mm", "40 mm"]`; bare
+//! numbers are metres) in place of `eps`, `kappa` and `p`. Each placed resonator is then a
+//! `defect.rod` of that length, of the regular rods' diameter and material, whose host and
+//! resonator masses and spring follow from its bending mode (`each_resonator` may add a
+//! `quality_factor`); the table adds each design's `length` (m) and lists the eps and kappa
+//! the rods derive, and the summary's `bill_of_rods` gives the best design's rods as a lab
+//! cuts them: site, length, masses, spring and bending frequency.
+//!
 //! The optimiser is differential evolution (DE/rand/1/bin, population 20, F = 0.6, CR = 0.9)
 //! on a genome in [0, 1]^(1 + 4 K) (the count, then site, eps, kappa, p for K slots), decoded
 //! to a scene with its defects sorted by site, so equal designs share one cached point. Random
@@ -246,10 +255,16 @@ impl Design {
                             let mut wobble = |x: f64| {
                                 round_sig(x * (1.0 + spread * (2.0 * rng.uniform() - 1.0)))
                             };
-                            Resonator {
-                                eps: wobble(r.eps),
-                                kappa: wobble(r.kappa),
-                                ..*r
+                            match r.length {
+                                Some(length) => Resonator {
+                                    length: Some(wobble(length)),
+                                    ..*r
+                                },
+                                None => Resonator {
+                                    eps: wobble(r.eps),
+                                    kappa: wobble(r.kappa),
+                                    ..*r
+                                },
                             }
                         })
                         .collect(),
@@ -319,7 +334,7 @@ impl Design {
         let random_best = self.best_of(rows, Search::Random);
         let refined = self.best_of(rows, Search::Refinement);
         let refined_random = self.best_of(rows, Search::RefinementOfRandom);
-        json!({
+        let mut summary = json!({
             "objective": self.objective_name(),
             "goal": if self.maximise { "max" } else { "min" },
             "evaluations": rows.len(),
@@ -336,7 +351,36 @@ impl Design {
             "baseline_beat_optimiser": refined_random.max(random_best) > refined.max(de_best),
             "verify_tolerance": self.verify_tolerance,
             "best_file": best_file.file_name().map(|n| n.to_string_lossy().into_owned()),
-        })
+        });
+        if let Some(rods) = self.bill_of_rods(&verified.layout) {
+            summary["bill_of_rods"] = rods;
+        }
+        summary
+    }
+
+    /// A rod design's best layout as the lab cuts it: each rod's site, length (m), host and
+    /// resonator masses (kg), spring (N/m) and bending frequency (Hz), as its scene derives
+    /// them; none for a design of eps and kappa.
+    fn bill_of_rods(&self, layout: &Layout) -> Option<serde_json::Value> {
+        self.space.length.as_ref()?;
+        let scene = self.scene(layout, Some(self.verify_tolerance)).ok()?;
+        let derived = scene.physical.map(|p| p.defects).unwrap_or_default();
+        let rods: Vec<serde_json::Value> = layout
+            .resonators
+            .iter()
+            .map(|r| {
+                let d = derived.iter().find(|d| d.site == r.site);
+                json!({
+                    "site": r.site,
+                    "length_m": r.length,
+                    "host_mass_kg": d.and_then(|d| d.host_mass_kg),
+                    "resonator_mass_kg": d.and_then(|d| d.resonator_mass_kg),
+                    "stiffness_n_per_m": d.and_then(|d| d.stiffness_n_per_m),
+                    "bending_f1_hz": d.and_then(|d| d.bending_f1_hz),
+                })
+            })
+            .collect();
+        Some(json!(rods))
     }
 
     /// Nelder–Mead from `start` (score `score`) on the eps and kappa genes of its resonators,
@@ -358,7 +402,9 @@ impl Design {
             .filter(|j| {
                 let gene = (j - 1) % GENES;
                 let slot = (j - 1) / GENES;
-                (gene == 1 || gene == 2) && slot < layout.resonators.len()
+                // eps and kappa, or a rod's length alone (its eps gene).
+                let searched = gene == 1 || (gene == 2 && self.space.length.is_none());
+                searched && slot < layout.resonators.len()
             })
             .collect();
         let mut refined: Vec<Evaluated> = Vec::new();

@@ -90,6 +90,10 @@ pub struct Space {
     pub p: Vec<i64>,
     /// Bound on the sum of eps.
     pub max_total_eps: Option<f64>,
+    /// In a `[physical]` scene, the defect rods' lengths (m) instead of eps, kappa and p: each
+    /// placed resonator is a rod of that length, its masses and spring derived from its
+    /// bending mode (`defect.rod`).
+    pub length: Option<Values>,
 }
 
 /// One resonator of a design.
@@ -103,6 +107,9 @@ pub struct Resonator {
     pub kappa: f64,
     /// Coupling exponent.
     pub p: i64,
+    /// A defect rod's length (m), when the space searches rods: eps and kappa are then the
+    /// values its rod derives ([`Design::with_derived`](super::Design)).
+    pub length: Option<f64>,
 }
 
 /// One decoded design: resonators sorted by site.
@@ -159,11 +166,22 @@ impl Space {
                 break;
             };
             taken[index] = true;
-            resonators.push(Resonator {
-                site: choices[index],
-                eps: round_sig(self.eps.at(g[1])),
-                kappa: round_sig(self.kappa.at(g[2])),
-                p: self.p[pick(g[3], self.p.len())],
+            resonators.push(match &self.length {
+                // A rod: its length in the eps gene; eps and kappa follow from the rod.
+                Some(length) => Resonator {
+                    site: choices[index],
+                    eps: 0.0,
+                    kappa: 0.0,
+                    p: 1,
+                    length: Some(round_sig(length.at(g[1]))),
+                },
+                None => Resonator {
+                    site: choices[index],
+                    eps: round_sig(self.eps.at(g[1])),
+                    kappa: round_sig(self.kappa.at(g[2])),
+                    p: self.p[pick(g[3], self.p.len())],
+                    length: None,
+                },
             });
         }
         resonators.sort_by_key(|r| r.site);
@@ -199,10 +217,16 @@ impl Space {
         (self.resonators.0..=self.resonators.1).contains(&n)
             && seen.len() == n
             && layout.resonators.iter().all(|r| {
-                sites.contains(&r.site)
-                    && within(&self.eps, r.eps)
-                    && within(&self.kappa, r.kappa)
-                    && self.p.contains(&r.p)
+                let parameters = match (&self.length, r.length) {
+                    (Some(lengths), Some(length)) => within(lengths, length),
+                    (None, None) => {
+                        within(&self.eps, r.eps)
+                            && within(&self.kappa, r.kappa)
+                            && self.p.contains(&r.p)
+                    }
+                    _ => false,
+                };
+                sites.contains(&r.site) && parameters
             })
             && self
                 .max_total_eps
@@ -237,6 +261,7 @@ mod tests {
             }),
             p: vec![1, 3],
             max_total_eps: None,
+            length: None,
         }
     }
 
@@ -255,6 +280,7 @@ mod tests {
                 eps,
                 kappa,
                 p,
+                length: _,
             } in &layout.resonators
             {
                 assert!((0..=4).contains(&site));

@@ -25,6 +25,7 @@ impl Design {
                     evaluation: counters[s],
                     best_so_far: bests[s].is_finite().then(|| self.fraction_of(bests[s])),
                     quantile: None,
+                    rods: self.space.length.is_some(),
                 }
             })
             .collect();
@@ -55,6 +56,8 @@ struct TrialRow<'a> {
     evaluation: i64,
     best_so_far: Option<f64>,
     quantile: Option<f64>,
+    /// Whether the design places rods: the table then has their `length` (m).
+    rods: bool,
 }
 
 impl Row for TrialRow<'_> {
@@ -62,7 +65,7 @@ impl Row for TrialRow<'_> {
         let e = self.trial;
         let ok = e.result.as_ref().ok();
         let last = |pick: fn(&PointData) -> &Vec<f64>| ok.and_then(|p| pick(p).last().copied());
-        vec![
+        let mut cells = vec![
             ("search", e.search.label().into()),
             ("search_index", Cell::from(self.search_index as i64)),
             ("evaluation", Cell::from(self.evaluation)),
@@ -95,6 +98,12 @@ impl Row for TrialRow<'_> {
                 "scene_key",
                 (!e.key.is_empty()).then(|| e.key.clone()).into(),
             ),
-        ]
+        ];
+        if self.rods {
+            let lengths = e.layout.resonators.iter();
+            let metres = lengths.map(|r| r.length.unwrap_or(f64::NAN)).collect();
+            cells.insert(5, ("length", Cell::F64List(metres)));
+        }
+        cells
     }
 }
