@@ -305,13 +305,19 @@ fn damping_json(damping: &Damping) -> Value {
         law,
         ground,
         resonator,
+        contacts,
     } = damping;
-    json!({
+    let mut damping = json!({
         "contact": contact,
         "law": law.name(),
         "ground": ground,
         "resonators": resonator,
-    })
+    });
+    // Per-contact dashpots joined the key after the rest: a chain without them keeps its key.
+    if let Some(each) = contacts {
+        damping["contacts"] = json!(each);
+    }
+    damping
 }
 
 #[cfg(test)]

@@ -24,6 +24,7 @@ wall_contact = 1.2
 sites = [3, 6]
 mass = [1.0, 0.5]
 contact = 1.1
+damping = 0.02
 [impulse]
 site = -8
 velocity = 1.2
@@ -86,6 +87,7 @@ boundary = { left = "free" }
 mass = 2.0
 velocity = 0.8
 contact = 1.5
+damping = 0.01
 [[defect]]
 site = 0
 eps = 1.0
@@ -116,6 +118,7 @@ rod = {{ length = 0.020, diameter = 0.005 }}
 [striker]
 velocity = 1.98
 sphere = {{ diameter = 0.010, material = {{ youngs_modulus = 70e9, poisson_ratio = 0.23, density = 2500.0 }} }}
+restitution = {{ e = 0.8, velocity = "1.2 m/s" }}
 [[defect]]
 site = 0
 rod = {{ length = 0.040, diameter = 0.006, material = {MATERIAL} }}
@@ -137,6 +140,9 @@ site = -10
 contact = 2.47e9
 mass = 0.866e-3
 velocity = 1.98
+[[segment]]
+sites = [1, 3]
+restitution = { e = 0.95, velocity = "0.5 m/s" }
 [[defect]]
 site = 0
 mass = 0.838e-3

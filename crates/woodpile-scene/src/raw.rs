@@ -71,6 +71,10 @@ pub(crate) struct Segment {
     pub mass: Option<toml::Value>,
     /// A number, or a list repeated from the segment's first contact.
     pub contact: Option<toml::Value>,
+    /// γ of the contacts between its sites, instead of `[damping] contact`.
+    pub damping: Option<f64>,
+    /// Or γ calibrated so that the segment's first two sites part with this e.
+    pub restitution: Option<Restitution>,
 }
 
 /// A body that strikes the first site, instead of `[impulse]`.
@@ -82,6 +86,10 @@ pub(crate) struct Striker {
     pub contact: Option<f64>,
     /// SI scenes: a sphere whose Hertz coefficient against the first rod is derived.
     pub sphere: Option<Sphere>,
+    /// γ of its contact with the first site, instead of `[damping] contact`.
+    pub damping: Option<f64>,
+    /// Or γ calibrated so that it and the first site part with this e.
+    pub restitution: Option<Restitution>,
 }
 
 /// A spherical striker of an SI scene.

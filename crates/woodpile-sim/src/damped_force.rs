@@ -123,8 +123,8 @@ impl Model {
         // At c = 0 the dashpot already acts: a contact closing from touching (an impulse
         // given to a site beside one at rest) feels γ ċ from its first instant.
         let total = match self.damping() {
-            Some(d) if d.contact > 0.0 && c >= 0.0 => {
-                (elastic + d.law.force(d.contact, c, rate)).max(0.0)
+            Some(d) if d.contact_at(bond) > 0.0 && c >= 0.0 => {
+                (elastic + d.law.force(d.contact_at(bond), c, rate)).max(0.0)
             }
             _ => elastic,
         };
@@ -183,7 +183,7 @@ impl Model {
             let inv_pair = self.inv_mass()[r.site] + 1.0 / r.eps;
             rates.push((Dissipator::Resonator(j), d.resonator(j) * inv_pair));
         }
-        if d.contact > 0.0 {
+        if d.has_contact_dashpot() {
             for bond in 0..=n {
                 let pair = inv(bond.checked_sub(1)) + inv((bond < n).then_some(bond));
                 let overlap = match self.contacts() {
@@ -192,7 +192,7 @@ impl Model {
                 };
                 rates.push((
                     Dissipator::Contact,
-                    d.law.force(d.contact, overlap, 1.0) * pair,
+                    d.law.force(d.contact_at(bond), overlap, 1.0) * pair,
                 ));
             }
         }

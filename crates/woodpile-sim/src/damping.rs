@@ -56,6 +56,9 @@ pub struct Damping {
     pub ground: f64,
     /// c_j, one per resonator in the model's order.
     pub resonator: Vec<f64>,
+    /// γ_b of each bond (walls included, the bond numbering of [`crate::contact`]) where a
+    /// segment or the striker gives its own dashpot; `None`: every contact has `contact`.
+    pub contacts: Option<Vec<f64>>,
 }
 
 impl Damping {
@@ -78,12 +81,42 @@ impl Damping {
             law,
             ground,
             resonator,
+            contacts: None,
         })
+    }
+
+    /// The same damping with each bond's own γ_b (`contacts[b]`, walls included), each finite
+    /// and ≥ 0: what segments and a striker with their own dashpots give.
+    pub fn with_contacts(self, contacts: Vec<f64>) -> Result<Damping, ModelError> {
+        for (b, &c) in contacts.iter().enumerate() {
+            non_negative(&format!("contact {b} damping"), c)?;
+        }
+        Ok(Damping {
+            contacts: Some(contacts),
+            ..self
+        })
+    }
+
+    /// γ of bond `bond`: its own, or every contact's.
+    #[inline(always)]
+    pub fn contact_at(&self, bond: usize) -> f64 {
+        match &self.contacts {
+            Some(each) => each[bond],
+            None => self.contact,
+        }
+    }
+
+    /// Whether any contact has a dashpot.
+    pub fn has_contact_dashpot(&self) -> bool {
+        match &self.contacts {
+            Some(each) => each.iter().any(|&c| c > 0.0),
+            None => self.contact > 0.0,
+        }
     }
 
     /// Whether any coefficient is non-zero: a model with none keeps the conservative path.
     pub fn dissipates(&self) -> bool {
-        self.contact > 0.0 || self.ground > 0.0 || self.resonator.iter().any(|&c| c > 0.0)
+        self.has_contact_dashpot() || self.ground > 0.0 || self.resonator.iter().any(|&c| c > 0.0)
     }
 
     /// The resonator `j`'s dashpot (0 when none was given).

@@ -94,7 +94,7 @@ fn bonds(model: &Model, overlaps: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Spectr
         // The dashpot's force per unit closing rate at the static overlap.
         let damping = model
             .damping()
-            .map_or(0.0, |d| d.law.force(d.contact, delta, 1.0));
+            .map_or(0.0, |d| d.law.force(d.contact_at(bond), delta, 1.0));
         match delta > 0.0 {
             true => (stiffness, damping),
             false => (0.0, 0.0),

@@ -210,7 +210,7 @@ fn model(file: &raw::SceneFile, layout: &chain::Layout, si: Option<&Si>) -> Resu
         .striker
         .as_ref()
         .map(|_| (sites.masses[0], sites.contacts[1]));
-    let dissipation = damping::damping(file, &resonators, &sites.masses, si)?;
+    let dissipation = damping::damping(file, &resonators, (&sites, layout), si)?;
     let model = Model::with_masses(layout.n_sites(), boundary, resonators, Some(sites.masses))
         .map_err(|e| invalid("defect", e.to_string()))?;
     let mut model = match law {

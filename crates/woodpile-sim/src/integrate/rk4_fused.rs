@@ -95,7 +95,7 @@ const LATE: f64 = 1e-8;
 /// Whether `rk4-contact` ends its steps at force switches: on a chain whose contacts carry a
 /// dashpot.
 fn locates_switches(model: &Model, scratch: &FixedStepScratch<4>) -> bool {
-    scratch.contact.is_some() && model.damping().is_some_and(|d| d.contact > 0.0)
+    scratch.contact.is_some() && model.damping().is_some_and(|d| d.has_contact_dashpot())
 }
 
 impl Rk4Fused {

@@ -121,6 +121,14 @@ impl Model {
                 n_resonators: self.resonators.len(),
             });
         }
+        if let Some(each) = &damping.contacts {
+            if each.len() != self.n_sites + 1 {
+                return Err(ModelError::BondCount {
+                    n_bonds: each.len(),
+                    n_sites: self.n_sites,
+                });
+            }
+        }
         if damping.dissipates() {
             self.damping = Some(Box::new(damping));
             self.dissipative = true;

@@ -73,7 +73,7 @@ pub fn forecast(scenario: &Scenario) -> Option<Forecast> {
         // The coarse run once, then fine runs at dt, dt/2, ...: 0.5 + (2^rungs - 1) first-rung
         // fine runs of the first rung's 1.5.
         whole_ladder_s: rung / 1.5 * (0.5 + 2f64.powf(rungs) - 1.0),
-        halvings_likely: model.damping().is_some_and(|d| d.contact > 0.0),
+        halvings_likely: model.damping().is_some_and(|d| d.has_contact_dashpot()),
     })
 }
 
