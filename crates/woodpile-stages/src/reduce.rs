@@ -10,6 +10,10 @@
 //! over = ["eps"]             #   searching over these axes
 //! ```
 //!
+//! Over a sweep of `[physical]` scenes `at` may carry a unit, `at = "0.5 ms"` (s, ms, us or
+//! µs, ns): it is converted with the sweep's time scale, which all its points must share (an
+//! axis over the impact velocity or the masses moves it; read such a sweep in scaled time).
+//!
 //! Because sweeps keep time series, changing `at` re-runs this stage only, never a simulation.
 
 use serde_json::json;
@@ -30,6 +34,9 @@ use woodpile_sim::{Share, ShareSet};
 pub struct Reduce {
     /// Read-out time; `None` means each point's last sample.
     pub at: Option<f64>,
+    /// A read-out time with a unit (`at = "0.5 ms"`), in seconds: converted with the input
+    /// sweep's time scale when the stage runs (its points must share one).
+    pub at_seconds: Option<f64>,
     /// Optional maximisation.
     pub maximize: Option<Maximize>,
 }
@@ -45,8 +52,27 @@ pub struct Maximize {
 
 impl Reduce {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Reduce> {
-        let at: Option<f64> = fields.optional("at")?;
-        if at.is_some_and(|t| t < 0.0) {
+        let (at, at_seconds) = match fields.take("at") {
+            None => (None, None),
+            Some(toml::Value::String(text)) => {
+                let seconds =
+                    woodpile_scene::seconds(&text).map_err(|reason| fields.error("at", reason))?;
+                (None, Some(seconds))
+            }
+            Some(value) => {
+                let t = value
+                    .as_float()
+                    .or_else(|| value.as_integer().map(|i| i as f64))
+                    .ok_or_else(|| {
+                        fields.error(
+                            "at",
+                            "expected a time: a number (scaled) or text such as \"0.5 ms\"",
+                        )
+                    })?;
+                (Some(t), None)
+            }
+        };
+        if at.or(at_seconds).is_some_and(|t| t < 0.0) {
             return Err(fields.error("at", "the read-out time must be >= 0"));
         }
         let maximize = match fields.optional::<toml::Table>("maximize")? {
@@ -62,7 +88,11 @@ impl Reduce {
                 Some(Maximize { column, over })
             }
         };
-        Ok(Reduce { at, maximize })
+        Ok(Reduce {
+            at,
+            at_seconds,
+            maximize,
+        })
     }
 
     /// Checks the names in `maximize.over` against the input sweep's axes.
@@ -83,11 +113,11 @@ impl Reduce {
         &self,
         stage: &str,
         input: &polars::prelude::DataFrame,
-        axes: &[Axis],
+        (axes, at): (&[Axis], Option<f64>),
     ) -> Result<Output> {
         let sweep = SweepRows::read(input, axes)?;
         let picks = sweep
-            .read_out(self.at)
+            .read_out(at)
             .map_err(|r| PipelineError::stage(stage, r))?;
         let rows: Vec<Pick> = match &self.maximize {
             None => picks,
@@ -101,9 +131,33 @@ impl Reduce {
         let failed: usize = rows.iter().map(|p| p.failed).sum();
         Ok(Output::table(
             rows_frame(&reduced)?,
-            json!({"rows": rows.len(), "failed_points": failed, "at": self.at}),
+            json!({"rows": rows.len(), "failed_points": failed, "at": at}),
         ))
     }
+}
+
+/// `seconds` in the sweep's scaled time: every point of a physical sweep must share one time
+/// scale (an axis that moves the impact velocity or the masses moves it, and each point's
+/// samples are then at other seconds: read such a sweep at a scaled time).
+fn scaled_at(seconds: f64, sweep: &Sweep) -> std::result::Result<f64, String> {
+    let mut scale: Option<f64> = None;
+    for point in 0..sweep.count() {
+        let scene = sweep.scene_at(point).map_err(|e| e.to_string())?;
+        let Some(physical) = scene.physical else {
+            return Err("a time with a unit needs a sweep of [physical] scenes; give a number in scaled time".into());
+        };
+        let here = physical.scales.time_s();
+        match scale {
+            Some(s) if s != here => {
+                return Err(format!(
+                    "the sweep's points have different time scales ({s:e} s and {here:e} s at point {point}): give `at` in scaled time"
+                ))
+            }
+            _ => scale = Some(here),
+        }
+    }
+    let scale = scale.ok_or("the sweep has no points")?;
+    Ok(seconds / scale)
 }
 
 /// An output row: a point (or the best of a group) read out at the time.
@@ -369,11 +423,17 @@ impl Kind for Reduce {
         let input = &ctx.stage.inputs[0];
         let frame = ctx.input(input)?;
         let upstream = ctx.upstream(input)?;
-        let axes = &upstream
+        let sweep = upstream
             .get::<Sweep>()
-            .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?
-            .axes;
-        let mut output = self.compute(ctx.name(), &frame, axes)?;
+            .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?;
+        let at = match self.at_seconds {
+            None => self.at,
+            Some(seconds) => Some(
+                scaled_at(seconds, sweep)
+                    .map_err(|reason| PipelineError::stage(ctx.name(), format!("at: {reason}")))?,
+            ),
+        };
+        let mut output = self.compute(ctx.name(), &frame, (&sweep.axes, at))?;
         // The sweep's scene, grid and tolerance, so the table explains itself without its input.
         let params = &upstream.params;
         output.summary["input"] = json!({
