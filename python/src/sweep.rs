@@ -39,7 +39,7 @@ use crate::SceneError;
 /// written to that point store. Ctrl-C raises `KeyboardInterrupt` whose `partial` holds the
 /// table of the points finished so far.
 #[pyfunction]
-#[pyo3(signature = (scene, axes, series = None, cache = None, progress = None))]
+#[pyo3(signature = (scene, axes, series = None, cache = None, progress = None, units = "scaled"))]
 pub(crate) fn sweep<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -47,6 +47,7 @@ pub(crate) fn sweep<'py>(
     series: Option<&Bound<'py, PyAny>>,
     cache: Option<PathBuf>,
     progress: Option<Py<PyAny>>,
+    units: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let kind = match series {
         Some(value) => series::parse(value, true)?,
@@ -57,6 +58,9 @@ pub(crate) fn sweep<'py>(
     // A bad template fails at once, not as a column of failures: the grid's corners exercise
     // every axis's extremes, as a sweep stage checks them.
     let first = grid.scene_at(0).map_err(SceneError::new_err)?;
+    let units = Units::parse(units)
+        .and_then(|u| SiFactors::of(&first, u).map(|_| u))
+        .map_err(|reason| SceneError::new_err(format!("{}: units: {reason}", grid.label)))?;
     let last = grid.scene_at(count - 1).map_err(SceneError::new_err)?;
     woodpile_scene::grid::check_sweep_memory(count, &last)
         .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
@@ -70,6 +74,7 @@ pub(crate) fn sweep<'py>(
         every_sample: kind.is_some(),
         store: store.as_ref(),
         done: AtomicUsize::new(0),
+        units,
     };
     let shape = SweepShape {
         axes: &grid.axes,
@@ -77,6 +82,7 @@ pub(crate) fn sweep<'py>(
             striker: first.scenario.region.has_striker(),
             dissipative: grid.template.declares_dissipation(),
         },
+        kinetic: kind == Some(Shares::Kinetic),
     };
     run.table(py, count, shape, progress.as_ref())
 }
@@ -158,6 +164,8 @@ struct Run<'a> {
     store: Option<&'a PointStore>,
     /// Points finished so far, for the progress line.
     done: AtomicUsize,
+    /// The table's units: each point's own SI factors convert it.
+    units: Units,
 }
 
 impl Run<'_> {
@@ -223,9 +231,20 @@ impl Run<'_> {
                 values,
                 key,
                 result,
+                si: self.si_of(*index),
             })
             .collect();
         table_dict(py, &shape.rows(&points))
+    }
+
+    /// Point `index`'s SI factors, when the table is asked in SI (checked on the first point
+    /// before the run: every point of the grid is a physical scene).
+    fn si_of(&self, index: usize) -> Option<SiFactors> {
+        if self.units == Units::Scaled {
+            return None;
+        }
+        let scene = self.grid.scene_at(index).ok()?;
+        SiFactors::of(&scene, self.units).ok().flatten()
     }
 
     /// Points `indices`, together: as [`Run::point`] makes each. A panic in the core makes

@@ -238,3 +238,26 @@ def test_neighbouring_points_in_lanes_match_simulate():
         row = table.iloc[k]
         assert (row["R"], row["T"], row["E_tr"]) == (alone.R, alone.T, alone.E_tr)
         assert (many["R"][k], many["T"][k], many["E_tr"][k]) == (alone.R, alone.T, alone.E_tr)
+
+
+def test_a_physical_sweep_in_si_is_the_scaled_one_times_each_points_scales():
+    """``units="SI"``: t, dt and end_reached_at in s and E in J, each point by its own scales
+    (the impact velocity is an axis here, so they differ), the shares as they were."""
+    scene = {
+        "chain": {"sites": [-10, 9], "boundary": "free"},
+        "impulse": {"site": -10},
+        "physical": {"contact": 2.47e9, "mass": 0.866e-3, "velocity": "$V"},
+        "run": {"t_end": 30.0, "tolerance": 1e-6},
+    }
+    axes = {"V": [0.5, 2.0]}
+    scaled = woodpile.sweep(scene, axes)
+    si = woodpile.sweep(scene, axes, units="SI")
+    for (_, a), (_, b) in zip(scaled.iterrows(), si.iterrows()):
+        one = woodpile.simulate({**scene, "physical": {**scene["physical"], "velocity": a["V"]}})
+        time_s = one.physical["time_scale_s"]
+        assert b["t"] == pytest.approx(a["t"] * time_s, rel=1e-12)
+        assert b["R"] == a["R"] and b["T"] == a["T"]
+        energy_j = 0.866e-3 * a["V"] ** 2
+        assert b["E"] == pytest.approx(a["E"] * energy_j, rel=1e-12)
+    with pytest.raises(woodpile.SceneError, match="units"):
+        woodpile.sweep({"defect": [{"site": 0, "eps": "$eps"}]}, {"eps": [1.0]}, units="SI")

@@ -26,6 +26,7 @@ def sweep(
     series: Union[bool, str] = False,
     cache: Optional[str] = None,
     progress: Optional[Callable[[int, int], None]] = None,
+    units: str = "scaled",
 ) -> Dict[str, Any]: ...
 def simulate_many(
     scenes: Sequence[Scene],

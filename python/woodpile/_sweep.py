@@ -25,6 +25,7 @@ def sweep(
     series: Union[bool, str] = False,
     cache: Optional[Union[str, "os.PathLike[str]"]] = None,
     progress: Optional[bool] = None,
+    units: str = "scaled",
 ) -> pd.DataFrame:
     """Simulate every point of a grid of scenes, on all cores, and return one table.
 
@@ -50,6 +51,9 @@ def sweep(
         progress: a line on stderr with the points done, the rate and the time left:
             ``True`` always, ``False`` never, ``None`` (the default) in a terminal or a
             notebook once the sweep has run two seconds.
+        units: ``"scaled"`` (the model's units, as a sweep stage writes them) or ``"SI"``
+            for a grid of ``[physical]`` scenes: ``t``, ``dt`` and ``end_reached_at`` in s and
+            ``E`` in J (a kinetic series' ``E`` stays a share), each point by its own scales.
 
     Returns:
         A DataFrame with a sweep stage's columns: ``point``, the axes (integer axes as
@@ -71,7 +75,7 @@ def sweep(
     path = None if cache is None else os.fspath(cache)
     bar = Progress("sweep", progress)
     try:
-        return _frame(_core.sweep(scene, dict(axes), series, path, bar.points))
+        return _frame(_core.sweep(scene, dict(axes), series, path, bar.points, units))
     except KeyboardInterrupt as stopped:
         partial = getattr(stopped, "partial", None)
         if isinstance(partial, dict):

@@ -7,6 +7,7 @@
 //! code.
 
 use woodpile_scene::grid::{Axis, AxisValue};
+use woodpile_scene::units_out::SiFactors;
 use woodpile_sim::ShareSet;
 
 use crate::canonical::Key;
@@ -147,6 +148,9 @@ pub struct SweepShape<'a> {
     /// Its shares: `S` when its scenes have a striker, `D` on every row when its scene
     /// declares dissipation.
     pub shares: ShareSet,
+    /// Whether `E` is the kinetic share of the impact energy (a kinetic series), which has
+    /// no unit, rather than an energy.
+    pub kinetic: bool,
 }
 
 /// One point of a sweep, as its rows need it.
@@ -160,6 +164,9 @@ pub struct SweepPoint<'a> {
     pub key: &'a Key,
     /// Its series, or why it failed.
     pub result: &'a PointResult,
+    /// Its SI factors, when the table is asked in SI: `t`, `dt` and `end_reached_at` in s,
+    /// `E` in J.
+    pub si: Option<SiFactors>,
 }
 
 impl<'a> SweepShape<'a> {
@@ -200,15 +207,21 @@ impl Row for SweepRow<'_> {
         }
         let ok = self.point.result.as_ref().ok();
         let at = |series: fn(&PointData) -> &Vec<f64>| ok.map(|p| series(p)[self.sample]);
-        cells.push((sweep::TIME, at(|p| &p.t).into()));
+        // Scaled units multiply by 1, which leaves every bit as it was.
+        let (time, energy) = match self.point.si {
+            Some(f) if self.shape.kinetic => (f.time_s, 1.0),
+            Some(f) => (f.time_s, f.energy_j),
+            None => (1.0, 1.0),
+        };
+        cells.push((sweep::TIME, at(|p| &p.t).map(|t| t * time).into()));
         for share in self.shape.shares.iter() {
             let value = ok.and_then(|p| p.share_at(share, self.sample));
             cells.push((share.name(), value.into()));
         }
         cells.extend([
-            (sweep::ENERGY, at(|p| &p.energy).into()),
+            (sweep::ENERGY, at(|p| &p.energy).map(|e| e * energy).into()),
             (sweep::METHOD, ok.map(|p| p.method.clone()).into()),
-            (sweep::DT, ok.and_then(|p| p.dt).into()),
+            (sweep::DT, ok.and_then(|p| p.dt).map(|dt| dt * time).into()),
             (sweep::STEPS, ok.map(|p| p.steps as i64).into()),
             (
                 sweep::ERROR_ESTIMATE,
@@ -217,7 +230,7 @@ impl Row for SweepRow<'_> {
             (sweep::ENERGY_DRIFT, ok.and_then(|p| p.energy_drift).into()),
             (
                 sweep::END_REACHED_AT,
-                ok.and_then(|p| p.end_reached_at).into(),
+                ok.and_then(|p| p.end_reached_at).map(|t| t * time).into(),
             ),
             (
                 sweep::FAILURE,

@@ -233,6 +233,7 @@ impl Sweep {
                 values,
                 key,
                 result,
+                si: None,
             })
             .collect();
         rows_frame(&self.shape().rows(&points))
@@ -243,6 +244,7 @@ impl Sweep {
         SweepShape {
             axes: &self.axes,
             shares: self.shares,
+            kinetic: self.series == Shares::Kinetic,
         }
     }
 }
