@@ -93,6 +93,9 @@ def calibrate(
     sigma: Optional[np.ndarray] = None
     if "sigma" in frame.columns:
         sigma = frame["sigma"].to_numpy(dtype=float)
+    rods = frame["rod"].to_numpy(dtype=float)
+    if not np.all(np.isfinite(rods) & (rods == np.round(rods))):
+        raise _core.SceneError("calibrate: column 'rod' holds a value that is not a whole paper site")
     asked = [_parameter(key, bounds) for key, bounds in parameters.items()]
     raw = _core.calibrate(
         scene,

@@ -16,6 +16,9 @@ pub struct Bounds {
     pub min: f64,
     /// Greatest value.
     pub max: f64,
+    /// The forward difference's step, when the parameter's size is not its value (a
+    /// logarithm near 0 stands for a value near 1); `None`: [`STEP`] of its value.
+    pub step: Option<f64>,
 }
 
 impl Bounds {
@@ -165,7 +168,8 @@ where
 {
     let mut columns = Vec::with_capacity(x.len());
     for i in 0..x.len() {
-        let mut h = STEP * x[i].abs().max(1e-3 * (bounds[i].max - bounds[i].min).abs());
+        let relative = STEP * x[i].abs().max(1e-3 * (bounds[i].max - bounds[i].min).abs());
+        let mut h = bounds[i].step.unwrap_or(relative);
         if x[i] + h > bounds[i].max {
             h = -h;
         }
@@ -259,8 +263,13 @@ mod tests {
             Bounds {
                 min: 0.0,
                 max: 10.0,
+                step: None,
             },
-            Bounds { min: 0.0, max: 5.0 },
+            Bounds {
+                min: 0.0,
+                max: 5.0,
+                step: None,
+            },
         ];
         let fit = least_squares(model, &[1.0, 2.0], &bounds).unwrap();
         assert!((fit.params[0] - 2.5).abs() < 1e-6, "{fit:?}");
@@ -288,6 +297,7 @@ mod tests {
         let wide = [Bounds {
             min: -10.0,
             max: 10.0,
+            step: None,
         }; 2];
         let fit = least_squares(model, &[0.0, 0.0], &wide).unwrap();
         let mean = x.iter().sum::<f64>() / 20.0;
@@ -301,8 +311,13 @@ mod tests {
             Bounds {
                 min: -10.0,
                 max: 10.0,
+                step: None,
             },
-            Bounds { min: 0.0, max: 0.4 },
+            Bounds {
+                min: 0.0,
+                max: 0.4,
+                step: None,
+            },
         ];
         let held = least_squares(model, &[0.0, 0.0], &narrow).unwrap();
         assert_eq!(held.params[1], 0.4);

@@ -188,6 +188,8 @@ impl<'a> Problem<'a> {
             .map(|(p, scale)| Bounds {
                 min: scale.to_fit(p.min),
                 max: scale.to_fit(p.max),
+                // A logarithm's size is not its value: step it by a relative STEP of the value.
+                step: (*scale == Scale::Log).then_some(woodpile_analysis::least_squares::STEP),
             })
             .collect()
     }

@@ -57,20 +57,34 @@ impl Trace {
         (lo, hi)
     }
 
-    /// The smallest positive spacing of distinct times: the simulation samples this often, so
-    /// every measured time lies between two samples no further apart than the probe's own.
+    /// The probe's spacing: the smallest gap between distinct times of one rod (rods may be
+    /// recorded at offset times, whose gaps across rods say nothing of the probe). The
+    /// simulation samples a fraction of it ([`crate::prediction`]).
     pub fn spacing(&self) -> f64 {
-        let mut times = self.t.clone();
-        times.sort_by(f64::total_cmp);
-        times.dedup();
-        let smallest = times
-            .windows(2)
-            .map(|w| w[1] - w[0])
-            .fold(f64::INFINITY, f64::min);
+        let (lo, hi) = self.rods();
+        let mut smallest = f64::INFINITY;
+        for rod in lo..=hi {
+            let mut times: Vec<f64> = (0..self.t.len())
+                .filter(|&i| self.rod[i] == rod)
+                .map(|i| self.t[i])
+                .collect();
+            times.sort_by(f64::total_cmp);
+            times.dedup();
+            let gap = times
+                .windows(2)
+                .map(|w| w[1] - w[0])
+                .fold(f64::INFINITY, f64::min);
+            smallest = smallest.min(gap);
+        }
         match smallest.is_finite() {
             true => smallest,
-            // One time only: sample at it.
-            false => times[0].max(f64::MIN_POSITIVE),
+            // One time a rod: sample at the earliest.
+            false => self
+                .t
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min)
+                .max(f64::MIN_POSITIVE),
         }
     }
 

@@ -55,7 +55,12 @@ impl Calibrate {
             let bounds = value.as_table().ok_or_else(|| {
                 fields.error(&field, "expected { min, max } or { min, max, start }")
             })?;
-            let number = |name: &str| bounds.get(name).and_then(toml::Value::as_float);
+            let number = |name: &str| {
+                let value = bounds.get(name)?;
+                value
+                    .as_float()
+                    .or_else(|| value.as_integer().map(|i| i as f64))
+            };
             let (Some(min), Some(max)) = (number("min"), number("max")) else {
                 return Err(fields.error(&field, "expected { min, max } (numbers)"));
             };
