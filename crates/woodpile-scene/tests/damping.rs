@@ -6,15 +6,10 @@ mod common;
 
 use std::path::Path;
 
-use common::invalid_key;
+use common::{invalid_key, scene};
 
-use woodpile_scene::Scene;
 use woodpile_sim::model::End;
 use woodpile_sim::DashpotLaw;
-
-fn scene(toml: &str) -> Scene {
-    woodpile_scene::parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
 
 const DAMPED: &str = r#"
 [chain]

@@ -5,19 +5,12 @@
 
 mod common;
 
-use std::path::Path;
+use common::{invalid_key, scene};
 
-use common::invalid_key;
-
-use woodpile_scene::Scene;
 use woodpile_sim::energy::{total_energy, total_momentum};
 use woodpile_sim::integrate::{Accuracy, Method, MethodChoice, Plan};
 use woodpile_sim::observe::SiteField;
 use woodpile_sim::simulation::simulate;
-
-fn scene(toml: &str) -> Scene {
-    woodpile_scene::parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
 
 fn fixed(dt: f64) -> Accuracy {
     Accuracy {

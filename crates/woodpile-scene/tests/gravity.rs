@@ -3,15 +3,8 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::invalid_key;
-use woodpile_scene::Scene;
+use common::{invalid_key, scene};
 use woodpile_sim::simulation::simulate;
-
-fn scene(toml: &str) -> Scene {
-    woodpile_scene::parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// A scaled chain -10..9 standing on a wall in gravity 0.01, a dimer of masses 1 and 2, two
 /// linear resonators, struck on its top site with `velocity`.

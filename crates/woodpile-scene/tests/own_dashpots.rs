@@ -7,16 +7,9 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::invalid_key;
+use common::{invalid_key, parting_restitution, scene};
 use woodpile_scene::Scene;
-use woodpile_sim::observe::SiteField;
 use woodpile_sim::simulation::simulate;
-
-fn scene(toml: &str) -> Scene {
-    woodpile_scene::parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
 
 /// A striker of mass 3 hitting a free site of mass 1 through a contact of 2 at `v`: e from
 /// their velocities once apart, (v1 − v0) / v. (The site's neighbour is held off by a contact
@@ -48,11 +41,7 @@ sample_every = {t_end:?}
     ));
     let d = s.scenario.model.damping().unwrap();
     assert_eq!(d.contact_at(0), 0.0, "the wall keeps [damping] contact");
-    let mut field = SiteField::new(&s.scenario.model, 0, 1);
-    simulate(&s.scenario, &mut field).unwrap();
-    let last = field.t.len() - 1;
-    let (v0, v1) = (field.velocity[2 * last], field.velocity[2 * last + 1]);
-    (v1 - v0) / v
+    parting_restitution(&s, v)
 }
 
 #[test]

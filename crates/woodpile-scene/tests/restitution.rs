@@ -7,14 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::invalid_key;
-use woodpile_scene::Scene;
-use woodpile_sim::observe::SiteField;
-use woodpile_sim::simulation::simulate;
-
-fn scene(toml: &str) -> Scene {
-    woodpile_scene::parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
-}
+use common::{invalid_key, parting_restitution, scene};
 
 /// Two free sites, the first struck at `v`, run past their parting; e from their velocities
 /// at the end: (v1 − v0) / v.
@@ -40,11 +33,7 @@ sample_every = {t_end:?}
         t_end = 40.0 * v.powf(-0.2),
         dt = 1e-4 * v.powf(-0.2),
     ));
-    let mut field = SiteField::new(&s.scenario.model, 0, 1);
-    simulate(&s.scenario, &mut field).unwrap();
-    let last = field.t.len() - 1;
-    let (v0, v1) = (field.velocity[2 * last], field.velocity[2 * last + 1]);
-    (v1 - v0) / v
+    parting_restitution(&s, v)
 }
 
 #[test]

@@ -3,7 +3,25 @@
 
 use std::path::Path;
 
-use woodpile_scene::{parse, SceneError};
+use woodpile_scene::{parse, Scene, SceneError};
+use woodpile_sim::observe::SiteField;
+use woodpile_sim::simulation::simulate;
+
+/// The scene `toml` (named `test.toml` in messages), which must resolve.
+pub fn scene(toml: &str) -> Scene {
+    parse(toml, Path::new("test.toml")).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The restitution two bodies part with, the first two of `scene`'s chain (internal sites 0
+/// and 1, a striker and the first rod where there is one) after the first struck at `v`:
+/// (v1 − v0) / v from their velocities at the end of the run.
+pub fn parting_restitution(scene: &Scene, v: f64) -> f64 {
+    let mut field = SiteField::new(&scene.scenario.model, 0, 1);
+    simulate(&scene.scenario, &mut field).unwrap();
+    let last = field.t.len() - 1;
+    let (v0, v1) = (field.velocity[2 * last], field.velocity[2 * last + 1]);
+    (v1 - v0) / v
+}
 
 /// The key a scene file `text` is refused for (it must be refused for an invalid key).
 pub fn invalid_key(text: &str) -> String {
