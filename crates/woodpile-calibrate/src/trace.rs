@@ -61,21 +61,19 @@ impl Trace {
     /// recorded at offset times, whose gaps across rods say nothing of the probe). The
     /// simulation samples a fraction of it ([`crate::prediction`]).
     pub fn spacing(&self) -> f64 {
-        let (lo, hi) = self.rods();
-        let mut smallest = f64::INFINITY;
-        for rod in lo..=hi {
-            let mut times: Vec<f64> = (0..self.t.len())
-                .filter(|&i| self.rod[i] == rod)
-                .map(|i| self.t[i])
-                .collect();
-            times.sort_by(f64::total_cmp);
-            times.dedup();
-            let gap = times
-                .windows(2)
-                .map(|w| w[1] - w[0])
-                .fold(f64::INFINITY, f64::min);
-            smallest = smallest.min(gap);
-        }
+        // Every row as (rod, time), sorted once: a rod's gaps are then its neighbours'.
+        let mut rows: Vec<(i64, f64)> = self
+            .rod
+            .iter()
+            .copied()
+            .zip(self.t.iter().copied())
+            .collect();
+        rows.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let smallest = rows
+            .windows(2)
+            .filter(|w| w[0].0 == w[1].0 && w[1].1 > w[0].1)
+            .map(|w| w[1].1 - w[0].1)
+            .fold(f64::INFINITY, f64::min);
         match smallest.is_finite() {
             true => smallest,
             // One time a rod: sample at the earliest.
@@ -99,5 +97,31 @@ impl Trace {
             Some(sigma) => sigma.iter().map(|s| 1.0 / s).collect(),
             None => vec![1.0; self.t.len()],
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two rods recorded every 2 µs, one 1 ns after the other: the probe's spacing is 2 µs,
+    /// not the nanosecond between the rods.
+    #[test]
+    fn the_spacing_is_one_rods_own() {
+        let t: Vec<f64> = (1..=5)
+            .flat_map(|k| [k as f64 * 2e-6, k as f64 * 2e-6 + 1e-9])
+            .collect();
+        let rod = (0..10).map(|i| i % 2).collect();
+        let trace = Trace {
+            velocity: vec![0.0; t.len()],
+            t,
+            rod,
+            sigma: None,
+        };
+        assert!(
+            (trace.spacing() - 2e-6).abs() < 1e-15,
+            "{}",
+            trace.spacing()
+        );
     }
 }
