@@ -27,12 +27,13 @@ pub mod spectrum;
 pub mod stability;
 pub mod sweep;
 pub mod table;
+mod table_units;
 pub mod vary;
 pub mod workprecision;
 
 /// Every kind, in pipeline order: its name in stage files, and its parser.
 pub static KINDS: &Registry = &[
-    ("sweep", |f, _| Ok(Arc::new(sweep::Sweep::parse(f)?))),
+    ("sweep", |f, _| Ok(Arc::new(sweep::Sweep::parse_stage(f)?))),
     ("spacetime", |f, _| {
         Ok(Arc::new(spacetime::SpaceTime::parse(f)?))
     }),

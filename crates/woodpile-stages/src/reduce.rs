@@ -11,8 +11,10 @@
 //! ```
 //!
 //! Over a sweep of `[physical]` scenes `at` may carry a unit, `at = "0.5 ms"` (s, ms, us or
-//! µs, ns): it is converted with the sweep's time scale, which all its points must share (an
-//! axis over the impact velocity or the masses moves it; read such a sweep in scaled time).
+//! µs, ns). Over a sweep with `units = "SI"` it is read in each point's own seconds, and a bare
+//! number is refused; over a scaled sweep it is converted with the sweep's time scale, which
+//! all its points must share (an axis over the impact velocity or the masses moves it: read
+//! such a sweep in SI, or in scaled time).
 //!
 //! Because sweeps keep time series, changing `at` re-runs this stage only, never a simulation.
 
@@ -27,6 +29,7 @@ use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row};
 use woodpile_pipeline::Output;
+use woodpile_scene::units_out::Units;
 use woodpile_sim::{Share, ShareSet};
 
 /// A parsed reduce stage.
@@ -133,6 +136,22 @@ impl Reduce {
             rows_frame(&reduced)?,
             json!({"rows": rows.len(), "failed_points": failed, "at": at}),
         ))
+    }
+}
+
+impl Reduce {
+    /// The read-out time in the units of `sweep`'s table: seconds as given for an SI table
+    /// (each point's samples are at its own seconds), converted to the scaled time of a
+    /// scaled one; a bare number is scaled time, which an SI table does not have.
+    fn read_at(&self, input: &str, sweep: &Sweep) -> std::result::Result<Option<f64>, String> {
+        match (self.at, self.at_seconds, sweep.units()) {
+            (Some(_), _, Units::Si) => Err(format!(
+                "`{input}` is in SI (units = \"SI\"), so a bare number has no meaning: give the time with a unit, such as \"0.5 ms\""
+            )),
+            (at, None, _) => Ok(at),
+            (_, Some(seconds), Units::Si) => Ok(Some(seconds)),
+            (_, Some(seconds), Units::Scaled) => scaled_at(seconds, sweep).map(Some),
+        }
     }
 }
 
@@ -321,10 +340,16 @@ impl SweepRows {
                     failure: Some(reason.clone()),
                 }
             } else {
+                // A sample within a billionth of the time or of the sampling interval: the
+                // same test in scaled units (intervals near 1) and in seconds (near 1e-6).
+                let interval = match (self.t[start], self.t.get(start + 1).copied().flatten()) {
+                    (Some(first), Some(second)) if end > start + 1 => (second - first).abs(),
+                    _ => 1.0,
+                };
                 let chosen = match at {
                     None => Some(end - 1),
                     Some(t) => (start..end).find(|&i| {
-                        self.t[i].is_some_and(|s| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
+                        self.t[i].is_some_and(|s| (s - t).abs() <= 1e-9 * t.abs().max(interval))
                     }),
                 };
                 let Some(i) = chosen else {
@@ -426,13 +451,9 @@ impl Kind for Reduce {
         let sweep = upstream
             .get::<Sweep>()
             .ok_or_else(|| PipelineError::stage(ctx.name(), format!("`{input}` is not a sweep")))?;
-        let at = match self.at_seconds {
-            None => self.at,
-            Some(seconds) => Some(
-                scaled_at(seconds, sweep)
-                    .map_err(|reason| PipelineError::stage(ctx.name(), format!("at: {reason}")))?,
-            ),
-        };
+        let at = self
+            .read_at(input, sweep)
+            .map_err(|reason| PipelineError::stage(ctx.name(), format!("at: {reason}")))?;
         let mut output = self.compute(ctx.name(), &frame, (&sweep.axes, at))?;
         // The sweep's scene, grid and tolerance, so the table explains itself without its input.
         let params = &upstream.params;

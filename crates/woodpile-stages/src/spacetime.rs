@@ -27,13 +27,14 @@
 
 use rayon::prelude::*;
 use serde_json::json;
-use woodpile_scene::units_out::{SiFactors, Units, SCALED};
+use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::observe::SpaceTimeField;
 use woodpile_sim::simulation::simulate;
 
 use crate::sweep::Sweep;
+use crate::table_units;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::grid::{Axis, AxisValue};
@@ -90,10 +91,7 @@ fn field_size(scene: &Scene, count: usize, sites: [i64; 2]) -> std::result::Resu
 
 impl SpaceTime {
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<SpaceTime> {
-        let units = match fields.optional::<String>("units")? {
-            None => Units::Scaled,
-            Some(name) => Units::parse(&name).map_err(|reason| fields.error("units", reason))?,
-        };
+        let units = table_units::parse(fields)?;
         if let Some(design) = fields.optional::<String>("design")? {
             let table: toml::Table = fields.optional("field")?.unwrap_or_default();
             let mut f = fields.nested("field", table);
@@ -171,14 +169,7 @@ impl SpaceTime {
             "max_error_estimate": max_error_estimate,
         });
         // What a figure may call its axes: seconds and metres per second, or the model's own.
-        let unit = |si: &'static str| match self.units {
-            Units::Si => si,
-            Units::Scaled => SCALED,
-        };
-        summary["column_units"] = json!({ "t": unit("s"), "velocity": unit("m/s") });
-        if self.units == Units::Si {
-            summary["units"] = json!(Units::Si.name());
-        }
+        table_units::declare(&mut summary, self.units, &[("t", "s"), ("velocity", "m/s")]);
         Ok(Output::table(columns.into_frame()?, summary).with_simulated(simulated))
     }
 

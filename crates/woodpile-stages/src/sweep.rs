@@ -14,6 +14,11 @@
 //! eps = "$eps"
 //! ```
 //!
+//! An optional `units = "SI"` (scenes with `[physical]` only) gives the table's times (`t`,
+//! `dt`, `end_reached_at`) in s and its energy `E` in J, each point by its own scales; the
+//! manifest's `column_units` says which units the table is in, and `render` takes its axis
+//! units from it.
+//!
 //! An optional `series = "kinetic"` records kinetic-energy shares divided by the impact energy
 //! (what the woodpile experiment measures, paper Fig. 2 c, f) instead of total-energy fractions;
 //! the columns keep their names (`R`, `T`, `E_tr`, `E`). Scenes with a `[striker]` add the
@@ -33,11 +38,14 @@ use std::path::PathBuf;
 use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde_json::{json, Value};
+use woodpile_scene::columns;
+use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::simulation::batch_size;
 use woodpile_sim::ShareSet;
 
+use crate::table_units;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
@@ -62,9 +70,21 @@ pub struct Sweep {
     /// The shares its table has: `S` when its scenes have a striker, `D` when its scene
     /// declares dissipation (on every row, a point that loses nothing showing 0).
     shares: ShareSet,
+    /// The units of its table: scaled, or SI by each point's own scales.
+    units: Units,
 }
 
 impl Sweep {
+    /// A `kind = "sweep"` stage: the grid ([`Sweep::parse`]) and the units of its table.
+    pub(crate) fn parse_stage(fields: &mut Fields<'_>) -> Result<Sweep> {
+        let units = table_units::parse(fields)?;
+        let sweep = Sweep::parse(fields)?;
+        SiFactors::of(&sweep.scene_at(0)?, units)
+            .map_err(|reason| fields.error("units", reason))?;
+        Ok(Sweep { units, ..sweep })
+    }
+
+    /// The grid of a stage over scenes: its `axes`, `series` and `scene`.
     pub(crate) fn parse(fields: &mut Fields<'_>) -> Result<Sweep> {
         let axes = match fields.optional::<toml::Table>("axes")? {
             Some(table) => parse_axes(fields.nested("axes", table))?,
@@ -105,6 +125,7 @@ impl Sweep {
                 striker: false,
                 dissipative,
             },
+            units: Units::Scaled,
         };
         // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
         // the grid exercise the extremes of every axis. A placeholder cannot add or remove a
@@ -126,6 +147,11 @@ impl Sweep {
             },
             ..sweep
         })
+    }
+
+    /// The units of its table.
+    pub fn units(&self) -> Units {
+        self.units
     }
 
     /// Number of grid points.
@@ -228,15 +254,27 @@ impl Sweep {
             .iter()
             .zip(&values)
             .zip(keys.iter().zip(results))
-            .map(|((&index, values), (key, result))| SweepPoint {
-                index,
-                values,
-                key,
-                result,
-                si: None,
+            .map(|((&index, values), (key, result))| {
+                Ok(SweepPoint {
+                    index,
+                    values,
+                    key,
+                    result,
+                    si: self.si_factors(index)?,
+                })
             })
-            .collect();
+            .collect::<Result<_>>()?;
         rows_frame(&self.shape().rows(&points))
+    }
+
+    /// Point `index`'s SI factors when the table is in SI (each point by its own scales:
+    /// an axis may change the striker's speed, and so the time scale).
+    fn si_factors(&self, index: usize) -> Result<Option<SiFactors>> {
+        if self.units == Units::Scaled {
+            return Ok(None);
+        }
+        SiFactors::of(&self.scene_at(index)?, self.units)
+            .map_err(|reason| self.error("units".into(), reason + &self.at(&self.values(index))))
     }
 
     /// What every row of its table shares.
@@ -337,7 +375,7 @@ impl PointGrid for Sweep {
             })
         });
         let first = scene.scenario;
-        Ok(json!({
+        let mut summary = json!({
             "points": stats.points,
             "failed": stats.failed,
             "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
@@ -351,7 +389,19 @@ impl PointGrid for Sweep {
             "rhs_evals": stats.rhs_evals,
             "max_error_estimate": stats.max_error_estimate,
             "max_energy_drift": stats.max_energy_drift,
-        }))
+        });
+        // A kinetic series' `E` is a share of the impact energy, with no unit.
+        let energy: &[(&str, &str)] = match self.series {
+            Shares::Energy => &[(columns::ENERGY, "J")],
+            Shares::Kinetic => &[],
+        };
+        let times = [
+            (columns::TIME, "s"),
+            (columns::DT, "s"),
+            (columns::END_REACHED_AT, "s"),
+        ];
+        table_units::declare(&mut summary, self.units, &[&times[..], energy].concat());
+        Ok(summary)
     }
 }
 

@@ -44,7 +44,7 @@
 //! bar (or category legend) once, beside the panels.
 //!
 //! An axis label may end with its unit in parentheses, `x_label = "t (µs)"`. When the input
-//! says its columns' units (a spacetime stage with `units = "SI"`, a spectrum stage's
+//! says its columns' units (a sweep or spacetime stage with `units = "SI"`, a spectrum stage's
 //! `frequency`), the column is drawn in that unit; a label naming a unit the column is not in
 //! (µs on the model's scaled time) is refused.
 //!
