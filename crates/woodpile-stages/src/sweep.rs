@@ -78,10 +78,16 @@ impl Sweep {
     /// A `kind = "sweep"` stage: the grid ([`Sweep::parse`]) and the units of its table.
     pub(crate) fn parse_stage(fields: &mut Fields<'_>) -> Result<Sweep> {
         let units = table_units::parse(fields)?;
-        let sweep = Sweep::parse(fields)?;
-        SiFactors::of(&sweep.scene_at(0)?, units)
-            .map_err(|reason| fields.error("units", reason))?;
-        Ok(Sweep { units, ..sweep })
+        Sweep::parse(fields)?
+            .in_units(units)
+            .map_err(|reason| fields.error("units", reason))
+    }
+
+    /// The sweep with its table in `units`: SI needs `[physical]` scenes.
+    pub(crate) fn in_units(self, units: Units) -> std::result::Result<Sweep, String> {
+        let scene = self.scene_at(0).map_err(|e| e.to_string())?;
+        SiFactors::of(&scene, units)?;
+        Ok(Sweep { units, ..self })
     }
 
     /// The grid of a stage over scenes: its `axes`, `series` and `scene`.
@@ -277,6 +283,21 @@ impl Sweep {
             .map_err(|reason| self.error("units".into(), reason + &self.at(&self.values(index))))
     }
 
+    /// Writes its table's `units` and `column_units` into `summary`.
+    pub(crate) fn declare_units(&self, summary: &mut Value) {
+        // A kinetic series' `E` is a share of the impact energy, with no unit.
+        let energy: &[(&str, &str)] = match self.series {
+            Shares::Energy => &[(columns::ENERGY, "J")],
+            Shares::Kinetic => &[],
+        };
+        let times = [
+            (columns::TIME, "s"),
+            (columns::DT, "s"),
+            (columns::END_REACHED_AT, "s"),
+        ];
+        table_units::declare(summary, self.units, &[&times[..], energy].concat());
+    }
+
     /// What every row of its table shares.
     fn shape(&self) -> SweepShape<'_> {
         SweepShape {
@@ -390,17 +411,7 @@ impl PointGrid for Sweep {
             "max_error_estimate": stats.max_error_estimate,
             "max_energy_drift": stats.max_energy_drift,
         });
-        // A kinetic series' `E` is a share of the impact energy, with no unit.
-        let energy: &[(&str, &str)] = match self.series {
-            Shares::Energy => &[(columns::ENERGY, "J")],
-            Shares::Kinetic => &[],
-        };
-        let times = [
-            (columns::TIME, "s"),
-            (columns::DT, "s"),
-            (columns::END_REACHED_AT, "s"),
-        ];
-        table_units::declare(&mut summary, self.units, &[&times[..], energy].concat());
+        self.declare_units(&mut summary);
         Ok(summary)
     }
 }

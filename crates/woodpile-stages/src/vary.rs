@@ -28,7 +28,8 @@
 //! striker), stacked in the order of `inputs`, after a `design` column naming the input stage
 //! and `design_index`, its place in `inputs` (a figure draws a curve per design with `series =
 //! "design_index"` and `series_label = "design"`).
-//! Points are cached and shared as a sweep's are.
+//! Points are cached and shared as a sweep's are. `units = "SI"` gives the table in SI, as a
+//! sweep's (inputs whose best scenes are `[physical]`, such as a design of defect rods).
 
 use polars::prelude::{Column, DataFrame};
 use serde_json::json;
@@ -42,9 +43,11 @@ use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
 use woodpile_points::{PointStats, Shares};
+use woodpile_scene::units_out::Units;
 use woodpile_sim::integrate::MethodChoice;
 
 use crate::sweep::Sweep;
+use crate::table_units;
 
 /// The column naming the input stage whose best scene a row varies.
 pub const DESIGN: &str = "design";
@@ -59,6 +62,8 @@ pub struct Vary {
     set_each: toml::Table,
     unset: Vec<String>,
     file: std::path::PathBuf,
+    /// The units of its table.
+    units: Units,
 }
 
 impl Vary {
@@ -88,6 +93,7 @@ impl Vary {
             fields.error(&key, reason)
         })?;
         let unset: Vec<String> = fields.optional("unset")?.unwrap_or_default();
+        let units = table_units::parse(fields)?;
         if let Some(bad) = unset.iter().find(|k| k.split('.').any(str::is_empty)) {
             return Err(fields.error("unset", format!("`{bad}` is not a dotted key")));
         }
@@ -97,6 +103,7 @@ impl Vary {
             set_each,
             unset,
             file: fields.file().to_path_buf(),
+            units,
         })
     }
 
@@ -128,8 +135,12 @@ impl Vary {
                 )
             })?;
         }
-        Sweep::over(self.axes.clone(), Shares::Energy, scene, &self.file).map_err(|e| {
-            PipelineError::stage(stage, format!("`{design}`'s best scene, varied: {e}"))
+        let sweep =
+            Sweep::over(self.axes.clone(), Shares::Energy, scene, &self.file).map_err(|e| {
+                PipelineError::stage(stage, format!("`{design}`'s best scene, varied: {e}"))
+            })?;
+        sweep.in_units(self.units).map_err(|reason| {
+            PipelineError::stage(stage, format!("units: `{design}`'s best scene: {reason}"))
         })
     }
 }
@@ -197,10 +208,12 @@ impl Kind for Vary {
             events: ctx.events,
         };
         let mut stacked: Option<DataFrame> = None;
+        let mut units = json!({});
         let mut stats = PointStats::default();
         let mut tolerance = None;
         for (index, design) in ctx.stage.inputs.iter().enumerate() {
             let sweep = self.sweep_of(ctx, design)?;
+            sweep.declare_units(&mut units);
             let all: Vec<usize> = (0..sweep.count()).collect();
             let first = sweep.scene_at(0)?.scenario;
             let asked = first.method == MethodChoice::Auto || first.accuracy.tolerance_explicit;
@@ -224,9 +237,7 @@ impl Kind for Vary {
             });
         }
         let frame = stacked.ok_or_else(|| PipelineError::stage(ctx.name(), "no inputs"))?;
-        Ok(Output::table(
-            frame,
-            json!({
+        let mut summary = json!({
                 "points": stats.points,
                 "failed": stats.failed,
                 "designs": ctx.stage.inputs,
@@ -235,9 +246,13 @@ impl Kind for Vary {
                 "rhs_evals": stats.rhs_evals,
                 "max_error_estimate": stats.max_error_estimate,
                 "max_energy_drift": stats.max_energy_drift,
-            }),
-        )
-        .with_points(stats))
+        });
+        for key in ["units", "column_units"] {
+            if let Some(value) = units.get(key) {
+                summary[key] = value.clone();
+            }
+        }
+        Ok(Output::table(frame, summary).with_points(stats))
     }
 }
 

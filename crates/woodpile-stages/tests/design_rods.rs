@@ -69,3 +69,41 @@ fn a_rod_space_refuses_eps_and_kappa() {
     let error = common::load_error(&[("rods", &RODS.replace("\"20 mm\"", "\"20 s\""))]);
     assert!(error.contains("length"), "{error}");
 }
+
+/// `vary` takes the design's best SI scene as it is and varies physical keys on it: each
+/// defect rod's quality factor (inside the design's own `[[defect]]` list) and the run's
+/// length in ms, its table in SI. The lossier rods lose more.
+#[test]
+fn a_rod_design_is_varied_over_physical_keys() {
+    let vary = r#"
+kind = "vary"
+inputs = ["rods"]
+units = "SI"
+[axes]
+Q = [10.0, 1000.0]
+[set]
+run = { t_end = "0.3 ms", tolerance = 1e-5 }
+[set_each]
+defect = { quality_factor = "$Q" }
+"#;
+    let p = Project::new(&[("rods", RODS), ("varied", vary)]);
+    p.run(&[]).unwrap();
+    let (frame, manifest) = table::read_with_manifest(&p.output("varied")).unwrap();
+    assert_eq!(manifest.summary["column_units"]["t"], "s");
+    let q = table::f64_column(&frame, "Q").unwrap();
+    let trapped = table::f64_column(&frame, "E_tr").unwrap();
+    let dissipated = table::f64_column(&frame, "D").unwrap();
+    let last = |value: f64| {
+        let rows: Vec<usize> = (0..q.len()).filter(|&i| q[i] == Some(value)).collect();
+        let i = *rows.last().unwrap();
+        (trapped[i].unwrap(), dissipated[i].unwrap())
+    };
+    let (lossy, nearly_lossless) = (last(10.0), last(1000.0));
+    assert!(
+        lossy.1 > nearly_lossless.1 && lossy.1 > 0.0,
+        "{lossy:?} {nearly_lossless:?}"
+    );
+    let t = table::f64_column(&frame, "t").unwrap();
+    let end = t.iter().flatten().fold(0.0_f64, |a, &b| a.max(b));
+    assert!((end / 0.3e-3 - 1.0).abs() < 1e-9, "{end} s");
+}
