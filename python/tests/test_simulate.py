@@ -208,6 +208,18 @@ def test_a_wave_reaching_an_end_before_t_end_warns():
     assert 10.0 < r.end_reached_at < 60.0
 
 
+def test_the_end_reached_warning_of_si_outputs_is_in_seconds():
+    scene = {
+        "chain": {"sites": [-10, 9], "boundary": "free"},
+        "impulse": {"site": -10},
+        "physical": {"contact": 2.47e9, "mass": 0.866e-3, "velocity": 1.0},
+        "run": {"t_end": "0.5 ms"},
+    }
+    with pytest.warns(woodpile.EndReachedWarning, match=r"before t_end = 0\.0005 s"):
+        r = woodpile.simulate(scene, units="SI")
+    assert 0.0 < r.end_reached_at < 5e-4
+
+
 def test_si_outputs_of_a_physical_scene():
     path = REPO / "scenes" / "woodpile_experiment.toml"
     scaled = woodpile.simulate(path, fields=True)

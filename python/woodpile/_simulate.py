@@ -224,9 +224,10 @@ def simulate(
     result = SimulationResult(raw)
     reached = result.end_reached_at
     if reached is not None and reached < result.t_end:
+        unit = " s" if result.units == "SI" else ""
         warnings.warn(
-            f"the wave reached an end of the chain at t = {reached}, before t_end = "
-            f"{result.t_end}: R and T include what that end sent back",
+            f"the wave reached an end of the chain at t = {reached}{unit}, before t_end = "
+            f"{result.t_end}{unit}: R and T include what that end sent back",
             EndReachedWarning,
             stacklevel=2,
         )

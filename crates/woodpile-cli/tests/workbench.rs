@@ -175,3 +175,18 @@ fn the_examples_are_listed_and_printed_without_a_clone() {
         stderr(&missing)
     );
 }
+
+/// The note that the wave reached an end names its times as the scene gave them: in seconds
+/// for a `[physical]` scene, whose scaled time the user never wrote.
+#[test]
+fn the_end_reached_note_of_an_si_scene_is_in_seconds() {
+    let out = simulate(
+        "[chain]\nsites = [-10, 9]\nboundary = \"free\"\n[impulse]\nsite = -10\n[physical]\ncontact = 2.47e9\nmass = 0.866e-3\nvelocity = 1.0\n[run]\nt_end = \"0.5 ms\"\n",
+    );
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let note = stderr(&out);
+    assert!(
+        note.contains("before t_end = 5.0000e-4 s (") && note.contains("in scaled time"),
+        "{note}"
+    );
+}

@@ -74,9 +74,19 @@ pub fn simulate_report(scene: &Scene, out: &Outcome, wall_s: f64) -> Value {
 pub fn wall_note(scene: &Scene, out: &Outcome) -> Option<String> {
     let t_end = scene.scenario.t_end;
     let reached = out.stats.end_reached_at.filter(|&t| t < t_end)?;
+    let (reached, t_end) = (time_text(scene, reached), time_text(scene, t_end));
     Some(format!(
         "the wave reached an end of the chain at t = {reached}, before t_end = {t_end}: R and T include what that end sent back (a longer chain, or an earlier t_end, keeps them apart)"
     ))
+}
+
+/// The scaled time `t` as a user of `scene` wrote it: in seconds for a `[physical]` scene
+/// (its scaled value beside), else as the number it is.
+fn time_text(scene: &Scene, t: f64) -> String {
+    match &scene.physical {
+        Some(p) => format!("{:.4e} s ({t:.4} in scaled time)", t * p.scales.time_s()),
+        None => format!("{t}"),
+    }
 }
 
 /// The note for a run `auto` forecasts to be long ([`budget::LONG_RUN_S`] for its first rung),
