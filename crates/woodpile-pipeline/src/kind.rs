@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use polars::prelude::DataFrame;
-use serde_json::Value;
 
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
@@ -158,8 +157,9 @@ pub struct Stage {
     pub kind: &'static str,
     /// What it does: the kind's parameters and behaviour.
     pub spec: Arc<dyn Kind>,
-    /// The file's content without `description`, as canonical JSON: what the key hashes.
-    pub params: Value,
+    /// The file's content without `description`, over its kind's defaults: what the key
+    /// hashes ([`crate::params::Params::value`]).
+    pub params: crate::params::Params,
 }
 
 impl Stage {

@@ -27,6 +27,7 @@ pub mod grid;
 pub mod kind;
 pub mod lock;
 pub mod manifest;
+pub mod params;
 pub mod pipeline;
 pub mod run;
 pub mod sealed_files;

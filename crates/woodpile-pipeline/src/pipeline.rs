@@ -100,7 +100,7 @@ impl Pipeline {
                 .collect();
             keys.push(Key::of(&json!({
                 "kind": stage.kind,
-                "params": stage.params,
+                "params": stage.params.value(),
                 "inputs": inputs,
                 "code": code_version(),
             })));

@@ -424,7 +424,7 @@ pub(crate) fn manifest_for(
         kind: stage.kind.to_string(),
         key: pipeline.key(&stage.name).to_string(),
         code_version: code_version(),
-        params: stage.params.clone(),
+        params: stage.params.value(),
         inputs: stage
             .inputs
             .iter()

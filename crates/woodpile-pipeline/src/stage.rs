@@ -10,13 +10,16 @@
 //! The remaining keys belong to the kind (its module documents them); unknown keys anywhere
 //! are errors naming the file and key.
 
+use std::collections::BTreeMap;
 use std::path::Path;
+use std::sync::Arc;
 
 use serde_json::Value;
 
 use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::kind::Registry;
+use crate::params::{own_params, Params};
 use woodpile_points::canonical::toml_to_json;
 
 pub use crate::kind::Stage;
@@ -52,17 +55,33 @@ impl Stage {
         let mut table = parse_table(text, file)?;
         include_scene_file(&mut table, file, root)?;
         include_data_digest(&mut table, file, root)?;
-        defaults.lay_under(&mut table);
-        Stage::from_table(table, file, kinds)
+        let own = own_params(&table);
+        // The kind parses its defaults with its own keys, from a copy dropped once it is
+        // parsed; the stage keeps only its own keys and the one shared copy of the defaults.
+        let params = Params {
+            own,
+            defaults: defaults.lay_under(&mut table),
+        };
+        Stage::from_parts(table, file, kinds, params)
     }
 
-    /// A stage from its parsed table (scene files already included).
+    /// A stage from its parsed table (scene files already included, no defaults).
     pub fn from_table(table: toml::Table, file: &Path, kinds: &'static Registry) -> Result<Stage> {
+        let params = Params {
+            own: own_params(&table),
+            defaults: None,
+        };
+        Stage::from_parts(table, file, kinds, params)
+    }
+
+    /// A stage from `table` (its defaults laid under it), whose parameters are `params`.
+    fn from_parts(
+        table: toml::Table,
+        file: &Path,
+        kinds: &'static Registry,
+        params: Params,
+    ) -> Result<Stage> {
         let name = stage_name(file)?;
-        let mut params = toml_to_json(&toml::Value::Table(table.clone()));
-        if let Value::Object(map) = &mut params {
-            map.remove("description");
-        }
         let mut fields = Fields::new(file, "", table);
         let kind: String = fields.required("kind")?;
         let description: String = fields.optional("description")?.unwrap_or_default();
@@ -92,17 +111,20 @@ impl Stage {
 /// kind (`[render.style]`, say). A stage's own keys override them, tables merging key by key;
 /// they are laid in before parsing, so they are part of each stage's key and manifest, and
 /// editing them makes exactly the stages of that kind stale. The engine reads the file without
-/// knowing any kind: it only matches table names against each stage's `kind`.
+/// knowing any kind: it only matches table names against each stage's `kind`. Each kind's
+/// table is also kept as JSON, shared by every stage of the kind ([`Params`]).
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct Defaults(toml::Table);
+pub struct Defaults {
+    table: toml::Table,
+    json: BTreeMap<String, Arc<Value>>,
+}
 
 impl Defaults {
     /// The name of the defaults file in a stage folder; it is not a stage.
     pub const FILE: &'static str = "defaults.toml";
 
-    /// The largest defaults file: a few dozen keys take a kilobyte. Its tables are copied into
-    /// every stage of their kind, so an unbounded one multiplies by the number of stages (a
-    /// 946 KB file under 700 stages took 3.7 GB).
+    /// The largest defaults file: a few dozen keys take a kilobyte. Its tables are shared
+    /// by the stages of their kind, but each kind still parses them once per stage.
     pub const MAX_BYTES: usize = 64 * 1024;
 
     /// The defaults in `dir` (none when it has no defaults file), read and parsed once.
@@ -124,7 +146,7 @@ impl Defaults {
             return Err(PipelineError::Syntax {
                 file,
                 reason: format!(
-                    "{} bytes, more than the {} a defaults file may have: its tables are copied into every stage of their kind",
+                    "{} bytes, more than the {} a defaults file may have: every stage of a kind parses its table",
                     text.len(),
                     Defaults::MAX_BYTES
                 ),
@@ -139,16 +161,25 @@ impl Defaults {
                 "expected a table of defaults named after a kind ([render], say)",
             ));
         }
-        Ok(Defaults(table))
+        let json = table
+            .iter()
+            .map(|(kind, value)| (kind.clone(), Arc::new(toml_to_json(value))))
+            .collect();
+        Ok(Defaults { table, json })
     }
 
-    /// Lays the defaults of `table`'s kind under it: its own keys win.
-    fn lay_under(&self, table: &mut toml::Table) {
-        let kind = table.get("kind").and_then(|k| k.as_str());
-        if let Some(toml::Value::Table(defaults)) = kind.and_then(|k| self.0.get(k)) {
-            let own = std::mem::replace(table, defaults.clone());
-            merge(table, own);
-        }
+    /// Lays the defaults of `table`'s kind under it (its own keys win), and returns them as
+    /// the shared JSON its parameters refer to.
+    fn lay_under(&self, table: &mut toml::Table) -> Option<Arc<Value>> {
+        let kind = table.get("kind").and_then(|k| k.as_str())?;
+        let (toml::Value::Table(defaults), Some(json)) =
+            (self.table.get(kind)?, self.json.get(kind))
+        else {
+            return None;
+        };
+        let own = std::mem::replace(table, defaults.clone());
+        merge(table, own);
+        Some(Arc::clone(json))
     }
 }
 

@@ -83,7 +83,7 @@ pub fn state(pipeline: &Pipeline, results: &Path, figures: &Path, stage: &Stage)
             stored.code_version
         ));
     }
-    for change in changed_paths(&stored.params, &stage.params) {
+    for change in changed_paths(&stored.params, &stage.params.value()) {
         reasons.push(format!("parameter {change}"));
     }
     for input in &stage.inputs {

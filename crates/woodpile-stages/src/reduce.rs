@@ -456,7 +456,7 @@ impl Kind for Reduce {
             .map_err(|reason| PipelineError::stage(ctx.name(), format!("at: {reason}")))?;
         let mut output = self.compute(ctx.name(), &frame, (&sweep.axes, at))?;
         // The sweep's scene, grid and tolerance, so the table explains itself without its input.
-        let params = &upstream.params;
+        let params = upstream.params.value();
         output.summary["input"] = json!({
             "stage": input,
             "scene": params.get("scene"),

@@ -109,7 +109,7 @@ defect = [{ site = 0, eps = "$eps" }]
         ]
     );
     // The override replaced the file's defects: one defect at 0.
-    let params = &pipeline.stage("sweep").unwrap().params;
+    let params = pipeline.stage("sweep").unwrap().params.value();
     assert_eq!(params["scene"]["defect"].as_array().unwrap().len(), 1);
     assert_eq!(params["scene"]["chain"]["n"], 10);
 

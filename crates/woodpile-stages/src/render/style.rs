@@ -3,7 +3,10 @@
 //! stage folder's `defaults.toml` under `[render.style]` and `[render.labels]`; a stage's own
 //! keys override them.
 
-use std::collections::BTreeMap;
+use std::collections::hash_map::DefaultHasher;
+use std::collections::{BTreeMap, HashMap};
+use std::hash::{Hash, Hasher};
+use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 use woodpile_pipeline::error::Result;
 use woodpile_pipeline::fields::Fields;
@@ -110,9 +113,36 @@ impl StyleSpec {
 
 /// `labels = { E_tr = "E_{tr}", eps = "\\varepsilon" }`: how a name (a curve's column, a
 /// colour bar's label) is written in the figure, in the markup of [`woodpile_plot::markup`].
-/// The stage's table keeps the names; only the drawing shows the labels.
+/// The stage's table keeps the names; only the drawing shows the labels. Most stages take
+/// theirs from `defaults.toml` alone, so equal label sets are held once ([`shared`]).
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct Labels(BTreeMap<String, String>);
+pub struct Labels(Arc<BTreeMap<String, String>>);
+
+/// `labels`, or an equal set already held by another stage: thousands of render stages
+/// under a large `[render.labels]` would otherwise each keep a copy.
+fn shared(labels: BTreeMap<String, String>) -> Arc<BTreeMap<String, String>> {
+    type Pool = Mutex<HashMap<u64, Vec<Weak<BTreeMap<String, String>>>>>;
+    static POOL: OnceLock<Pool> = OnceLock::new();
+    let mut hasher = DefaultHasher::new();
+    labels.hash(&mut hasher);
+    let hash = hasher.finish();
+    let mut pool = POOL
+        .get_or_init(Pool::default)
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    let held = pool.entry(hash).or_default();
+    held.retain(|weak| weak.strong_count() > 0);
+    if let Some(same) = held
+        .iter()
+        .filter_map(Weak::upgrade)
+        .find(|h| **h == labels)
+    {
+        return same;
+    }
+    let labels = Arc::new(labels);
+    held.push(Arc::downgrade(&labels));
+    labels
+}
 
 impl Labels {
     pub(super) fn parse(fields: &mut Fields<'_>) -> Result<Labels> {
@@ -127,7 +157,7 @@ impl Labels {
             labels.insert(key, drawn);
         }
         f.finish()?;
-        Ok(Labels(labels))
+        Ok(Labels(shared(labels)))
     }
 
     /// `text` as drawn: its label if it has one, else its own markup rendered.
