@@ -201,3 +201,43 @@ fn a_stiff_contact_dashpot_is_forecast_long() {
         woodpile_sim::simulation::budget::forecast(&scene("[damping]\nground = 0.001\n").scenario);
     assert!(!ground.unwrap().halvings_likely);
 }
+
+/// B6: when a contact dashpot makes the halvings likely and even the finest rung `auto` may
+/// need is beyond the step budget, the scene is refused at once, naming the key that declares
+/// the dashpot: the ladder would otherwise spend every rung before it to be stopped at the
+/// last. A named method with its own dt runs once, and is admitted.
+#[test]
+fn a_contact_dashpot_whose_finest_rung_is_unaffordable_is_refused() {
+    let scene = |damping: &str, run: &str| {
+        let text = format!("[chain]\nn = 30\n[impulse]\nsite = -10\n{damping}[run]\n{run}");
+        woodpile_scene::parse(&text, std::path::Path::new("dashpot.toml"))
+    };
+    // Each past the budget at its finest rung (first rung x 64), within it at its first.
+    for (damping, key, t_end) in [
+        ("[damping]\ncontact = 1000.0\n", "damping.contact", 5000.0),
+        (
+            "[damping]\nrestitution = { e = 0.2, velocity = 1.0 }\n",
+            "damping.restitution",
+            20000.0,
+        ),
+        (
+            "[[segment]]\nsites = [-15, 14]\ndamping = 1000.0\n",
+            "segment[0].damping",
+            5000.0,
+        ),
+    ] {
+        let error = scene(damping, &format!("t_end = {t_end:?}\n"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains(&format!("key `{key}`")) && error.contains("finest rung"),
+            "{error}"
+        );
+        assert!(scene(damping, "t_end = 30.0\n").is_ok(), "{damping}");
+        let named = format!("t_end = {t_end:?}\nmethod = \"rk4-contact\"\ndt = 0.01\n");
+        let named = scene(damping, &named);
+        assert!(named.is_ok(), "{damping}: {:?}", named.err());
+    }
+    // Without a contact dashpot the same run is admitted: its halvings are not likely.
+    assert!(scene("[damping]\nground = 0.001\n", "t_end = 5000.0\n").is_ok());
+}

@@ -220,6 +220,10 @@ pub enum StepSetBy {
     Contacts,
     /// Keeping the fastest dashpot or soft end stable.
     Dissipation(Dissipator),
+    /// The finest rung `auto` is likely to need: a contact dashpot switches on with its
+    /// contact, a kink that costs `rk4-contact` its order, so the ladder halves its first step
+    /// up to `simulation::MAX_HALVINGS` times.
+    DashpotOnsets,
 }
 
 /// A velocity-dependent force of a chain, by what declares it: what
@@ -272,6 +276,7 @@ impl StepSetBy {
             StepSetBy::Resonator(_) => "the fastest resonator's frequency",
             StepSetBy::Contacts => "the chain's stiffest contact",
             StepSetBy::Dissipation(_) => "the fastest dashpot or soft end",
+            StepSetBy::DashpotOnsets => "auto's finest rung, which a contact dashpot's onset makes likely: it costs rk4-contact its order; a named method with a dt runs once instead",
         }
     }
 }

@@ -115,6 +115,8 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         striker_sites: usize::from(file.striker.is_some()),
     };
     let built = model(&file, &layout, si.as_ref())?;
+    // Named before `run` and `fractions` are taken from the file.
+    let contact_dashpot = run::contact_dashpot_key(&file);
     let settings = run::settings(file.run, si.as_ref())?;
     let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
     let mut region = Region::new(lo as i64, hi as i64, layout.n_sites())
@@ -134,7 +136,11 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
         accuracy: settings.accuracy,
         sample_every: settings.sample_every,
     };
-    run::within_budget(&scenario, settings.sample_every_given, &file.defect)?;
+    let keys = run::StepKeys {
+        defects: &file.defect,
+        contact_dashpot,
+    };
+    run::within_budget(&scenario, settings.sample_every_given, &keys)?;
     let physical = si.map(|si| {
         let mut values = physical_values(si, built.derived, built.striker, &scenario);
         values.derived.extend(built.damping_values);

@@ -161,7 +161,7 @@ pub(crate) fn region(
 pub(crate) fn within_budget(
     scenario: &Scenario,
     sample_every_given: bool,
-    defects: &[raw::Defect],
+    keys: &StepKeys<'_>,
 ) -> Result<(), Invalid> {
     let error = match woodpile_sim::simulation::budget::check(scenario) {
         Ok(()) => return Ok(()),
@@ -183,10 +183,61 @@ pub(crate) fn within_budget(
             StepSetBy::Tolerance => "run.tolerance".to_string(),
             StepSetBy::Resonator(i) => format!("defect[{i}]"),
             StepSetBy::Contacts => "chain".to_string(),
-            StepSetBy::Dissipation(which) => dissipator_key(*which, defects),
+            StepSetBy::Dissipation(which) => dissipator_key(*which, keys.defects),
+            StepSetBy::DashpotOnsets => keys.contact_dashpot.clone(),
         },
     };
     Err(invalid(key, error.to_string()))
+}
+
+/// What a step-budget refusal blames, read from the scene file before it is taken apart.
+pub(crate) struct StepKeys<'a> {
+    /// The defects, whose dashpots or quality factors may set the step.
+    pub defects: &'a [raw::Defect],
+    /// The key that declares a contact dashpot ([`contact_dashpot_key`]).
+    pub contact_dashpot: String,
+}
+
+/// The first key that declares a contact dashpot: the chain's, then the striker's, then a
+/// segment's.
+pub(crate) fn contact_dashpot_key(file: &raw::SceneFile) -> String {
+    let damping = file.damping.as_ref();
+    let striker = file.striker.as_ref();
+    let segment = file
+        .segment
+        .iter()
+        .enumerate()
+        .find(|(_, s)| s.damping.is_some_and(|d| d > 0.0) || s.restitution.is_some());
+    let declared = [
+        (
+            damping.is_some_and(|d| d.contact.is_some_and(|c| c > 0.0)),
+            "damping.contact".to_string(),
+        ),
+        (
+            damping.is_some_and(|d| d.restitution.is_some()),
+            "damping.restitution".to_string(),
+        ),
+        (
+            striker.is_some_and(|s| s.damping.is_some_and(|d| d > 0.0)),
+            "striker.damping".to_string(),
+        ),
+        (
+            striker.is_some_and(|s| s.restitution.is_some()),
+            "striker.restitution".to_string(),
+        ),
+    ];
+    let chain_or_striker = declared
+        .into_iter()
+        .find(|(yes, _)| *yes)
+        .map(|(_, key)| key);
+    chain_or_striker
+        .or_else(|| {
+            segment.map(|(i, s)| match s.restitution {
+                Some(_) => format!("segment[{i}].restitution"),
+                None => format!("segment[{i}].damping"),
+            })
+        })
+        .unwrap_or_else(|| "damping".into())
 }
 
 /// The key that declares `which` dashpot or soft end.

@@ -117,17 +117,34 @@ pub fn check(scenario: &Scenario) -> Result<(), SimError> {
         }
     };
     let steps = (scenario.t_end / dt).max(intervals(scenario.t_end, scenario.sample_every) as f64);
-    if steps <= MAX_STEPS as f64 {
-        Ok(())
-    } else {
-        Err(OverBudget::Steps {
+    if steps > MAX_STEPS as f64 {
+        return Err(OverBudget::Steps {
             steps,
             dt,
             set_by,
             limit: MAX_STEPS,
         }
-        .into())
+        .into());
     }
+    finest_rung_affordable(scenario, dt, steps)
+}
+
+/// Refuses an `auto` run whose halvings are likely ([`Forecast::halvings_likely`]) when its
+/// finest rung would take more steps than the budget: the ladder would otherwise spend every
+/// rung before it (half the finest's steps, then a quarter, ...) to be stopped at the last.
+fn finest_rung_affordable(scenario: &Scenario, dt: f64, steps: f64) -> Result<(), SimError> {
+    let likely = forecast(scenario).is_some_and(|f| f.halvings_likely);
+    let halving = 2f64.powi(super::MAX_HALVINGS as i32);
+    if !likely || steps * halving <= MAX_STEPS as f64 {
+        return Ok(());
+    }
+    Err(OverBudget::Steps {
+        steps: steps * halving,
+        dt: dt / halving,
+        set_by: StepSetBy::DashpotOnsets,
+        limit: MAX_STEPS,
+    }
+    .into())
 }
 
 /// Whether `dt` is the tolerance's step (`for_tolerance`) or a resonator's cap, and which.
