@@ -98,6 +98,10 @@ pub fn calibrate(
     stop: &dyn Fn() -> bool,
 ) -> Result<Calibration, String> {
     trace.check().map_err(|reason| format!("trace: {reason}"))?;
+    // Before the scene is resolved: a scaled scene's own run may not even be admitted.
+    if !scene.contains_key("physical") {
+        return Err(prediction::NOT_PHYSICAL.into());
+    }
     let problem = Problem::new(scene, file, parameters)?;
     let start = problem.start();
     let (_, first) = problem.with(&start)?;

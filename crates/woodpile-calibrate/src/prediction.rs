@@ -28,6 +28,10 @@ pub enum Stepping {
     },
 }
 
+/// Why a scene without `[physical]` cannot be fitted to a measured trace.
+pub(crate) const NOT_PHYSICAL: &str =
+    "the scene has no [physical] table: a measured trace is in s and m/s, so its scene must be in SI";
+
 /// The velocities `scene` predicts at `trace`'s rows, and the run that made them. The run is
 /// sampled [`SAMPLES_PER_SPACING`] times per `trace.spacing()` up to the trace's end, and each
 /// row is read by linear interpolation between the two samples around it.
@@ -36,9 +40,7 @@ pub fn predict(
     trace: &Trace,
     stepping: Stepping,
 ) -> Result<(Vec<f64>, Outcome), String> {
-    let physical = scene.physical.as_ref().ok_or(
-        "the scene has no [physical] table: a measured trace is in s and m/s, so its scene must be in SI",
-    )?;
+    let physical = scene.physical.as_ref().ok_or(NOT_PHYSICAL)?;
     let (time_s, speed) = (physical.scales.time_s(), physical.scales.velocity);
     let (lo, hi) = trace.rods();
     let (first, last) = scene

@@ -84,7 +84,8 @@ fn bad_requests_name_what_is_wrong() {
     let error = calibrate(&scaled, Path::new("s.toml"), &noisy, &parameters(), &|| {
         false
     });
-    assert!(error.unwrap_err().contains("[physical]"));
+    let error = error.unwrap_err();
+    assert!(error.contains("[physical]"), "{error}");
     let stopped = calibrate(&table, Path::new("s.toml"), &noisy, &parameters(), &|| true);
     assert_eq!(stopped.unwrap_err(), woodpile_calibrate::STOPPED);
 }
