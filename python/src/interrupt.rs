@@ -152,6 +152,7 @@ pub(crate) fn internal_message(panic: &Box<dyn std::any::Any + Send>) -> String 
 ///
 /// Panics on the worker thread, as a bug in the core would: the test suite's check that a
 /// panic becomes a `SimulationError` and leaves the interpreter running.
+#[cfg(feature = "testing")]
 #[pyfunction]
 #[pyo3(name = "_panic_in_worker")]
 pub(crate) fn panic_in_worker(py: Python<'_>) -> PyResult<()> {

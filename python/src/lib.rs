@@ -37,6 +37,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // table built after Ctrl-C would otherwise import it with a second interrupt pending,
     // and the failed import is a panic, not an exception.
     numpy::PyArray1::<f64>::zeros(py, 0, false);
+    // `WOODPILE_SIMD` and `WOODPILE_LANES`, read once, as the command line reads them.
+    woodpile_scene::cpu::apply_environment();
     m.add("SceneError", py.get_type::<SceneError>())?;
     m.add("SimulationError", py.get_type::<SimulationError>())?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
@@ -47,6 +49,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(examples::examples, m)?)?;
     m.add_function(wrap_pyfunction!(examples::example, m)?)?;
     m.add_function(wrap_pyfunction!(scene_input::scene_toml, m)?)?;
+    #[cfg(feature = "testing")]
     m.add_function(wrap_pyfunction!(interrupt::panic_in_worker, m)?)?;
     m.add_function(wrap_pyfunction!(table_integrity, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

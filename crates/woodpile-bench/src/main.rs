@@ -86,6 +86,7 @@ fn baseline(program: &str, args: &[&str]) -> Result<(f64, f64, String), String> 
 }
 
 fn main() {
+    woodpile_scene::cpu::apply_environment();
     let args: Vec<String> = std::env::args().collect();
     let option = |name: &str| {
         args.iter()

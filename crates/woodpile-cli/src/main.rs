@@ -156,8 +156,10 @@ fn main() -> ExitCode {
 }
 
 /// Starts the worker threads now, so that a bad `RAYON_NUM_THREADS` (not a number, or more
-/// threads than the system gives) is an input error rather than a panic deep inside a run.
+/// threads than the system gives) is an input error rather than a panic deep inside a run;
+/// the simulator is handed the environment's CPU choices first.
 fn start_threads() -> Result<(), String> {
+    woodpile_scene::cpu::apply_environment();
     let mut builder = rayon::ThreadPoolBuilder::new();
     if let Some(n) = woodpile_scene::threads::asked_threads()? {
         builder = builder.num_threads(n);

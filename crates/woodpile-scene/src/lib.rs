@@ -7,6 +7,7 @@
 #![warn(missing_docs)]
 
 pub mod columns;
+pub mod cpu;
 pub mod examples;
 pub mod grid;
 pub mod quantity;

@@ -6,9 +6,10 @@
 //! AVX-512 tier runs too.
 //!
 //! Every copy computes the same bits: every operation is element-wise, Rust never fuses a
-//! multiply and an add on its own, and no loop is reassociated. `WOODPILE_SIMD=baseline` or
-//! `WOODPILE_SIMD=avx2` caps the copy taken, so every path can be run (and compared) on one
-//! machine.
+//! multiply and an add on its own, and no loop is reassociated. [`cap`] caps the copy taken,
+//! so every path can be run (and compared) on one machine: the command line and the Python
+//! module call it with their `WOODPILE_SIMD` (`woodpile_scene::environment`); the simulator
+//! reads no environment itself.
 
 use std::sync::OnceLock;
 
@@ -24,19 +25,32 @@ pub enum Tier {
     Avx512,
 }
 
-/// The copy of the hot loops this process runs: the best the CPU has, capped by
-/// `WOODPILE_SIMD` (`baseline` or `avx2`; any other value caps nothing). Decided once per
-/// process.
+/// The cap [`cap`] set, if any.
+static CAP: OnceLock<Tier> = OnceLock::new();
+
+/// Caps the copy this process runs at `tier`, as an edge asks (`WOODPILE_SIMD`). Call it
+/// before the first run: the tier is decided once per process, at its first use.
+pub fn cap(tier: Tier) {
+    // A second cap, or one after the first run, cannot change the copy a run began with.
+    let _ = CAP.set(tier);
+}
+
+impl Tier {
+    /// The tier a cap's name asks for: `baseline` or `avx2` (any other name caps nothing).
+    pub fn cap_named(name: &str) -> Option<Tier> {
+        match name {
+            "baseline" => Some(Tier::Baseline),
+            "avx2" => Some(Tier::Avx2),
+            _ => None,
+        }
+    }
+}
+
+/// The copy of the hot loops this process runs: the best the CPU has, under the [`cap`].
+/// Decided once per process.
 pub fn tier() -> Tier {
     static CHOICE: OnceLock<Tier> = OnceLock::new();
-    *CHOICE.get_or_init(|| {
-        let cap = match std::env::var("WOODPILE_SIMD").as_deref() {
-            Ok("baseline") => Tier::Baseline,
-            Ok("avx2") => Tier::Avx2,
-            _ => Tier::Avx512,
-        };
-        detected().min(cap)
-    })
+    *CHOICE.get_or_init(|| detected().min(CAP.get().copied().unwrap_or(Tier::Avx512)))
 }
 
 /// The best tier the CPU runs. AVX-512 needs x86-64-v4's features and, as the marker of the

@@ -166,12 +166,18 @@ impl LaneChain {
     }
 }
 
-/// Whether scenes may take lanes at all: unless `WOODPILE_LANES` is `off`, which runs every
-/// scene alone (same results), so that both paths can be timed on one machine. Decided once
-/// per process.
+/// Set by [`turn_off`].
+static OFF: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Runs every scene of this process alone (same results), as an edge asks
+/// (`WOODPILE_LANES=off`), so that both paths can be timed on one machine.
+pub fn turn_off() {
+    OFF.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether scenes may take lanes at all: unless [`turn_off`] was called.
 pub fn enabled() -> bool {
-    static CHOICE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *CHOICE.get_or_init(|| !std::env::var("WOODPILE_LANES").is_ok_and(|v| v == "off"))
+    !OFF.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// Whether `models` (one per lane) can step together: they share a chain that takes lanes.
