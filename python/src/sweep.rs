@@ -5,7 +5,7 @@
 //! never numbers. `simulate_many` runs a list of scenes as `simulate` would, one row each.
 
 use std::panic::AssertUnwindSafe;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use pyo3::exceptions::{PyOSError, PyValueError};
@@ -14,10 +14,8 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use woodpile_points::rows::{SweepPoint, SweepShape};
 use woodpile_points::{point_key, simulate_points_until, Key, PointResult, PointStore, Shares};
-use woodpile_scene::grid::{
-    at_point, parse_axes, point, point_count, Axis, AxisValue, MAX_SWEEP_BYTES,
-    PLANNED_BYTES_PER_SITE,
-};
+use woodpile_scene::grid::{parse_axes, AxisValue, MAX_SWEEP_BYTES, PLANNED_BYTES_PER_SITE};
+use woodpile_scene::sweep_grid::{GridError, SceneGrid};
 use woodpile_scene::template::Template;
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
@@ -53,17 +51,13 @@ pub(crate) fn sweep<'py>(
         Some(value) => series::parse(value, true)?,
         None => None,
     };
-    let grid = Grid::of(scene, axes)?;
-    let count = point_count(&grid.axes);
     // A bad template fails at once, not as a column of failures: the grid's corners exercise
     // every axis's extremes, as a sweep stage checks them.
-    let first = grid.scene_at(0).map_err(SceneError::new_err)?;
+    let (grid, first) = Grid::of(scene, axes)?;
+    let count = grid.scenes.count();
     let units = Units::parse(units)
         .and_then(|u| SiFactors::of(&first, u).map(|_| u))
         .map_err(|reason| SceneError::new_err(format!("{}: units: {reason}", grid.label)))?;
-    let last = grid.scene_at(count - 1).map_err(SceneError::new_err)?;
-    woodpile_scene::grid::check_sweep_memory(count, &last)
-        .map_err(|reason| SceneError::new_err(format!("{}: {reason}", grid.label)))?;
     let store = match cache {
         Some(dir) => Some(point_store(dir)?),
         None => None,
@@ -77,10 +71,10 @@ pub(crate) fn sweep<'py>(
         units,
     };
     let shape = SweepShape {
-        axes: &grid.axes,
+        axes: &grid.scenes.axes,
         shares: ShareSet {
             striker: first.scenario.region.has_striker(),
-            dissipative: grid.template.declares_dissipation(),
+            dissipative: grid.scenes.template().declares_dissipation(),
         },
         kinetic: kind == Some(Shares::Kinetic),
     };
@@ -95,16 +89,16 @@ fn point_store(dir: PathBuf) -> PyResult<PointStore> {
     Ok(PointStore::new(dir))
 }
 
-/// A grid of scenes: a template over its axes.
+/// A grid of scenes ([`SceneGrid`], the sweep stage's own type) and what its messages call it.
 struct Grid {
-    axes: Vec<Axis>,
-    template: Template,
+    scenes: SceneGrid,
     label: String,
 }
 
 impl Grid {
-    /// The grid of template `scene` (a dict, a TOML string or a path) over `axes`.
-    fn of(scene: &Bound<'_, PyAny>, axes: &Bound<'_, PyDict>) -> PyResult<Grid> {
+    /// The grid of template `scene` (a dict, a TOML string or a path) over `axes`, checked
+    /// as a sweep stage checks its own, with its first scene.
+    fn of(scene: &Bound<'_, PyAny>, axes: &Bound<'_, PyDict>) -> PyResult<(Grid, Scene)> {
         let source = Source::of(scene)?;
         let label = label_text(&source.label());
         let template = source.table()?;
@@ -119,25 +113,27 @@ impl Grid {
         let template = Template::new(template, &axes).map_err(|(key, reason)| {
             SceneError::new_err(format!("{label}: key `{}`: {reason}", unprefixed(&key)))
         })?;
-        Ok(Grid {
-            axes,
-            template,
-            label,
-        })
+        let (scenes, first) = SceneGrid::checked(axes, template, Path::new(&label))
+            .map_err(|e| SceneError::new_err(grid_message(&label, e)))?;
+        Ok((Grid { scenes, label }, first))
     }
 
     /// The validated scene of point `index`, or the error naming its axis values.
     fn scene_at(&self, index: usize) -> Result<Scene, String> {
-        let values = point(&self.axes, index);
-        let at = at_point(&self.axes, &values);
-        let table = self
-            .template
-            .instantiate(&self.axes, &values)
-            .map_err(|(key, reason)| {
-                format!("{}: key `{}`: {reason}{at}", self.label, unprefixed(&key))
-            })?;
-        woodpile_scene::from_table(table, std::path::Path::new(&self.label))
-            .map_err(|e| format!("{e}{at}"))
+        self.scenes
+            .scene_at(index)
+            .map_err(|e| grid_message(&self.label, e))
+    }
+}
+
+/// A grid's error as Python words it: the dict is the scene, so keys lose `scene.`.
+fn grid_message(label: &str, e: GridError) -> String {
+    match e {
+        GridError::Template { key, reason } => {
+            format!("{label}: key `{}`: {reason}", unprefixed(&key))
+        }
+        GridError::Scene { error, at } => format!("{error}{at}"),
+        GridError::Memory(reason) => format!("{label}: {reason}"),
     }
 }
 
@@ -221,7 +217,7 @@ impl Run<'_> {
     ) -> PyResult<Bound<'py, PyDict>> {
         let values: Vec<Vec<AxisValue>> = finished
             .iter()
-            .map(|(i, _)| point(&self.grid.axes, *i))
+            .map(|(i, _)| self.grid.scenes.values(*i))
             .collect();
         let points: Vec<SweepPoint<'_>> = finished
             .iter()

@@ -102,12 +102,12 @@ fn grid_scenes(
         .ok()
         .and_then(|s| s.get::<Sweep>())
         .ok_or_else(|| format!("no sweep stage `{stage}`"))?;
-    let count = point_count(&sweep.axes);
+    let count = point_count(&sweep.grid.axes);
     let every = max_points.map_or(1, |m| count.div_ceil(m.max(1)));
     (0..count)
         .step_by(every)
         .map(|i| {
-            let scene = sweep.scene_with(&point(&sweep.axes, i), None);
+            let scene = sweep.scene_with(&point(&sweep.grid.axes, i), None);
             scene.map(|s| s.scenario).map_err(|e| e.to_string())
         })
         .collect()

@@ -14,6 +14,7 @@ pub mod quantity;
 mod raw;
 pub mod report;
 mod resolve;
+pub mod sweep_grid;
 pub mod template;
 pub mod threads;
 pub mod units_out;

@@ -432,7 +432,7 @@ impl Kind for Reduce {
         };
         match inputs.get::<Sweep>(input) {
             Some(sweep) => self
-                .check_axes(&sweep.axes)
+                .check_axes(&sweep.grid.axes)
                 .map_err(|reason| ("maximize.over".to_string(), reason)),
             None => Err((
                 "inputs[0]".into(),
@@ -454,7 +454,7 @@ impl Kind for Reduce {
         let at = self
             .read_at(input, sweep)
             .map_err(|reason| PipelineError::stage(ctx.name(), format!("at: {reason}")))?;
-        let mut output = self.compute(ctx.name(), &frame, (&sweep.axes, at))?;
+        let mut output = self.compute(ctx.name(), &frame, (&sweep.grid.axes, at))?;
         // The sweep's scene, grid and tolerance, so the table explains itself without its input.
         let params = upstream.params.value();
         output.summary["input"] = json!({

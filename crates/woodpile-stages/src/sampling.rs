@@ -76,8 +76,13 @@ fn drawn<T>(
                 .ok_or_else(|| {
                     PipelineError::stage(stage, "a survey draws from this sweep, which is missing")
                 })?;
-            let values: Vec<_> = sweep.axes.iter().map(|a| rng.pick(&a.values)).collect();
-            let named = woodpile_scene::grid::named_values(&sweep.axes, &values, "=");
+            let values: Vec<_> = sweep
+                .grid
+                .axes
+                .iter()
+                .map(|a| rng.pick(&a.values))
+                .collect();
+            let named = woodpile_scene::grid::named_values(&sweep.grid.axes, &values, "=");
             scenes.push((
                 format!("{label} {}", named.join(" ")),
                 make(sweep, &values)?,

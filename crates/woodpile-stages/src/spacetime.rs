@@ -182,7 +182,7 @@ impl SpaceTime {
                 (0..sweep.count())
                     .map(|i| Ok((sweep.values(i), sweep.scene_at(i)?)))
                     .collect::<Result<_>>()?,
-                &sweep.axes,
+                &sweep.grid.axes,
             ),
             Source::Design(design) => {
                 let path = ctx.best_scene(design)?;

@@ -183,7 +183,7 @@ impl Spectrum {
         &self,
         points: Vec<(Vec<AxisValue>, Vec<Column>)>,
     ) -> Result<polars::prelude::DataFrame> {
-        let axes = &self.sweep.axes;
+        let axes = &self.sweep.grid.axes;
         let mut out: Vec<Column> = Vec::new();
         let mut prefix: Vec<Vec<f64>> = vec![Vec::new(); axes.len() + 1];
         for (point, (values, columns)) in points.into_iter().enumerate() {

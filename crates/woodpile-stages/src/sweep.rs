@@ -39,6 +39,7 @@ use polars::prelude::DataFrame;
 use rayon::prelude::*;
 use serde_json::{json, Value};
 use woodpile_scene::columns;
+use woodpile_scene::sweep_grid::{GridError, SceneGrid};
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;
 use woodpile_sim::integrate::MethodChoice;
@@ -49,7 +50,7 @@ use crate::table_units;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::grid::{parse_axes, point, point_count, Axis, AxisValue};
+use woodpile_pipeline::grid::{parse_axes, Axis, AxisValue};
 use woodpile_pipeline::kind::{Context, Kind, PointGrid, PointsAt};
 use woodpile_pipeline::table::rows_frame;
 use woodpile_pipeline::template::Template;
@@ -61,11 +62,11 @@ use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, S
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]
 pub struct Sweep {
-    /// The grid axes, sorted by name (the last varies fastest).
-    pub axes: Vec<Axis>,
+    /// The grid of scenes: the axes, sorted by name (the last varies fastest), and the
+    /// template.
+    pub grid: SceneGrid,
     /// Which energy the recorded fractions split.
     pub series: Shares,
-    template: Template,
     file: PathBuf,
     /// The shares its table has: `S` when its scenes have a striker, `D` when its scene
     /// declares dissipation (on every row, a point that loses nothing showing 0).
@@ -107,7 +108,7 @@ impl Sweep {
 
     /// The sweep of `scene` (a scene table with "$axis" placeholders, from `file`) over
     /// `axes`, checked at the corners of the grid and for the memory its points will hold
-    /// (its last point's scene is the largest).
+    /// ([`SceneGrid::checked`]).
     pub fn over(
         axes: Vec<Axis>,
         series: Shares,
@@ -122,36 +123,20 @@ impl Sweep {
                 source: None,
             })?;
         let dissipative = template.declares_dissipation();
-        let sweep = Sweep {
-            axes,
-            series,
-            template,
-            file: file.to_path_buf(),
-            shares: ShareSet {
-                striker: false,
-                dissipative,
-            },
-            units: Units::Scaled,
-        };
-        // Catch a bad template now (status, dry runs) rather than mid-sweep: the corners of
-        // the grid exercise the extremes of every axis. A placeholder cannot add or remove a
-        // table, so the first scene says whether every scene has a striker.
-        let striker = sweep.scene_at(0)?.scenario.region.has_striker();
-        let last = sweep.scene_at(sweep.count() - 1)?;
-        woodpile_scene::grid::check_sweep_memory(sweep.count(), &last).map_err(|reason| {
-            PipelineError::Definition {
-                file: file.to_path_buf(),
-                key: "axes".into(),
-                reason,
-                source: None,
-            }
-        })?;
+        let (grid, first) =
+            SceneGrid::checked(axes, template, file).map_err(|e| grid_error(file, e))?;
+        // A placeholder cannot add or remove a table, so the first scene says whether every
+        // scene has a striker.
+        let striker = first.scenario.region.has_striker();
         Ok(Sweep {
+            grid,
+            series,
+            file: file.to_path_buf(),
             shares: ShareSet {
                 striker,
                 dissipative,
             },
-            ..sweep
+            units: Units::Scaled,
         })
     }
 
@@ -162,12 +147,12 @@ impl Sweep {
 
     /// Number of grid points.
     pub fn count(&self) -> usize {
-        point_count(&self.axes)
+        self.grid.count()
     }
 
     /// The axis values of point `index`.
     pub fn values(&self, index: usize) -> Vec<AxisValue> {
-        point(&self.axes, index)
+        self.grid.values(index)
     }
 
     /// The validated scene of point `index`.
@@ -178,40 +163,16 @@ impl Sweep {
     /// The validated scene at arbitrary axis `values` (one per axis, in order), optionally with
     /// `run.tolerance` replaced (an optimiser's refinement runs between grid points, tighter).
     pub fn scene_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<Scene> {
-        let table = self.table_with(values, tolerance)?;
-        woodpile_scene::from_table(table, &self.file)
-            .map_err(|e| PipelineError::scene(&self.file, "scene", e, &self.at(values)))
-    }
-
-    /// ` (at eps = 1, L = 2)` for messages about the point at `values`.
-    fn at(&self, values: &[AxisValue]) -> String {
-        woodpile_scene::grid::at_point(&self.axes, values)
+        self.grid
+            .scene_with(values, tolerance)
+            .map_err(|e| grid_error(&self.file, e))
     }
 
     /// The scene table at `values` (a scene file's content), before validation.
     pub fn table_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<toml::Table> {
-        let mut table = self
-            .template
-            .instantiate(&self.axes, values)
-            .map_err(|(key, reason)| self.error(key, reason + &self.at(values)))?;
-        if let Some(tol) = tolerance {
-            let run = table
-                .entry("run")
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            if let toml::Value::Table(run) = run {
-                run.insert("tolerance".into(), toml::Value::Float(tol));
-            }
-        }
-        Ok(table)
-    }
-
-    fn error(&self, key: String, reason: String) -> PipelineError {
-        PipelineError::Definition {
-            file: self.file.clone(),
-            key,
-            reason,
-            source: None,
-        }
+        self.grid
+            .table_with(values, tolerance)
+            .map_err(|e| grid_error(&self.file, e))
     }
 
     /// Every point's scene and cache key, in grid order.
@@ -279,8 +240,14 @@ impl Sweep {
         if self.units == Units::Scaled {
             return Ok(None);
         }
-        SiFactors::of(&self.scene_at(index)?, self.units)
-            .map_err(|reason| self.error("units".into(), reason + &self.at(&self.values(index))))
+        SiFactors::of(&self.scene_at(index)?, self.units).map_err(|reason| {
+            PipelineError::Definition {
+                file: self.file.clone(),
+                key: "units".into(),
+                reason: reason + &self.grid.at(&self.values(index)),
+                source: None,
+            }
+        })
     }
 
     /// Writes its table's `units` and `column_units` into `summary`.
@@ -301,10 +268,26 @@ impl Sweep {
     /// What every row of its table shares.
     fn shape(&self) -> SweepShape<'_> {
         SweepShape {
-            axes: &self.axes,
+            axes: &self.grid.axes,
             shares: self.shares,
             kinetic: self.series == Shares::Kinetic,
         }
+    }
+}
+
+/// A grid's error as the pipeline words it, naming the stage `file`: a scene's key under
+/// `scene.`, a template's key as written, the memory against `axes`.
+fn grid_error(file: &std::path::Path, e: GridError) -> PipelineError {
+    let definition = |key: String, reason: String| PipelineError::Definition {
+        file: file.to_path_buf(),
+        key,
+        reason,
+        source: None,
+    };
+    match e {
+        GridError::Template { key, reason } => definition(key, reason),
+        GridError::Scene { error, at } => PipelineError::scene(file, "scene", error, &at),
+        GridError::Memory(reason) => definition("axes".into(), reason),
     }
 }
 
@@ -399,7 +382,7 @@ impl PointGrid for Sweep {
         let mut summary = json!({
             "points": stats.points,
             "failed": stats.failed,
-            "axes": self.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
+            "axes": self.grid.axes.iter().map(|a| a.name.clone()).collect::<Vec<_>>(),
             "method": match first.method { MethodChoice::Auto => "auto", MethodChoice::Named(m) => m.name() },
             "tolerance": first.accuracy.tolerance,
             "dt": first.accuracy.dt,

@@ -106,7 +106,7 @@ impl Optimize {
     /// Checks `over` against the sweep: float axes only.
     pub(crate) fn check_axes(&self, sweep: &Sweep) -> Result<(), String> {
         for name in &self.over {
-            match sweep.axes.iter().find(|a| &a.name == name) {
+            match sweep.grid.axes.iter().find(|a| &a.name == name) {
                 None => return Err(format!("`{name}` is not an axis of the sweep")),
                 Some(a) if a.is_integer() => {
                     return Err(format!(
@@ -222,7 +222,7 @@ impl Optimize {
             .sensitivity
             .as_ref()
             .is_some_and(|s| s.iter().any(|&d| d > SHARP));
-        let axes = &search.sweep.axes;
+        let axes = &search.sweep.grid.axes;
         let edge: Vec<&str> = search
             .searched
             .iter()
@@ -265,7 +265,7 @@ impl Optimize {
         );
         for &k in searched {
             columns.f64(
-                &sweep.axes[k].name,
+                &sweep.grid.axes[k].name,
                 rows.iter().map(|r| Some(r.values[k].as_f64())).collect(),
             );
         }
@@ -281,7 +281,7 @@ impl Optimize {
             rows.iter().map(|r| Some(r.simulations as i64)).collect(),
         );
         for (slot, &k) in searched.iter().enumerate() {
-            let name = &sweep.axes[k].name;
+            let name = &sweep.grid.axes[k].name;
             columns.f64(
                 &format!("sensitivity_{name}"),
                 rows.iter()
@@ -320,6 +320,7 @@ fn grid_values_of(
     row: usize,
 ) -> std::result::Result<Vec<AxisValue>, PipelineError> {
     sweep
+        .grid
         .axes
         .iter()
         .map(|a| {

@@ -46,11 +46,11 @@ impl<'a> Search<'a> {
         let searched: Vec<usize> = optimize
             .over
             .iter()
-            .filter_map(|n| sweep.axes.iter().position(|a| &a.name == n))
+            .filter_map(|n| sweep.grid.axes.iter().position(|a| &a.name == n))
             .collect();
         let bounds = searched
             .iter()
-            .map(|&k| optimize.bounds_of(&sweep.axes[k]))
+            .map(|&k| optimize.bounds_of(&sweep.grid.axes[k]))
             .collect();
         Search {
             optimize,
