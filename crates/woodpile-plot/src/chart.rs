@@ -62,21 +62,43 @@ pub(crate) fn text<E: std::fmt::Debug>(e: E) -> String {
     format!("{e:?}")
 }
 
-/// Builds a chart on `area` over plot-space ranges, ticked by the scales, with its mesh drawn.
+/// One axis of a chart: its visible range in plot space, and the scale that maps values there.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AxisSpan {
+    /// The range's low end, in plot space.
+    pub lo: f64,
+    /// Its high end.
+    pub hi: f64,
+    /// How a value is placed on the axis and labelled.
+    pub scale: Scale,
+}
+
+/// Builds a chart on `area` over the axes `x` and `y`, ticked by their scales, with its mesh
+/// drawn.
 pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
     area: &'a DrawingArea<DB, Shift>,
-    (x0, x1, sx): (f64, f64, Scale),
-    (y0, y1, sy): (f64, f64, Scale),
+    x: AxisSpan,
+    y: AxisSpan,
     style: &Style,
     draw_mesh: Option<(&str, &str, bool)>,
 ) -> Result<Chart<'a, DB>, String> {
+    let AxisSpan {
+        lo: x0,
+        hi: x1,
+        scale: sx,
+    } = x;
+    let AxisSpan {
+        lo: y0,
+        hi: y1,
+        scale: sy,
+    } = y;
     let (w, h) = area.dim_in_pixel();
     let keep_minor = |(major, minor): (Vec<f64>, Vec<f64>)| {
         (major, if style.minor_grid { minor } else { Vec::new() })
     };
     let xticks = keep_minor(sx.ticks(x0, x1, ((w as f64 / style.pt(48.0)) as usize).clamp(3, 8)));
     let yticks = keep_minor(sy.ticks(y0, y1, ((h as f64 / style.pt(28.0)) as usize).clamp(3, 8)));
-    let right = right_margin(area, &xticks.0, (x0, x1, sx), style);
+    let right = right_margin(area, &xticks.0, x, style);
     let mut chart = ChartBuilder::on(area)
         .margin(style.pt(4.0) as u32)
         .margin_right(right)
@@ -112,9 +134,14 @@ pub(crate) fn chart<'a, DB: DrawingBackend + 'a>(
 fn right_margin<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     ticks: &[f64],
-    (x0, x1, sx): (f64, f64, Scale),
+    x: AxisSpan,
     style: &Style,
 ) -> u32 {
+    let AxisSpan {
+        lo: x0,
+        hi: x1,
+        scale: sx,
+    } = x;
     let usual = style.pt(4.0);
     let Some(&last) = ticks.last() else {
         return usual as u32;

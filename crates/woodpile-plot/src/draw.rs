@@ -5,8 +5,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::axis::Scale;
-use crate::chart::{chart, plot_rect, text, wrap, FONT};
+use crate::chart::{chart, plot_rect, text, wrap, AxisSpan, FONT};
 use crate::legend::{self, Entry, Glyph, Rect};
 use crate::panel::{inside_place, mark_entries, marks, pixel_curves, range, Ranges, Shared};
 use crate::style::{Corner, Legend, Style};
@@ -221,7 +220,18 @@ fn lines_panel<DB: DrawingBackend>(
     if x1 <= x0 || x0.is_nan() || x1.is_nan() {
         (x0, x1) = (x0 - 0.5, x0 + 0.5);
     }
-    let (xs, ys) = ((x0, x1, sx), (y0, y1, sy));
+    let (xs, ys) = (
+        AxisSpan {
+            lo: x0,
+            hi: x1,
+            scale: sx,
+        },
+        AxisSpan {
+            lo: y0,
+            hi: y1,
+            scale: sy,
+        },
+    );
     let curves: Vec<Vec<(f64, f64)>> = p
         .series
         .iter()
@@ -234,7 +244,7 @@ fn lines_panel<DB: DrawingBackend>(
         .collect();
     let entries = line_entries(p);
     let size = legend::measure(area, &entries, style);
-    let placement = line_legend_placement(area, p, (xs, ys), &curves, size, style)?;
+    let placement = line_legend_placement(area, p, [xs, ys], &curves, size, style)?;
     let gap = style.pt(4.0);
     let (main, side) = match placement {
         Legend::OutsideRight => {
@@ -312,7 +322,7 @@ fn line_entries(p: &LinePanel) -> Vec<Entry> {
 fn line_legend_placement<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &LinePanel,
-    (xs, ys): ((f64, f64, Scale), (f64, f64, Scale)),
+    [xs, ys]: [AxisSpan; 2],
     curves: &[Vec<(f64, f64)>],
     size: (f64, f64),
     style: &Style,

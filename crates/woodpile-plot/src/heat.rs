@@ -6,7 +6,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::axis::Scale;
-use crate::chart::{chart, pixel, plot_rect, text, Chart, Ticked, FONT};
+use crate::chart::{chart, pixel, plot_rect, text, AxisSpan, Chart, Ticked, FONT};
 use crate::colour::{diverging, viridis, Dash, Marker, CATEGORIES};
 use crate::legend::{self, Entry, Glyph, Rect};
 use crate::panel::{inside_place, mark_entries, marks, pixel_curves, Ranges, Shared};
@@ -117,9 +117,9 @@ fn raster(
     h: &HeatPanel,
     scale: &ColourScale<'_>,
     (w, hgt): (u32, u32),
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
+    [x, y]: [AxisSpan; 2],
 ) -> Vec<u8> {
+    let (x0, x1, y0, y1) = (x.lo, x.hi, y.lo, y.hi);
     let ex = drawn_edges(&plot_space(&h.xs, h.view.x_scale));
     let ey = drawn_edges(&plot_space(&h.ys, h.view.y_scale));
     let cell = |edges: &[f64], v: f64| -> Option<usize> {
@@ -162,16 +162,20 @@ pub(crate) fn panel<DB: DrawingBackend>(
     let (main, bar, below) = panel_areas(area, h, style, own_bar);
     let ((x0, x1), (y0, y1)) = shared.apply(&h.view, ranges(h));
     let scale = ColourScale::of(h);
-    let chart = chart(
-        &main,
-        (x0, x1, sx),
-        (y0, y1, sy),
-        style,
-        Some((&h.x_label, &h.y_label, false)),
-    )?;
+    let x = AxisSpan {
+        lo: x0,
+        hi: x1,
+        scale: sx,
+    };
+    let y = AxisSpan {
+        lo: y0,
+        hi: y1,
+        scale: sy,
+    };
+    let chart = chart(&main, x, y, style, Some((&h.x_label, &h.y_label, false)))?;
     let size = chart.plotting_area().dim_in_pixel();
     if size.0 > 0 && size.1 > 0 {
-        let pixels = raster(h, &scale, size, (x0, x1), (y0, y1));
+        let pixels = raster(h, &scale, size, [x, y]);
         let image = BitMapElement::with_owned_buffer((x0, y1), size, pixels)
             .ok_or("heat-map raster of the wrong size")?;
         chart.plotting_area().draw(&image).map_err(text)?;

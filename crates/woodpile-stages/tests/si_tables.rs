@@ -36,6 +36,16 @@ fn sweep(velocity_axis: &str) -> String {
         )
 }
 
+/// A reduce stage reading `sweep` at `at` (TOML: a number, or a quoted time with a unit).
+fn reduce_at(at: &str) -> String {
+    format!("kind = \"reduce\"\ninputs = [\"sweep\"]\nat = {at}\n")
+}
+
+/// `text`, a sweep stage, with `units = "SI"`.
+fn in_si(text: &str) -> String {
+    text.replace("kind = \"sweep\"", "kind = \"sweep\"\nunits = \"SI\"")
+}
+
 /// The scene of `SWEEP`'s point `K`, striker speed 1 m/s.
 fn point_scene(stiffness: f64) -> woodpile_scene::Scene {
     let text = SWEEP
@@ -53,7 +63,7 @@ fn point_scene(stiffness: f64) -> woodpile_scene::Scene {
 
 #[test]
 fn a_si_sweep_gives_seconds_and_joules_and_the_same_shares() {
-    let si = sweep("").replace("kind = \"sweep\"", "kind = \"sweep\"\nunits = \"SI\"");
+    let si = in_si(&sweep(""));
     let p = Project::new(&[("scaled", &sweep("")), ("si", &si)]);
     p.run(&[]).unwrap();
     let (scaled, scaled_manifest) = table::read_with_manifest(&p.output("scaled")).unwrap();
@@ -96,7 +106,7 @@ fn a_figure_labels_a_sweep_in_the_units_its_table_has() {
         error.contains("names µs") && error.contains("scaled units"),
         "{error}"
     );
-    let si = sweep("").replace("kind = \"sweep\"", "kind = \"sweep\"\nunits = \"SI\"");
+    let si = in_si(&sweep(""));
     let p = Project::new(&[("sweep", &si), ("figure", figure)]);
     p.run(&[]).unwrap();
     let table = table::read(&p.output("sweep")).unwrap();
@@ -128,13 +138,7 @@ fn si_is_refused_on_a_scene_without_scales() {
 
 #[test]
 fn a_time_with_a_unit_reads_the_sample_that_many_seconds_in() {
-    let p = Project::new(&[
-        ("sweep", &sweep("")),
-        (
-            "reduce",
-            "kind = \"reduce\"\ninputs = [\"sweep\"]\nat = \"50 us\"\n",
-        ),
-    ]);
+    let p = Project::new(&[("sweep", &sweep("")), ("reduce", &reduce_at("\"50 us\""))]);
     p.run(&[]).unwrap();
     let frame = table::read(&p.output("reduce")).unwrap();
     let t = table::f64_column(&frame, "t").unwrap();
@@ -157,20 +161,11 @@ fn a_time_with_a_unit_reads_the_sample_that_many_seconds_in() {
 fn a_time_with_a_unit_is_refused_without_one_time_scale() {
     let p = Project::new(&[
         ("sweep", &sweep("V = [1.0, 2.0]\n")),
-        (
-            "reduce",
-            "kind = \"reduce\"\ninputs = [\"sweep\"]\nat = \"50 us\"\n",
-        ),
+        ("reduce", &reduce_at("\"50 us\"")),
     ]);
     let error = p.run(&[]).unwrap_err().to_string();
     assert!(error.contains("time scales"), "{error}");
-    let error = common::load_error(&[
-        ("sweep", &sweep("")),
-        (
-            "reduce",
-            "kind = \"reduce\"\ninputs = [\"sweep\"]\nat = \"50 m\"\n",
-        ),
-    ]);
+    let error = common::load_error(&[("sweep", &sweep("")), ("reduce", &reduce_at("\"50 m\""))]);
     assert!(error.contains("key `at`"), "{error}");
 }
 
@@ -178,10 +173,8 @@ fn a_time_with_a_unit_is_refused_without_one_time_scale() {
 /// speed (one time scale a point) can be read at "50 us"; a bare number is refused there.
 #[test]
 fn an_si_sweep_is_read_at_seconds_whatever_its_points_time_scales() {
-    let si =
-        sweep("V = [1.0, 2.0]\n").replace("kind = \"sweep\"", "kind = \"sweep\"\nunits = \"SI\"");
-    let reduce = |at: &str| format!("kind = \"reduce\"\ninputs = [\"sweep\"]\nat = {at}\n");
-    let p = Project::new(&[("sweep", &si), ("reduce", &reduce("\"50 us\""))]);
+    let si = in_si(&sweep("V = [1.0, 2.0]\n"));
+    let p = Project::new(&[("sweep", &si), ("reduce", &reduce_at("\"50 us\""))]);
     p.run(&[]).unwrap();
     let frame = table::read(&p.output("reduce")).unwrap();
     let t = table::f64_column(&frame, "t").unwrap();
@@ -189,7 +182,7 @@ fn an_si_sweep_is_read_at_seconds_whatever_its_points_time_scales() {
     for value in t {
         assert!((value.unwrap() / 50e-6 - 1.0).abs() < 1e-9, "{value:?}");
     }
-    let p = Project::new(&[("sweep", &si), ("reduce", &reduce("5.0"))]);
+    let p = Project::new(&[("sweep", &si), ("reduce", &reduce_at("5.0"))]);
     let error = p.run(&[]).unwrap_err().to_string();
     assert!(
         error.contains("is in SI") && error.contains("with a unit"),
