@@ -25,9 +25,10 @@ python: ## Install the Python package into .venv, as the README says (pip instal
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check ./python
 
+# The package is installed as `make python` installs it, plus the test-only entry points
+# (the Python crate's feature `testing`), which the wheel and `pip install ./python` leave out.
 python-test: build ## The Python package's tests and the quickstart notebook, in .venv (Pipeline drives this clone's woodpile)
 	test -x $(PY) || python3 -m venv $(VENV)
-	# The package as `make python` installs it, with the test-only entry points (feature `testing`).
 	MATURIN_PEP517_ARGS="--features testing" $(PY) -m pip install --quiet --disable-pip-version-check ./python
 	$(PY) -m pip install --quiet --disable-pip-version-check pytest matplotlib nbclient nbformat ipykernel scipy
 	WOODPILE_BIN=$(abspath $(WOODPILE)) $(PY) -m pytest -q -p no:cacheprovider python/tests

@@ -77,6 +77,11 @@ impl SceneGrid {
         at_point(&self.axes, values)
     }
 
+    /// What its scenes are named in messages.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
     /// The template.
     pub fn template(&self) -> &Template {
         &self.template

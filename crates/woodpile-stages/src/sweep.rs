@@ -33,7 +33,6 @@
 //! and the reason in `failure`: a failure is reported, never written as a number.
 
 use std::collections::HashMap;
-use std::path::PathBuf;
 
 use polars::prelude::DataFrame;
 use rayon::prelude::*;
@@ -67,7 +66,6 @@ pub struct Sweep {
     pub grid: SceneGrid,
     /// Which energy the recorded fractions split.
     pub series: Shares,
-    file: PathBuf,
     /// The shares its table has: `S` when its scenes have a striker, `D` when its scene
     /// declares dissipation (on every row, a point that loses nothing showing 0).
     shares: ShareSet,
@@ -131,7 +129,6 @@ impl Sweep {
         Ok(Sweep {
             grid,
             series,
-            file: file.to_path_buf(),
             shares: ShareSet {
                 striker,
                 dissipative,
@@ -165,14 +162,14 @@ impl Sweep {
     pub fn scene_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<Scene> {
         self.grid
             .scene_with(values, tolerance)
-            .map_err(|e| grid_error(&self.file, e))
+            .map_err(|e| grid_error(self.grid.file(), e))
     }
 
     /// The scene table at `values` (a scene file's content), before validation.
     pub fn table_with(&self, values: &[AxisValue], tolerance: Option<f64>) -> Result<toml::Table> {
         self.grid
             .table_with(values, tolerance)
-            .map_err(|e| grid_error(&self.file, e))
+            .map_err(|e| grid_error(self.grid.file(), e))
     }
 
     /// Every point's scene and cache key, in grid order.
@@ -242,7 +239,7 @@ impl Sweep {
         }
         SiFactors::of(&self.scene_at(index)?, self.units).map_err(|reason| {
             PipelineError::Definition {
-                file: self.file.clone(),
+                file: self.grid.file().to_path_buf(),
                 key: "units".into(),
                 reason: reason + &self.grid.at(&self.values(index)),
                 source: None,

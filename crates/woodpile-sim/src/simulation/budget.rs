@@ -73,8 +73,14 @@ pub fn forecast(scenario: &Scenario) -> Option<Forecast> {
         // The coarse run once, then fine runs at dt, dt/2, ...: 0.5 + (2^rungs - 1) first-rung
         // fine runs of the first rung's 1.5.
         whole_ladder_s: rung / 1.5 * (0.5 + 2f64.powf(rungs) - 1.0),
-        halvings_likely: model.damping().is_some_and(|d| d.has_contact_dashpot()),
+        halvings_likely: halvings_likely(model),
     })
+}
+
+/// Whether `auto`'s halvings are likely on `model` ([`Forecast::halvings_likely`]): it has a
+/// contact dashpot.
+fn halvings_likely(model: &crate::Model) -> bool {
+    model.damping().is_some_and(|d| d.has_contact_dashpot())
 }
 
 /// Most samples one run may record: each sample keeps five numbers per observer, so a
@@ -133,7 +139,7 @@ pub fn check(scenario: &Scenario) -> Result<(), SimError> {
 /// finest rung would take more steps than the budget: the ladder would otherwise spend every
 /// rung before it (half the finest's steps, then a quarter, ...) to be stopped at the last.
 fn finest_rung_affordable(scenario: &Scenario, dt: f64, steps: f64) -> Result<(), SimError> {
-    let likely = forecast(scenario).is_some_and(|f| f.halvings_likely);
+    let likely = scenario.method == MethodChoice::Auto && halvings_likely(&scenario.model);
     let halving = 2f64.powi(super::MAX_HALVINGS as i32);
     if !likely || steps * halving <= MAX_STEPS as f64 {
         return Ok(());
