@@ -7,7 +7,7 @@
 
 mod common;
 
-use common::{invalid_key, parting_restitution, scene};
+use common::{collision_run, invalid_key, parting_restitution, scene};
 use woodpile_scene::Scene;
 use woodpile_sim::simulation::simulate;
 
@@ -30,14 +30,8 @@ contact = 2.0
 restitution = {{ e = {e:?}, velocity = {v:?} }}
 [damping]
 law = "{law}"
-[run]
-t_end = {t_end:?}
-method = "rk4-contact"
-dt = {dt:?}
-sample_every = {t_end:?}
-"#,
-        t_end = 60.0 * v.powf(-0.2),
-        dt = 1e-4 * v.powf(-0.2),
+{run}"#,
+        run = collision_run(v, 60.0),
     ));
     let d = s.scenario.model.damping().unwrap();
     assert_eq!(d.contact_at(0), 0.0, "the wall keeps [damping] contact");

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{invalid_key, parting_restitution, scene};
+use common::{collision_run, invalid_key, parting_restitution, scene};
 
 /// Two free sites, the first struck at `v`, run past their parting; e from their velocities
 /// at the end: (v1 − v0) / v.
@@ -23,15 +23,8 @@ velocity = {v:?}
 [damping]
 law = "{law}"
 restitution = {{ e = {e:?}, velocity = {v:?} }}
-[run]
-t_end = {t_end:?}
-method = "rk4-contact"
-dt = {dt:?}
-sample_every = {t_end:?}
-"#,
-        // The elastic contact lasts about 3 c_max / v with c_max ~ v^{4/5}: end well after it.
-        t_end = 40.0 * v.powf(-0.2),
-        dt = 1e-4 * v.powf(-0.2),
+{run}"#,
+        run = collision_run(v, 40.0),
     ));
     parting_restitution(&s, v)
 }

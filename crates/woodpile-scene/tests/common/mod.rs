@@ -23,6 +23,15 @@ pub fn parting_restitution(scene: &Scene, v: f64) -> f64 {
     (v1 - v0) / v
 }
 
+/// The `[run]` table of a two-body collision at `v` simulated past its parting: `rk4-contact`
+/// at a step fine enough for e to 1e-6, to t_end = `lasting` · v^{-1/5} (the elastic contact
+/// lasts about 3 c_max / v with c_max ~ v^{4/5}), sampled at its end only.
+pub fn collision_run(v: f64, lasting: f64) -> String {
+    let t_end = lasting * v.powf(-0.2);
+    let dt = 1e-4 * v.powf(-0.2);
+    format!("[run]\nt_end = {t_end:?}\nmethod = \"rk4-contact\"\ndt = {dt:?}\nsample_every = {t_end:?}\n")
+}
+
 /// The key a scene file `text` is refused for (it must be refused for an invalid key).
 pub fn invalid_key(text: &str) -> String {
     match parse(text, Path::new("s.toml")) {
