@@ -66,8 +66,9 @@ docs: ## Regenerate docs/stage-kinds.md and the README's accuracy captions
 
 test: rust-test python-test ## Run the whole test suite: Rust, then Python (what CI runs)
 
-rust-test: ## The Rust tests (release profile, shared with `figures`)
+rust-test: ## The Rust tests (release profile, shared with `figures`), and the bench's independent reference's
 	$(CARGO) test --workspace --release --exclude woodpile-bench --exclude woodpile-py
+	$(CARGO) test --release -p woodpile-bench --test independent_reference
 
 figures: build ## Bring every stale stage up to date (nothing runs when all are fresh)
 	$(WOODPILE) run

@@ -3,6 +3,7 @@
 //! with one linear defect eps = 10, kappa = 1 at site 0, the scene of the C and numba
 //! timings (`baseline/`).
 
+pub mod independent;
 pub mod paper;
 pub mod sweeps;
 

@@ -169,6 +169,31 @@ const E5: [f64; STAGES] = [
     -0.223_553_078_638_862_952_588_442_784_5e-1,
 ];
 
+/// DOP853's tableau, for a driver that brings its own right-hand side: the bench's
+/// independent reference of damped chains integrates its own force code with it.
+#[derive(Debug, Clone, Copy)]
+pub struct Dop853Tableau {
+    /// Stage coefficients a_ij, row i holding j < i.
+    pub a: &'static [&'static [f64]; STAGES],
+    /// The 8th-order weights b.
+    pub b: &'static [f64; STAGES],
+    /// The nodes c.
+    pub c: &'static [f64; STAGES],
+    /// b minus the 3rd-order weights.
+    pub e3: &'static [f64; STAGES],
+    /// b minus the 5th-order weights.
+    pub e5: &'static [f64; STAGES],
+}
+
+/// The coefficients [`Dop853`] steps with.
+pub const DOP853_TABLEAU: Dop853Tableau = Dop853Tableau {
+    a: &A,
+    b: &B,
+    c: &C,
+    e3: &E3,
+    e5: &E5,
+};
+
 /// The adaptive DOP853 stepper with its tolerances and scratch.
 #[derive(Debug, Clone)]
 pub struct Dop853 {

@@ -34,7 +34,7 @@ mod stage_sum;
 mod symplectic;
 
 pub use active_sites::ActiveSites;
-pub use dop853::Dop853;
+pub use dop853::{Dop853, Dop853Tableau, DOP853_TABLEAU};
 pub use driver::{drive, intervals, END_ARRIVAL_SPEED};
 pub use method::{Method, MethodChoice};
 pub use plan::{
