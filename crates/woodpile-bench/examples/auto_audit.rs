@@ -24,12 +24,16 @@
 //! DOP853 at rtol 1e-13 with every contact switch located, checked against itself at 1e-12
 //! (the difference is reported as the bound).
 //!
+//! With `--linear-losses` first, the damped scenes without their contact dashpots
+//! (`woodpile_sim::testing::linear_losses_audit_scene`): `auto` splits the slow ones' losses
+//! from its step (`rkn6-split`); the same independent reference.
+//!
 //! With `--linear` first, the scenes are the plain ones with every resonator made linear and
 //! constant (`woodpile_sim::testing::linear_audit_scene`): the paper's kind of scene, judged
 //! without the stricter rules of a nonlinear or ramped resonator.
 //!
 //! ```text
-//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear | --gravity] SCENES [SEED [TOLERANCES [ONLY]]]]
+//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear-losses | --linear | --gravity] SCENES [SEED [TOLERANCES [ONLY]]]]
 //! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
@@ -41,7 +45,8 @@ use woodpile_sim::model::Coupling;
 use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{
     audit_scene, chain_audit_scene, damped_audit_scene, fixed_dt, gravity_audit_scene,
-    linear_audit_scene, tolerance, Lcg, AUDIT_REFERENCE_DT as REFERENCE_DT,
+    linear_audit_scene, linear_losses_audit_scene, tolerance, Lcg,
+    AUDIT_REFERENCE_DT as REFERENCE_DT,
 };
 use woodpile_sim::SimError;
 
@@ -102,7 +107,10 @@ fn audit(k: usize, scene: &Scenario, tolerances: &[f64]) -> Audit {
                 let error = out.fractions.largest_difference(&reference);
                 let estimate = out.error_estimate.unwrap_or(f64::NAN);
                 evals.push(out.total_rhs_evals);
-                cells.push(format!("{tol:.0e}: err {error:.1e} est {estimate:.1e}"));
+                cells.push(format!(
+                    "{tol:.0e}: err {error:.1e} est {estimate:.1e} ({})",
+                    out.plan.method.name()
+                ));
                 if error > tol + reference_error {
                     verdicts.push(Verdict::Miss { error, estimate });
                 } else {
@@ -167,6 +175,10 @@ fn main() {
         Some("--damped") => {
             args.next();
             damped_audit_scene
+        }
+        Some("--linear-losses") => {
+            args.next();
+            linear_losses_audit_scene
         }
         Some("--linear") => {
             args.next();

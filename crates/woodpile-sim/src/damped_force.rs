@@ -149,6 +149,33 @@ impl Model {
             .fold(0.0, |rate, (_, r)| rate.max(r))
     }
 
+    /// The fastest rate, 1/time, at which the losses that act on velocities alone damp a
+    /// motion: a soft end's dashpot d/m, ground damping g/m (on the lightest site), a
+    /// resonator's dashpot c (1/m + 1/ε). 0 without any. What decides whether `auto` may split
+    /// them from the conservative step ([`crate::integrate::Plan::choose`]).
+    pub fn linear_loss_rate(&self) -> f64 {
+        let n = self.n_sites();
+        let ends = [
+            (0, self.boundary().left()),
+            (n - 1, self.boundary().right()),
+        ];
+        let soft = ends
+            .into_iter()
+            .filter_map(|(site, end)| end.soft().map(|(_, d)| d * self.inv_mass()[site]));
+        let Some(d) = self.damping() else {
+            return soft.fold(0.0, f64::max);
+        };
+        let lightest = self.inv_mass()[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
+        let resonators = self
+            .resonators()
+            .iter()
+            .enumerate()
+            .map(|(j, r)| d.resonator(j) * (self.inv_mass()[r.site] + 1.0 / r.eps));
+        soft.chain([d.ground * lightest])
+            .chain(resonators)
+            .fold(0.0, f64::max)
+    }
+
     /// What acts fastest among the chain's dashpots and soft ends in a motion of total
     /// energy `energy`, and its rate ([`Model::max_dissipation_rate`]): what a scene whose
     /// step they set is told to change. `None` when the chain has none of them.

@@ -29,6 +29,7 @@ mod rk;
 mod rk4_fused;
 mod rkn;
 mod rkn4;
+mod split_losses;
 mod stage_step;
 mod stage_sum;
 mod symplectic;
@@ -39,12 +40,13 @@ pub use driver::{drive, intervals, END_ARRIVAL_SPEED};
 pub use method::{Method, MethodChoice};
 pub use plan::{
     Accuracy, Plan, AUTO_METHOD, BLOW_UP_DRIFT, DISSIPATIVE_AUTO_METHOD, DRIFT_PER_TOL,
-    HARMONIC_AUTO_METHOD,
+    HARMONIC_AUTO_METHOD, LINEAR_LOSSES_AUTO_METHOD,
 };
 pub use rk::{ExplicitRk, Rk4, Tableau};
 pub use rk4_fused::Rk4Fused;
 pub use rkn::{ContactMode, Rkn, RknTableau, DPRKN6, NYSTROM4};
 pub use rkn4::Rkn4;
+pub use split_losses::SplitLosses;
 pub use symplectic::{Composition, SymplecticStepper, VERLET, YOSHIDA4, YOSHIDA6};
 
 use crate::model::{Model, Window};

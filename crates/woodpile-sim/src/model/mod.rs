@@ -159,6 +159,33 @@ impl Model {
         }
     }
 
+    /// Whether every loss acts on velocities alone and linearly (ground damping, resonator
+    /// dashpots, soft ends' dashpots): no contact dashpot, whose force starts with its contact
+    /// and is clipped against its spring's. Such losses have an exact flow that a method may
+    /// integrate apart from the conservative step ([`crate::integrate::SplitLosses`]).
+    pub fn losses_are_linear(&self) -> bool {
+        self.damping().is_none_or(|d| !d.has_contact_dashpot())
+    }
+
+    /// The same chain without its losses: no damping, and each soft end's dashpot removed (its
+    /// spring kept). What [`crate::integrate::SplitLosses`] steps between the losses' flows.
+    pub fn without_losses(&self) -> Model {
+        let strip = |end: End| match end {
+            End::Soft { spring, .. } => End::Soft {
+                spring,
+                damping: 0.0,
+            },
+            other => other,
+        };
+        let boundary = Boundary::ends(strip(self.boundary.left()), strip(self.boundary.right()));
+        Model {
+            boundary,
+            damping: None,
+            dissipative: false,
+            ..self.clone()
+        }
+    }
+
     /// The same chain with the contact law `law` instead of the paper's: one coefficient per
     /// bond (sites + 1, walls included), its exponent and its precompression. A
     /// precompression needs walls at both ends.
