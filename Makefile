@@ -91,12 +91,13 @@ read-check: ## Open every result table with pyarrow, pandas and polars
 
 BASELINE := $(or $(CARGO_TARGET_DIR),target)/baseline
 
-bench: build ## Speed (PREVIOUS=old/woodpile adds it, same run): woodpile against the C and numba RK4 baselines in one run (standard scene, paper sample, the five sweeps whole, the whole paper cold), batched against scalar scenes
+bench: build ## Speed (PREVIOUS=old/woodpile adds it, same run): woodpile against the C and numba RK4 baselines in one run (standard scene, paper sample, the five sweeps whole, the whole paper cold), batched against scalar scenes, damped against undamped
 	mkdir -p $(BASELINE)
 	gcc -O3 -march=x86-64-v3 -o $(BASELINE)/rk4_chain baseline/rk4_chain.c -lm
 	python3 -c 'import numba' 2>/dev/null || python3 -m pip install --quiet --disable-pip-version-check numba
 	$(CARGO) run --release -q -p woodpile-bench -- --c $(BASELINE)/rk4_chain --numba baseline/rk4_numba.py --numba-scenes baseline/rk4_numba_scenes.py --sweeps --whole-paper
 	$(CARGO) run --release -q -p woodpile-bench --example batch_lanes -- 16 0.215
+	$(CARGO) run --release -q -p woodpile-bench --example damped_cost -- 1e-8,1e-10,1e-11
 	$(MAKE) --no-print-directory unused-cost
 	@if [ -n "$(PREVIOUS)" ]; then \
 	  echo "this build against the previous release build $(PREVIOUS):"; \

@@ -124,6 +124,7 @@ impl Plan {
             return Err(SimError::VelocityForces {
                 method: method.name(),
                 methods: Method::with_velocity_forces()
+                    .filter(|&m| m != Method::Rkn6Split || model.losses_are_linear())
                     .map(Method::name)
                     .collect::<Vec<_>>()
                     .join(", "),
