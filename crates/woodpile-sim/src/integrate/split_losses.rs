@@ -49,13 +49,18 @@ pub struct SplitLosses {
     site_masses: Vec<f64>,
     pairs: Vec<PairDashpot>,
     decay: Decay,
-    /// The velocities and D before a step, restored if the conservative step is rejected.
+    /// The window's velocities and D before a step, restored if the conservative step is
+    /// rejected.
     saved: Vec<f64>,
 }
 
 impl SplitLosses {
     /// The stepper for `model`, whose losses must be linear ([`Model::losses_are_linear`]).
     pub fn new(model: &Model) -> SplitLosses {
+        assert!(
+            model.losses_are_linear(),
+            "rkn6-split cannot integrate a contact dashpot (Plan::choose refuses it)"
+        );
         let conservative = model.without_losses();
         let n = model.n_sites();
         let damping = model.damping();
@@ -116,12 +121,15 @@ impl SplitLosses {
     }
 
     /// The losses' exact flow over the half-step of [`SplitLosses::decay_over`] on the
-    /// velocities `v`, sites first or (`reverse`) resonator pairs first, so that the step is
-    /// symmetric; the kinetic energy it removes. Sites outside `window` are at rest.
+    /// velocities `v`: sites, then each resonator pair in turn; or (`reverse`) the same flows
+    /// in the opposite order, pairs last to first, then sites. The step is then a palindrome,
+    /// which is what makes it order 2: two dashpots on one host do not commute, and repeating
+    /// their order would leave the method at order 1. The kinetic energy it removes. Sites
+    /// outside `window` are at rest.
     fn flow(&self, v: &mut [f64], window: Window, reverse: bool) -> f64 {
         match reverse {
-            false => self.site_flow(v, window) + self.pair_flow(v),
-            true => self.pair_flow(v) + self.site_flow(v, window),
+            false => self.site_flow(v, window) + self.pair_flow(v, false),
+            true => self.pair_flow(v, true) + self.site_flow(v, window),
         }
     }
 
@@ -143,9 +151,14 @@ impl SplitLosses {
         0.5 * removed
     }
 
-    fn pair_flow(&self, v: &mut [f64]) -> f64 {
+    fn pair_flow(&self, v: &mut [f64], reverse: bool) -> f64 {
         let mut removed = 0.0;
-        for (p, &decay) in self.pairs.iter().zip(&self.decay.pairs) {
+        let pairs = self.pairs.iter().zip(&self.decay.pairs);
+        let ordered: Box<dyn Iterator<Item = _>> = match reverse {
+            false => Box::new(pairs),
+            true => Box::new(pairs.rev()),
+        };
+        for (p, &decay) in ordered {
             let (host, inner) = (v[p.host], v[p.inner]);
             let (m, e) = p.masses;
             let centre = (m * host + e * inner) / (m + e);
@@ -167,16 +180,26 @@ impl Stepper for SplitLosses {
         Method::Rkn6Split.name()
     }
 
-    fn step(&mut self, _model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
+    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
         let n_dof = self.conservative.n_dof();
+        // What the flows change: the window's velocities and D (the fixed-step Nyström step
+        // never rejects, but a rejection must leave the state as it was).
+        let changed = &span.window.state_ranges(model)[2..];
         self.saved.clear();
-        self.saved.extend_from_slice(&y[n_dof..]);
+        for range in changed {
+            self.saved.extend_from_slice(&y[range.clone()]);
+        }
         self.decay_over(0.5 * span.h);
         let (state, dissipated) = y.split_at_mut(2 * n_dof);
         let mut removed = self.flow(&mut state[n_dof..], span.window, false);
         let outcome = self.inner.step(&self.conservative, state, span);
         if let StepOutcome::Rejected { .. } = outcome {
-            y[n_dof..].copy_from_slice(&self.saved);
+            let mut saved = self.saved.as_slice();
+            for range in changed {
+                let (part, rest) = saved.split_at(range.len());
+                y[range.clone()].copy_from_slice(part);
+                saved = rest;
+            }
             return outcome;
         }
         removed += self.flow(&mut state[n_dof..], span.window, true);

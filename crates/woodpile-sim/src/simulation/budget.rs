@@ -59,7 +59,8 @@ pub fn forecast(scenario: &Scenario) -> Option<Forecast> {
     let steps = (scenario.t_end / dt).max(intervals(scenario.t_end, scenario.sample_every) as f64);
     let sites = scenario.model.n_dof();
     let model = &scenario.model;
-    let per_site_step = match model.is_dissipative() {
+    // `rkn6-split` steps the conservative chain, its exact flows a few products per site.
+    let per_site_step = match model.is_dissipative() && plan.method != Method::Rkn6Split {
         true => DAMPED_SECONDS_PER_SITE_STEP,
         false => SECONDS_PER_SITE_STEP,
     };
