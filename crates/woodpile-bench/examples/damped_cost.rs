@@ -11,26 +11,13 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
-use std::path::Path;
 use std::time::Instant;
 use woodpile_bench::independent::reference;
+use woodpile_bench::standard_scene_with;
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::simulation::{simulate, Outcome, Scenario};
 use woodpile_sim::testing::tolerance;
 use woodpile_sim::SimError;
-
-/// The standard scene (`scenes/single_eps10.toml`) with `defect` added to its resonator and
-/// `tail` to the file.
-fn standard(defect: &str, tail: &str) -> Scenario {
-    let text = format!(
-        "[chain]\nn = 100\nboundary = \"fixed\"\n[impulse]\nsite = -25\nvelocity = 1.0\n\
-         [[defect]]\nsite = 0\neps = 10.0\nkappa = 1.0\np = 1\n{defect}\n\
-         [run]\nt_end = 150.0\nmethod = \"auto\"\ntolerance = 1e-8\n{tail}"
-    );
-    woodpile_scene::parse(&text, Path::new("damped_cost.toml"))
-        .unwrap()
-        .scenario
-}
 
 /// The median wall time of five runs, in ms, and the last run's outcome, or why the run
 /// failed.
@@ -51,22 +38,22 @@ fn main() {
         s.split(',').map(|t| t.parse().unwrap()).collect()
     });
     let rows = [
-        ("undamped", standard("", "")),
+        ("undamped", standard_scene_with("", "")),
         (
             "resonator quality_factor = 300",
-            standard("quality_factor = 300.0", ""),
+            standard_scene_with("quality_factor = 300.0", ""),
         ),
         (
             "[damping] ground = 0.001",
-            standard("", "[damping]\nground = 0.001"),
+            standard_scene_with("", "[damping]\nground = 0.001"),
         ),
         (
             "[damping] contact = 0.05, hertzian",
-            standard("", "[damping]\ncontact = 0.05\nlaw = \"hertzian\""),
+            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"hertzian\""),
         ),
         (
             "[damping] contact = 0.05, linear",
-            standard("", "[damping]\ncontact = 0.05\nlaw = \"linear\""),
+            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"linear\""),
         ),
     ];
     println!("| scene | method | ms (median of 5) | against undamped | evaluations | error against the independent reference |");

@@ -13,9 +13,9 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
-use std::path::Path;
 use std::time::Instant;
 use woodpile_bench::independent::reference;
+use woodpile_bench::standard_scene_with;
 use woodpile_sim::energy::{energy_density, Fractions};
 use woodpile_sim::integrate::{
     drive, ContactMode, DriveConfig, Rkn, StepControl, StepOutcome, StepSpan, Stepper, DPRKN6,
@@ -113,18 +113,6 @@ impl Stepper for Split<'_> {
     }
 }
 
-/// The standard scene with `defect` added to its resonator and `tail` to the file.
-fn standard(defect: &str, tail: &str) -> Scenario {
-    let text = format!(
-        "[chain]\nn = 100\nboundary = \"fixed\"\n[impulse]\nsite = -25\nvelocity = 1.0\n\
-         [[defect]]\nsite = 0\neps = 10.0\nkappa = 1.0\np = 1\n{defect}\n\
-         [run]\nt_end = 150.0\nmethod = \"auto\"\ntolerance = 1e-8\n{tail}"
-    );
-    woodpile_scene::parse(&text, Path::new("damped_split.toml"))
-        .unwrap()
-        .scenario
-}
-
 /// `scene` by the split method at step `dt`: its fractions and wall time in ms.
 fn split_run(scene: &Scenario, dt: f64) -> (Fractions, f64) {
     let damped = &scene.model;
@@ -184,7 +172,7 @@ fn split_run(scene: &Scenario, dt: f64) -> (Fractions, f64) {
 }
 
 fn main() {
-    let undamped = standard("", "");
+    let undamped = standard_scene_with("", "");
     let clock = Instant::now();
     simulate(&undamped, &mut ()).unwrap();
     let undamped_ms = clock.elapsed().as_secs_f64() * 1e3;
@@ -192,15 +180,15 @@ fn main() {
     let rows = [
         (
             "resonator quality_factor = 300",
-            standard("quality_factor = 300.0", ""),
+            standard_scene_with("quality_factor = 300.0", ""),
         ),
         (
             "[damping] ground = 0.001",
-            standard("", "[damping]\nground = 0.001"),
+            standard_scene_with("", "[damping]\nground = 0.001"),
         ),
         (
             "[damping] ground = 0.01",
-            standard("", "[damping]\nground = 0.01"),
+            standard_scene_with("", "[damping]\nground = 0.01"),
         ),
     ];
     for (name, scene) in &rows {

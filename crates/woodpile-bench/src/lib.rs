@@ -19,6 +19,20 @@ pub fn standard_scene(method: MethodChoice, accuracy: Accuracy) -> Scenario {
     paper_scene(&[PaperDefect::linear(0, 10.0, 1.0)], method, accuracy)
 }
 
+/// The standard scene as a scene file, `defect` added to its resonator's table and `tail` to
+/// the file, resolved: how the damped measurements add one kind of loss at a time.
+pub fn standard_scene_with(defect: &str, tail: &str) -> Scenario {
+    let text = format!(
+        "[chain]\nn = 100\nboundary = \"fixed\"\n[impulse]\nsite = -25\nvelocity = 1.0\n\
+         [[defect]]\nsite = 0\neps = 10.0\nkappa = 1.0\np = 1\n{defect}\n\
+         [run]\nt_end = 150.0\nmethod = \"auto\"\ntolerance = 1e-8\n{tail}"
+    );
+    match woodpile_scene::parse(&text, std::path::Path::new("standard_scene_with.toml")) {
+        Ok(scene) => scene.scenario,
+        Err(e) => panic!("the standard scene with {defect:?} and {tail:?}: {e}"),
+    }
+}
+
 /// The standard scene by a named fixed-step method at step `dt`.
 pub fn fixed(method: Method, dt: f64) -> Scenario {
     standard_scene(MethodChoice::Named(method), fixed_dt(dt))
