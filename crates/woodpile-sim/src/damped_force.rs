@@ -150,30 +150,12 @@ impl Model {
     }
 
     /// The fastest rate, 1/time, at which the losses that act on velocities alone damp a
-    /// motion: a soft end's dashpot d/m, ground damping g/m (on the lightest site), a
-    /// resonator's dashpot c (1/m + 1/ε). 0 without any. What decides whether `auto` may split
-    /// them from the conservative step ([`crate::integrate::Plan::choose`]).
+    /// motion ([`Model::linear_loss_rates`]); 0 without any. What decides whether `auto` may
+    /// split them from the conservative step ([`crate::integrate::Plan::choose`]).
     pub fn linear_loss_rate(&self) -> f64 {
-        let n = self.n_sites();
-        let ends = [
-            (0, self.boundary().left()),
-            (n - 1, self.boundary().right()),
-        ];
-        let soft = ends
+        self.linear_loss_rates()
             .into_iter()
-            .filter_map(|(site, end)| end.soft().map(|(_, d)| d * self.inv_mass()[site]));
-        let Some(d) = self.damping() else {
-            return soft.fold(0.0, f64::max);
-        };
-        let lightest = self.inv_mass()[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
-        let resonators = self
-            .resonators()
-            .iter()
-            .enumerate()
-            .map(|(j, r)| d.resonator(j) * (self.inv_mass()[r.site] + 1.0 / r.eps));
-        soft.chain([d.ground * lightest])
-            .chain(resonators)
-            .fold(0.0, f64::max)
+            .fold(0.0, |rate, (_, r)| rate.max(r))
     }
 
     /// What acts fastest among the chain's dashpots and soft ends in a motion of total
@@ -186,30 +168,19 @@ impl Model {
             .max_by(|a, b| a.1.total_cmp(&b.1))
     }
 
-    /// Each dashpot's and soft end's rate ([`Model::max_dissipation_rate`]), by what it is.
+    /// Each dashpot's and soft end's rate ([`Model::max_dissipation_rate`]), by what it is: a
+    /// soft end's spring, then the losses on velocities alone, then the contacts' dashpots.
     fn dissipation_rates(&self, energy: f64) -> Vec<(Dissipator, f64)> {
         let n = self.n_sites();
         let inv = |site: Option<usize>| site.map_or(0.0, |i| self.inv_mass()[i]);
-        let mut rates = Vec::new();
-        for (site, end) in [
-            (0, self.boundary().left()),
-            (n - 1, self.boundary().right()),
-        ] {
-            if let Some((spring, damping)) = end.soft() {
-                let inv_m = self.inv_mass()[site];
-                let rate = (spring * inv_m).sqrt().max(damping * inv_m);
-                rates.push((Dissipator::SoftEnd { last: site > 0 }, rate));
-            }
-        }
+        let mut rates: Vec<(Dissipator, f64)> = self
+            .each_soft_end()
+            .map(|(end, site, (spring, _))| (end, (spring * self.inv_mass()[site]).sqrt()))
+            .collect();
+        rates.extend(self.linear_loss_rates());
         let Some(d) = self.damping() else {
             return rates;
         };
-        let lightest = self.inv_mass()[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
-        rates.push((Dissipator::Ground, d.ground * lightest));
-        for (j, r) in self.resonators().iter().enumerate() {
-            let inv_pair = self.inv_mass()[r.site] + 1.0 / r.eps;
-            rates.push((Dissipator::Resonator(j), d.resonator(j) * inv_pair));
-        }
         if d.has_contact_dashpot() {
             for bond in 0..=n {
                 let pair = inv(bond.checked_sub(1)) + inv((bond < n).then_some(bond));
@@ -224,6 +195,38 @@ impl Model {
             }
         }
         rates
+    }
+
+    /// The rates of the losses that act on velocities alone, by what they are: each soft
+    /// end's dashpot d/m, ground damping g/m (on the lightest site), each resonator's dashpot
+    /// c (1/m + 1/ε).
+    fn linear_loss_rates(&self) -> Vec<(Dissipator, f64)> {
+        let n = self.n_sites();
+        let mut rates: Vec<(Dissipator, f64)> = self
+            .each_soft_end()
+            .map(|(end, site, (_, damping))| (end, damping * self.inv_mass()[site]))
+            .collect();
+        let Some(d) = self.damping() else {
+            return rates;
+        };
+        let lightest = self.inv_mass()[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
+        rates.push((Dissipator::Ground, d.ground * lightest));
+        for (j, r) in self.resonators().iter().enumerate() {
+            let inv_pair = self.inv_mass()[r.site] + 1.0 / r.eps;
+            rates.push((Dissipator::Resonator(j), d.resonator(j) * inv_pair));
+        }
+        rates
+    }
+
+    /// Each soft end: what it is, its site, and its spring and dashpot.
+    fn each_soft_end(&self) -> impl Iterator<Item = (Dissipator, usize, (f64, f64))> + '_ {
+        let last = self.n_sites() - 1;
+        [(0, self.boundary().left()), (last, self.boundary().right())]
+            .into_iter()
+            .filter_map(|(site, end)| {
+                let soft = end.soft()?;
+                Some((Dissipator::SoftEnd { last: site > 0 }, site, soft))
+            })
     }
 
     /// The soft ends' spring and dashpot forces on the window's end sites, added to `acc_u`;

@@ -123,18 +123,14 @@ impl Plan {
         if model.is_dissipative() && !method.takes_velocity_forces() {
             return Err(SimError::VelocityForces {
                 method: method.name(),
-                methods: Method::with_velocity_forces()
-                    .filter(|&m| m != Method::Rkn6Split || model.losses_are_linear())
-                    .map(Method::name)
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                methods: Self::methods_for_losses(model),
             });
         }
         if method == Method::Rkn6Split && !model.losses_are_linear() {
             return Err(SimError::BadRun(format!(
                 "method {} integrates only losses that act on velocities alone (ground damping, resonator dashpots, soft ends); a contact dashpot needs one of {}",
                 method.name(),
-                [Method::Rk4, Method::Rk4Contact, Method::Dop853].map(Method::name).join(", ")
+                Self::methods_for_losses(model)
             )));
         }
         let tolerance_drift = (DRIFT_PER_TOL * tol).max(1e-12);
@@ -176,6 +172,16 @@ impl Plan {
         let resolved = step_within(MAX_OMEGA_DT, omega).min(Self::harmonic_dt(model, method));
         let stable = step_within(0.9 * method.stability_limit(), omega);
         Self::tolerance_dt(method, tol).min(resolved).min(stable)
+    }
+
+    /// The named methods that can run `model`'s losses, listed for a refusal: those for
+    /// velocity-dependent forces, `rkn6-split` only where the losses are linear.
+    fn methods_for_losses(model: &Model) -> String {
+        Method::with_velocity_forces()
+            .filter(|&m| m != Method::Rkn6Split || model.losses_are_linear())
+            .map(Method::name)
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 
     /// Whether `auto` integrates `model`'s losses apart from its conservative step
