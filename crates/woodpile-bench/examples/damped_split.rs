@@ -1,12 +1,9 @@
-//! A lever for damped chains, measured: the linear losses that act on velocities alone
-//! (ground damping, resonator dashpots) integrated exactly, half a step before and half after
-//! the conservative chain's `rkn6-contact` step with its contact events (Strang splitting).
-//! Positions are untouched by the exact flows, so the Nyström step keeps its force reuse and
-//! its event corrections; D is the kinetic energy the flows remove, exactly.
+//! `rkn6-split` at fixed steps on the standard scene's smooth-loss rows: the linear losses
+//! (ground damping, resonator dashpots) integrated exactly half a step before and half after
+//! the conservative `rkn6-contact` step (`woodpile_sim::integrate::SplitLosses`).
 //!
-//! For each damped row of the standard scene it prints, per fixed step, the split run's error
-//! against the independent reference, its wall time, and the error's fall per halving, next to
-//! what `auto` pays today (`rk4-contact`).
+//! For each row it prints, per fixed step, the run's error against the independent reference,
+//! its wall time, and the error's fall per halving, next to what `auto` pays.
 //!
 //! ```text
 //! cargo run --release -p woodpile-bench --example damped_split
@@ -16,159 +13,21 @@
 use std::time::Instant;
 use woodpile_bench::independent::reference;
 use woodpile_bench::standard_scene_with;
-use woodpile_sim::energy::{energy_density, Fractions};
-use woodpile_sim::integrate::{
-    drive, ContactMode, DriveConfig, Rkn, StepControl, StepOutcome, StepSpan, Stepper, DPRKN6,
-};
-use woodpile_sim::model::Model;
+use woodpile_sim::energy::Fractions;
+use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::simulation::{simulate, Scenario};
+use woodpile_sim::testing::fixed_dt;
 
-/// A resonator's dashpot: host, its own index among the degrees of freedom, c, and masses.
-struct Dashpot {
-    host: usize,
-    inner: usize,
-    c: f64,
-    masses: (f64, f64),
-}
-
-/// The conservative step between two exact half-flows of the linear losses.
-struct Split<'a> {
-    inner: Box<dyn Stepper>,
-    ground: f64,
-    dashpots: Vec<Dashpot>,
-    masses: &'a [f64],
-    n_dof: usize,
-    dissipated: f64,
-    /// exp(-g h / m) per site for the half-step `h` it was computed for: steps repeat.
-    ground_factor: (f64, Vec<f64>),
-}
-
-impl Split<'_> {
-    /// The exact flow of ground damping and the resonator dashpots over `h`, both halves of a
-    /// symmetric composition (`reverse` applies them in the opposite order).
-    fn losses(&mut self, y: &mut [f64], h: f64, reverse: bool) {
-        match reverse {
-            false => {
-                self.ground_flow(y, h);
-                self.dashpot_flow(y, h);
-            }
-            true => {
-                self.dashpot_flow(y, h);
-                self.ground_flow(y, h);
-            }
-        }
-    }
-
-    fn ground_flow(&mut self, y: &mut [f64], h: f64) {
-        if self.ground == 0.0 {
-            return;
-        }
-        if self.ground_factor.0 != h {
-            let decay = self.masses.iter().map(|m| (-self.ground * h / m).exp());
-            self.ground_factor = (h, decay.collect());
-        }
-        for (site, (&m, &decay)) in self.masses.iter().zip(&self.ground_factor.1).enumerate() {
-            let v = &mut y[self.n_dof + site];
-            if *v == 0.0 {
-                continue; // At rest ahead of the wave.
-            }
-            let after = *v * decay;
-            self.dissipated += 0.5 * m * (*v * *v - after * after);
-            *v = after;
-        }
-    }
-
-    fn dashpot_flow(&mut self, y: &mut [f64], h: f64) {
-        for d in &self.dashpots {
-            let (m, e) = d.masses;
-            let (vh, vr) = (y[self.n_dof + d.host], y[self.n_dof + d.inner]);
-            let centre = (m * vh + e * vr) / (m + e);
-            let w = (vh - vr) * (-d.c * (1.0 / m + 1.0 / e) * h).exp();
-            let (nh, nr) = (centre + e / (m + e) * w, centre - m / (m + e) * w);
-            self.dissipated += 0.5 * (m * (vh * vh - nh * nh) + e * (vr * vr - nr * nr));
-            y[self.n_dof + d.host] = nh;
-            y[self.n_dof + d.inner] = nr;
-        }
-    }
-}
-
-impl Stepper for Split<'_> {
-    fn name(&self) -> &'static str {
-        "rkn6-contact split"
-    }
-
-    fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
-        self.losses(y, 0.5 * span.h, false);
-        let out = self.inner.step(model, y, span);
-        self.losses(y, 0.5 * span.h, true);
-        out
-    }
-
-    fn reach(&self) -> usize {
-        self.inner.reach()
-    }
-
-    fn rhs_evals(&self) -> u64 {
-        self.inner.rhs_evals()
-    }
-}
-
-/// `scene` by the split method at step `dt`: its fractions and wall time in ms.
+/// `scene` by `rkn6-split` at step `dt`: its fractions and wall time in ms.
 fn split_run(scene: &Scenario, dt: f64) -> (Fractions, f64) {
-    let damped = &scene.model;
-    let n = damped.n_sites();
-    let masses: Vec<f64> = (0..n).map(|i| damped.site_mass(i)).collect();
-    let conservative = Model::with_masses(
-        n,
-        damped.boundary(),
-        damped.resonators().to_vec(),
-        Some(masses.clone()),
-    )
-    .unwrap();
-    let damping = damped.damping().unwrap();
+    let split = Scenario {
+        method: MethodChoice::Named(Method::Rkn6Split),
+        accuracy: fixed_dt(dt),
+        ..scene.clone()
+    };
     let clock = Instant::now();
-    let mut split = Split {
-        inner: Box::new(Rkn::new(&conservative, DPRKN6, ContactMode::Corrected)),
-        ground: damping.ground,
-        dashpots: damped
-            .resonators()
-            .iter()
-            .enumerate()
-            .map(|(j, r)| Dashpot {
-                host: r.site,
-                inner: n + j,
-                c: damping.resonator(j),
-                masses: (masses[r.site], r.eps),
-            })
-            .filter(|d| d.c > 0.0)
-            .collect(),
-        masses: &masses,
-        n_dof: conservative.n_dof(),
-        dissipated: 0.0,
-        ground_factor: (f64::NAN, Vec::new()),
-    };
-    let mut y = conservative.rest_state();
-    conservative
-        .apply_impulse(&mut y, scene.impulse_site, scene.impulse_velocity)
-        .unwrap();
-    let cfg = DriveConfig {
-        t_end: scene.t_end,
-        sample_every: scene.sample_every,
-        control: StepControl::Fixed { dt },
-        max_steps: u64::MAX,
-        energy_drift_limit: None,
-        active_window: true,
-    };
-    drive(&conservative, &mut split, &mut y, &cfg, &mut ()).unwrap();
-    let mut density = vec![0.0; n];
-    energy_density(&conservative, scene.t_end, &y, &mut density);
-    let fractions = Fractions::of_ledger(
-        &density,
-        scene.region,
-        split.dissipated,
-        scene.impact_energy(),
-    );
-    (fractions, clock.elapsed().as_secs_f64() * 1e3)
+    let out = simulate(&split, &mut ()).unwrap();
+    (out.fractions, clock.elapsed().as_secs_f64() * 1e3)
 }
 
 fn main() {
