@@ -2,8 +2,9 @@
 //! velocities, with the dissipated power the ledger integrates. Only a scene that declares
 //! dissipation runs this loop; the conservative one ([`crate::force`]) keeps its bits.
 
+use crate::contact::{with_law, BondForce, Law};
 pub use crate::error::Dissipator;
-use crate::force::{hertz_force, odd_power};
+use crate::force::odd_power;
 use crate::model::{Model, Window};
 
 /// Where a dissipative force loop records each bond's force and dashpot power (indexing of
@@ -109,33 +110,10 @@ impl Model {
     }
 
     /// Bond `bond`'s force at relative displacement `r` (left minus right) closing at `rate`,
-    /// and its dashpot power: see the module documentation.
+    /// and its dashpot power: the law's dissipative part ([`Law::damped`]).
     #[inline(always)]
     pub(crate) fn contact_force(&self, bond: usize, r: f64, rate: f64) -> (BondForce, f64) {
-        let (c, elastic, rest) = match self.contacts() {
-            None => (r, hertz_force(r), 0.0),
-            Some(law) => (
-                law.static_overlap(bond) + r,
-                law.elastic(bond, r),
-                law.static_force(bond),
-            ),
-        };
-        // At c = 0 the dashpot already acts: a contact closing from touching (an impulse
-        // given to a site beside one at rest) feels γ ċ from its first instant.
-        let total = match self.damping() {
-            Some(d) if d.contact_at(bond) > 0.0 && c >= 0.0 => {
-                (elastic + d.law.force(d.contact_at(bond), c, rate)).max(0.0)
-            }
-            _ => elastic,
-        };
-        (
-            BondForce {
-                total,
-                elastic,
-                rest,
-            },
-            (total - elastic) * rate,
-        )
+        with_law!(self.law(), |law| law.damped(self.damping(), bond, r, rate))
     }
 
     /// The fastest rate, 1/time, at which the chain's dashpots and soft ends act in a
@@ -184,10 +162,7 @@ impl Model {
         if d.has_contact_dashpot() {
             for bond in 0..=n {
                 let pair = inv(bond.checked_sub(1)) + inv((bond < n).then_some(bond));
-                let overlap = match self.contacts() {
-                    None => (2.5 * energy.max(0.0)).powf(0.4),
-                    Some(law) => law.overlap_within(bond, energy),
-                };
+                let overlap = with_law!(self.law(), |law| law.overlap_within(bond, energy));
                 rates.push((
                     Dissipator::Contact,
                     d.law.force(d.contact_at(bond), overlap, 1.0) * pair,
@@ -246,13 +221,4 @@ impl Model {
         }
         power
     }
-}
-
-/// One contact's force: the total the sites feel (clipped at zero), its elastic part, and the
-/// static force the rest state balances (0 without precompression).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct BondForce {
-    pub total: f64,
-    pub elastic: f64,
-    pub rest: f64,
 }

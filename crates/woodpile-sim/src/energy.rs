@@ -10,8 +10,9 @@
 //! wholly to its end site, so that the sum of e_n is the conserved Hamiltonian through wall
 //! collisions.
 
+use crate::contact::{with_law, Law};
 use crate::error::ModelError;
-use crate::force::{hertz_potential, odd_power};
+use crate::force::odd_power;
 use crate::model::Model;
 
 /// A "defect region" of sites [lo, hi] (inclusive, internal 0-based numbering). Energy left of
@@ -215,10 +216,7 @@ impl Held {
 /// The potential of bond `bond` (numbering of [`crate::contact`]) at relative displacement
 /// `r`: the paper's (2/5) \[r\]_+^{5/2}, or the chain's [`crate::ContactLaw`].
 fn bond_potential(model: &Model, bond: usize, r: f64) -> f64 {
-    match model.contacts() {
-        None => hertz_potential(r),
-        Some(law) => law.potential(bond, r),
-    }
+    with_law!(model.law(), |law| law.potential(bond, r))
 }
 
 /// Energy density per site (length `n_sites`) of state `y` at time `t`, written into `density`.
@@ -347,7 +345,7 @@ mod tests {
         let sum: f64 = e.iter().sum();
         assert!((sum - total_energy(&model, 0.0, &y)).abs() < 1e-14);
         // The wall bonds: site 0 at -0.1 is pressed into the left wall, site 4 at 0.3 into the right.
-        assert!(e[0] >= hertz_potential(0.1));
+        assert!(e[0] >= crate::contact::hertz_potential(0.1));
     }
 
     #[test]

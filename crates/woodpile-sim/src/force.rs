@@ -4,29 +4,10 @@
 //! evaluates a power 3/2 only for compressed contacts: at any moment only a handful of the
 //! chain's contacts are closed.
 
-use crate::contact::ContactLaw;
+use crate::chain_force::{chain_accelerations, patch, Coupled, Frame};
+use crate::contact::with_law;
+pub use crate::contact::{hertz_force, hertz_potential};
 use crate::model::{Model, Window};
-
-/// Hertz contact force for an overlap `d`: `[d]_+^{3/2}`.
-#[inline(always)]
-pub fn hertz_force(d: f64) -> f64 {
-    if d > 0.0 {
-        d * d.sqrt()
-    } else {
-        0.0
-    }
-}
-
-/// Hertz contact potential for an overlap `d`: `(2/5) [d]_+^{5/2}`, whose derivative is
-/// [`hertz_force`].
-#[inline(always)]
-pub fn hertz_potential(d: f64) -> f64 {
-    if d > 0.0 {
-        0.4 * d * d * d.sqrt()
-    } else {
-        0.0
-    }
-}
 
 /// `x^p` for the odd coupling exponents (p = 1 is the common case and skips `powi`).
 #[inline(always)]
@@ -87,239 +68,71 @@ impl Model {
         window: Window,
         bond_force: Option<&mut [f64]>,
     ) {
-        let n_sites = self.n_sites();
         debug_assert_eq!(q.len(), self.n_dof());
         debug_assert_eq!(acc.len(), self.n_dof());
-        debug_assert!(window.lo <= window.hi && window.hi < n_sites);
-        let (u, v) = q.split_at(n_sites);
-        let (acc_u, acc_v) = acc.split_at_mut(n_sites);
-        let (lo, hi) = (window.lo, window.hi);
-
-        match self.contacts() {
-            None => Self::hertz_chain(self.walls(), u, acc_u, window, bond_force),
-            Some(law) => Self::law_chain(law, self.walls(), u, acc_u, window, bond_force),
-        }
-        if self.has_soft_end() {
-            self.spring_ends(u, acc_u, window);
-        }
-        for (j, r) in self.resonators().iter().enumerate() {
-            if r.site < lo || r.site > hi {
-                continue;
-            }
-            let f = r.coupling.at(t) * odd_power(u[r.site] - v[j], r.p);
-            acc_u[r.site] -= f;
-            acc_v[j] = f / r.eps;
-        }
-        if let Some(masses) = self.site_masses() {
-            for (a, m) in acc_u[lo..=hi].iter_mut().zip(&masses[lo..=hi]) {
-                *a /= m;
-            }
-        }
-    }
-
-    /// The paper's contact forces on the sites of `window` (unit coefficients, exponent 3/2,
-    /// no precompression), written into `acc_u`; with `bond_force`, every bond force too.
-    #[inline(always)]
-    fn hertz_chain(
-        [left_wall, right_wall]: [bool; 2],
-        u: &[f64],
-        acc_u: &mut [f64],
-        window: Window,
-        bond_force: Option<&mut [f64]>,
-    ) {
-        let (lo, hi) = (window.lo, window.hi);
-        let n_sites = u.len();
-        // Each site's force is (left bond) - (right bond). Computing it in one pass with the
-        // previous bond's force in a register writes every acceleration once (no store to load
-        // chain), and max(d, 0)^{3/2} has no branch to mispredict on the many barely-touching
-        // contacts behind the wave. Same bits as accumulating bond by bond. The recording loop
-        // is a separate copy so that the plain one carries no extra store.
-        let u_w = &u[lo..=hi];
-        let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
-        let mut previous = 0.0;
-        match bond_force {
-            None => {
-                for bond in 1..u_w.len() {
-                    let d = (u_w[bond - 1] - u_w[bond]).max(0.0);
-                    let f = d * d.sqrt();
-                    acc_w[bond - 1] = previous - f;
-                    previous = f;
-                }
-            }
-            Some(record) => {
-                let record_w = &mut record[lo + 1..=hi][..u_w.len() - 1];
-                for bond in 1..u_w.len() {
-                    let d = (u_w[bond - 1] - u_w[bond]).max(0.0);
-                    let f = d * d.sqrt();
-                    acc_w[bond - 1] = previous - f;
-                    record_w[bond - 1] = f;
-                    previous = f;
-                }
-                if lo == 0 && left_wall {
-                    record[0] = hertz_force(-u[0]);
-                }
-                if hi == n_sites - 1 && right_wall {
-                    record[n_sites] = hertz_force(u[n_sites - 1]);
-                }
-            }
-        }
-        acc_w[u_w.len() - 1] = previous;
-        if lo == 0 && left_wall {
-            acc_u[0] += hertz_force(-u[0]);
-        }
-        if hi == n_sites - 1 && right_wall {
-            acc_u[n_sites - 1] -= hertz_force(u[n_sites - 1]);
-        }
-    }
-
-    /// [`Model::hertz_chain`] under a [`ContactLaw`]: each bond's force beyond its static one,
-    /// a_b [δ_b + u_left − u_right]_+^α − F_b. A recorded bond force is the elastic part
-    /// a_b \[c_b\]_+^α, positive exactly while the contact is closed, as the contact-event scan
-    /// needs; the static part is constant over a step, so every quadrature integrates it exactly
-    /// and the event correction may leave it out.
-    #[inline(always)]
-    fn law_chain(
-        law: &ContactLaw,
-        [left_wall, right_wall]: [bool; 2],
-        u: &[f64],
-        acc_u: &mut [f64],
-        window: Window,
-        mut bond_force: Option<&mut [f64]>,
-    ) {
-        let (lo, hi) = (window.lo, window.hi);
-        let n_sites = u.len();
-        let mut previous = 0.0;
-        for bond in lo + 1..=hi {
-            let elastic = law.elastic(bond, u[bond - 1] - u[bond]);
-            if let Some(record) = bond_force.as_deref_mut() {
-                record[bond] = elastic;
-            }
-            let f = elastic - law.static_force(bond);
-            acc_u[bond - 1] = previous - f;
-            previous = f;
-        }
-        acc_u[hi] = previous;
-        if lo == 0 && left_wall {
-            let elastic = law.elastic(0, -u[0]);
-            if let Some(record) = bond_force.as_deref_mut() {
-                record[0] = elastic;
-            }
-            acc_u[0] += elastic - law.static_force(0);
-        }
-        if hi == n_sites - 1 && right_wall {
-            let elastic = law.elastic(n_sites, u[n_sites - 1]);
-            if let Some(record) = bond_force {
-                record[n_sites] = elastic;
-            }
-            acc_u[n_sites - 1] -= elastic - law.static_force(n_sites);
-        }
+        let frame = self.frame();
+        let (resonators, masses) = (self.coupled(t), self.site_masses());
+        with_law!(self.law(), |law| chain_accelerations(
+            (law, &frame),
+            resonators,
+            masses,
+            (q, acc),
+            window,
+            bond_force
+        ));
     }
 
     /// The forces of positions `q` near `sites`, whose positions a contact correction moved
     /// after `acc` and `record` (a whole evaluation's on `window`, as
-    /// [`Model::accelerations_recording`] writes them) were taken: the bonds beside them and
-    /// the accelerations of them and their neighbours, each by the operations the whole
-    /// evaluation makes of it, so that the patched forces are a whole evaluation's bit for bit
-    /// (tested). Each bond is evaluated once, in the chain loop's order. Returns the sites
-    /// whose accelerations it wrote. Every force of the chain acts between neighbours or
-    /// within a site and its resonators, which is why one site more on each side suffices.
+    /// [`Model::accelerations_recording`] writes them) were taken, bit for bit as a whole
+    /// evaluation gives them ([`crate::chain_force::patch`]). Returns the sites whose
+    /// accelerations it wrote.
     pub(crate) fn patch_accelerations(
         &self,
         t: f64,
         q: &[f64],
-        (acc, record): (&mut [f64], &mut [f64]),
+        forces: (&mut [f64], &mut [f64]),
         window: Window,
         sites: std::ops::RangeInclusive<usize>,
     ) -> std::ops::RangeInclusive<usize> {
-        let n = self.n_sites();
-        let (lo, hi) = (window.lo, window.hi);
-        let (u, v) = q.split_at(n);
-        let (acc_u, acc_v) = acc.split_at_mut(n);
-        let [left_wall, right_wall] = self.walls();
-        let bond = |b: usize| self.contact_forces(b, u[b - 1] - u[b]);
-        if *sites.start() == 0 && lo == 0 && left_wall {
-            record[0] = self.contact_forces(0, -u[0]).0;
-        }
-        if *sites.end() == n - 1 && hi == n - 1 && right_wall {
-            record[n] = self.contact_forces(n, u[n - 1]).0;
-        }
-        let patched = sites.start().saturating_sub(1).max(lo)..=(sites.end() + 1).min(hi);
-        let mut left = (0.0, 0.0);
-        if *patched.start() > lo {
-            left = bond(*patched.start());
-            record[*patched.start()] = left.0;
-        }
-        for k in patched.clone() {
-            let mut a = left.1;
-            if k < hi {
-                let right = bond(k + 1);
-                record[k + 1] = right.0;
-                a = left.1 - right.1;
-                left = right;
-            }
-            a = self.patched_ends(k, u, a);
-            for (j, r) in self.resonators().iter().enumerate() {
-                if r.site == k {
-                    let f = r.coupling.at(t) * odd_power(u[k] - v[j], r.p);
-                    a -= f;
-                    acc_v[j] = f / r.eps;
-                }
-            }
-            if let Some(masses) = self.site_masses() {
-                a /= masses[k];
-            }
-            acc_u[k] = a;
-        }
-        patched
+        let frame = self.frame();
+        let (resonators, masses) = (self.coupled(t), self.site_masses());
+        with_law!(self.law(), |law| patch(
+            (law, &frame),
+            resonators,
+            masses,
+            q,
+            forces,
+            window,
+            sites
+        ))
     }
 
-    /// Contact `b`'s (recorded, acting) force at overlap `d`: the paper's \[d\]_+^{3/2} for
-    /// both, or the law's elastic part and that less its static part, with the operations of
-    /// the chain loops and the walls ([`hertz_force`] gives the loop's max(d, 0)^{3/2} bits for
-    /// every d, NaN included).
-    fn contact_forces(&self, b: usize, d: f64) -> (f64, f64) {
-        match self.contacts() {
-            None => (hertz_force(d), hertz_force(d)),
-            Some(law) => {
-                let elastic = law.elastic(b, d);
-                (elastic, elastic - law.static_force(b))
-            }
+    /// What the force loops read of the chain besides its law, resonators and masses.
+    #[inline(always)]
+    fn frame(&self) -> Frame {
+        let spring = |end: crate::model::End| end.soft().map(|(spring, _)| spring);
+        let boundary = self.boundary();
+        Frame {
+            n_sites: self.n_sites(),
+            walls: self.walls(),
+            springs: [spring(boundary.left()), spring(boundary.right())],
         }
     }
 
-    /// Site `k`'s acceleration `a` (its bonds' part) with what a wall or a soft end adds there,
-    /// in the whole evaluation's order: the wall's contact, then the spring.
-    fn patched_ends(&self, k: usize, u: &[f64], mut a: f64) -> f64 {
-        let last = self.n_sites() - 1;
-        let [left_wall, right_wall] = self.walls();
-        if k == 0 && left_wall {
-            a += self.contact_forces(0, -u[0]).1;
-        }
-        if k == last && right_wall {
-            a -= self.contact_forces(last + 1, u[last]).1;
-        }
-        if let (0, Some((spring, _))) = (k, self.boundary().left().soft()) {
-            a -= spring * u[0];
-        }
-        if let (true, Some((spring, _))) = (k == last, self.boundary().right().soft()) {
-            a -= spring * u[last];
-        }
-        a
-    }
-
-    /// The springs of soft ends (without dashpots: a model with one is dissipative and runs
-    /// [`Model::damped_accelerations_in`]), added to the window's end sites. Out of line: the
-    /// force loop of chains without them should not carry it.
-    #[inline(never)]
-    #[cold]
-    fn spring_ends(&self, u: &[f64], acc_u: &mut [f64], window: Window) {
-        let last = self.n_sites() - 1;
-        if let (0, Some((spring, _))) = (window.lo, self.boundary().left().soft()) {
-            acc_u[0] -= spring * u[0];
-        }
-        if let (true, Some((spring, _))) = (window.hi == last, self.boundary().right().soft()) {
-            acc_u[last] -= spring * u[last];
-        }
+    /// The resonators as the force loops read them at time `t` (a coupling is computed only
+    /// where a loop reaches its host).
+    #[inline(always)]
+    fn coupled(
+        &self,
+        t: f64,
+    ) -> impl Iterator<Item = Coupled<f64, impl Fn() -> f64 + '_>> + Clone + '_ {
+        self.resonators().iter().map(move |r| Coupled {
+            site: r.site,
+            p: r.p,
+            eps: r.eps,
+            kappa: move || r.coupling.at(t),
+        })
     }
 
     /// First-order form `y' = (q', q'')` of the equations of motion, for Runge–Kutta methods.

@@ -20,6 +20,7 @@
 //! - [`units`]: the dimensional form (SI in, dimensionless eps and kappa out).
 #![warn(missing_docs)]
 
+mod chain_force;
 pub mod contact;
 pub mod damped_force;
 pub mod damping;

@@ -3,21 +3,8 @@
 //! those changes are too weak to correct.
 
 use super::contact_event::BondPath;
+use crate::contact::{with_law, Law, NEGLIGIBLE_FORCE};
 use crate::model::Model;
-
-/// Largest contact force for which an opening or closing is left to the method: the correction
-/// of such a bond is below |force| h, under 1e-15 in a dimensionless chain struck at unit
-/// velocity. Four in five contact changes on the paper's scenes are grazing touches of the
-/// quiet chain behind the wave, with forces below 1e-16; skipping them changes no fraction by
-/// more than 1e-16 and saves most of the correction's cost.
-const NEGLIGIBLE_FORCE: f64 = 1e-14;
-
-/// End overlaps of the paper's law whose force d√d is surely below [`NEGLIGIBLE_FORCE`]
-/// (4e-10: 8.0e-15), and surely not (5e-10: 1.12e-14). The rounded d·√d never decreases as d
-/// grows, so comparing d with these decides as the force itself would, without its square
-/// root: the grazing touches, most changed bonds, end far below the first.
-const SURELY_NEGLIGIBLE_OVERLAP: f64 = 4e-10;
-const SURELY_FELT_OVERLAP: f64 = 5e-10;
 
 /// Whether a changed bond's forces, at every stage and at the end of its `path`, all stay
 /// below [`NEGLIGIBLE_FORCE`]: then its correction is skipped. The end is looked at only when
@@ -31,27 +18,10 @@ pub(super) fn negligible<const S: usize>(
     stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force_negligible(model, bond, path)
 }
 
-/// Whether the bond's elastic force at the end of its path is below [`NEGLIGIBLE_FORCE`]: the
-/// paper's \[d\]_+^{3/2}, or the chain's [`crate::ContactLaw`] (coefficient, exponent, and
-/// the static overlap added to the path by `bond_path`).
+/// Whether the bond's elastic force at the end of its path is below [`NEGLIGIBLE_FORCE`], by
+/// the chain's law (the path is of the total overlap: `bond_path` adds the static overlap).
 fn end_force_negligible(model: &Model, bond: usize, path: &BondPath) -> bool {
-    match model.contacts() {
-        None => paper_force_negligible(path.d1),
-        Some(law) => law.coefficient(bond) * law.power(path.d1) < NEGLIGIBLE_FORCE,
-    }
-}
-
-/// [`end_force_negligible`] for the paper's law at end overlap `d`.
-#[inline(always)]
-fn paper_force_negligible(d: f64) -> bool {
-    let end = d.max(0.0);
-    if end < SURELY_NEGLIGIBLE_OVERLAP {
-        return true;
-    }
-    if end > SURELY_FELT_OVERLAP {
-        return false;
-    }
-    end * end.sqrt() < NEGLIGIBLE_FORCE
+    with_law!(model.law(), |law| law.force_negligible(bond, path.d1))
 }
 
 /// Whether a bond's contact changed state during a step: its stage forces and end overlap do
@@ -114,27 +84,6 @@ pub(super) fn block_changes<const S: usize, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_overlap_shortcut_decides_as_the_force_does() {
-        let by_force = |d: f64| {
-            let end = d.max(0.0);
-            end * end.sqrt() < NEGLIGIBLE_FORCE
-        };
-        // Both bounds and the force's own threshold, neighbours a few ulps apart, and a sweep
-        // over the decades around them (negative overlaps, a NaN and zeros too).
-        let threshold = NEGLIGIBLE_FORCE.powf(2.0 / 3.0);
-        let mut overlaps = vec![-1.0, -0.0, 0.0, f64::NAN, 1.0, 1e300];
-        for centre in [SURELY_NEGLIGIBLE_OVERLAP, SURELY_FELT_OVERLAP, threshold] {
-            let bits = centre.to_bits();
-            overlaps.extend((bits - 64..bits + 64).map(f64::from_bits));
-        }
-        overlaps.extend((0..20_000).map(|k| 1e-12 * 1.001f64.powi(k)));
-        for d in overlaps {
-            assert_eq!(paper_force_negligible(d), by_force(d), "overlap {d:e}");
-        }
-        assert!(by_force(SURELY_NEGLIGIBLE_OVERLAP) && !by_force(SURELY_FELT_OVERLAP));
-    }
 
     #[test]
     fn contact_changes_are_detected_only_at_sign_changes() {

@@ -6,15 +6,12 @@
 //! A method supplies only its quadrature: what its stage weights make of a bond's `S` stage
 //! forces, as an impulse `h Σ b_i F_i` and a position change `h² Σ b̄_i F_i`.
 
-use super::contact_event::{
-    damped_path_integrals, first_crossing, first_switch, path_integrals, path_integrals_of,
-    BondPath,
-};
+use super::contact_event::{damped_path_integrals, first_crossing, first_switch, BondPath};
 use super::contact_scan::{block_changes, block_of, changes_contact, negligible};
 use super::exact_resonator::{
     fast_mode_correction, Dofs, DofsMut, ExactResonators, FastModeCorrection,
 };
-use crate::contact::ContactLaw;
+use crate::contact::{with_law, Law};
 use crate::model::{Model, Window};
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
@@ -73,24 +70,15 @@ pub(super) fn bond_integrals(
     if model.is_dissipative() {
         return damped_path_integrals(path, h, damped_force(model, bond));
     }
-    match model.contacts() {
-        None => {
-            let (impulse, moment) = path_integrals(path, h);
-            (impulse, moment, 0.0)
-        }
-        Some(law) => {
-            let a = law.coefficient(bond);
-            let (impulse, moment) = path_integrals_of(path, h, |d| law.power(d));
-            (a * impulse, a * moment, 0.0)
-        }
-    }
+    let (impulse, moment) = with_law!(model.law(), |law| law.path_integrals(bond, path, h));
+    (impulse, moment, 0.0)
 }
 
 /// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the
 /// path integrals and the switch search take them (the path is of the total overlap; the
 /// force law takes the relative displacement, without the static overlap).
 fn damped_force(model: &Model, bond: usize) -> impl Fn(f64, f64) -> (f64, f64) + '_ {
-    let delta = model.contacts().map_or(0.0, |law| law.static_overlap(bond));
+    let delta = with_law!(model.law(), |law| law.static_overlap(bond));
     move |c, rate| {
         let (force, power) = model.contact_force(bond, c - delta, rate);
         (force.total, power)
@@ -127,10 +115,7 @@ impl<const S: usize> ContactEvents<S> {
         // A bond outside the window is at rest and carries its static force (0 but under
         // precompression): what its record must read when the window grows over it and a
         // reused stage (FSAL) was recorded before it did.
-        let at_rest: Vec<f64> = match model.contacts() {
-            None => vec![0.0; model.n_sites() + 1],
-            Some(law) => (0..law.n_bonds()).map(|b| law.static_force(b)).collect(),
-        };
+        let at_rest = with_law!(model.law(), |law| law.forces_at_rest(model.n_sites() + 1));
         let powers = match model.is_dissipative() {
             true => model.n_sites() + 1,
             false => 0,
@@ -401,10 +386,7 @@ impl<const S: usize> ContactEvents<S> {
         let inner = |i: usize| (lo + i + 1, Some(lo + i), Some(lo + i + 1));
         let n_bonds = hi - lo;
         // Under precompression a bond's overlap is its static overlap plus left − right.
-        let offsets = model
-            .contacts()
-            .map(ContactLaw::static_overlaps)
-            .filter(|delta| delta.iter().any(|&d| d > 0.0));
+        let offsets = with_law!(model.law(), |law| law.static_overlaps());
         let mut start = 0;
         if offsets.is_none() {
             const BLOCK: usize = 4;
@@ -474,8 +456,8 @@ pub(super) fn bond_path<D: Dofs + ?Sized>(
         d1: member(new_q, left) - member(new_q, right),
         rate1: member(new_v, left) - member(new_v, right),
     };
-    match model.contacts().map(|law| law.static_overlap(bond)) {
-        Some(delta) if delta > 0.0 => BondPath {
+    match with_law!(model.law(), |law| law.static_overlap(bond)) {
+        delta if delta > 0.0 => BondPath {
             d0: path.d0 + delta,
             d1: path.d1 + delta,
             ..path

@@ -29,8 +29,9 @@
 //! method keeps the tableau's order conditions; for any θ the free vibration (g = 0) and a
 //! constant forcing are integrated exactly.
 
-use super::contact_event::{oscillating_path_integrals, BondPath};
+use super::contact_event::BondPath;
 use super::erkn_weights::{pair_step, NystromWeights, PairStep};
+use crate::contact::{with_law, Law};
 use crate::model::Model;
 
 /// A vector of degrees of freedom as the pair steps read it: a state's own slice, or one lane
@@ -333,14 +334,8 @@ fn oscillating_bond_integrals(
     h: f64,
     theta: f64,
 ) -> (f64, f64) {
-    match model.contacts() {
-        None => oscillating_path_integrals(path, h, theta, |d| d * d.sqrt()),
-        Some(law) => {
-            let a = law.coefficient(bond);
-            let (impulse, moment) = oscillating_path_integrals(path, h, theta, |d| law.power(d));
-            (a * impulse, a * moment)
-        }
-    }
+    with_law!(model.law(), |law| law
+        .oscillating_integrals(bond, path, h, theta))
 }
 
 /// The part of a bond's correction that reaches a host's fast mode in an extended Nyström step

@@ -15,13 +15,13 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod active_sites;
-mod contact_event;
+pub(crate) mod contact_event;
 mod contact_scan;
 mod dop853;
 mod driver;
 mod erkn_weights;
 mod event_correction;
-mod exact_resonator;
+pub(crate) mod exact_resonator;
 pub mod lanes;
 mod method;
 mod plan;

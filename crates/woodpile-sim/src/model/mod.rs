@@ -22,7 +22,7 @@ pub use parts::ModelParts;
 pub use resonator::{Coupling, Resonator};
 pub use window::Window;
 
-use crate::contact::ContactLaw;
+use crate::contact::{with_law, ContactLaw, Contacts, Law};
 use crate::damping::Damping;
 use crate::error::ModelError;
 
@@ -209,6 +209,13 @@ impl Model {
         self.contacts.as_deref()
     }
 
+    /// The contact law the simulator runs, the paper's or the chain's, to dispatch on once per
+    /// call ([`crate::contact::with_law!`]).
+    #[inline(always)]
+    pub(crate) fn law(&self) -> Contacts<'_> {
+        Contacts::of(self.contacts.as_deref())
+    }
+
     /// Number of chain sites S.
     pub fn n_sites(&self) -> usize {
         self.n_sites
@@ -319,24 +326,25 @@ impl Model {
 
     /// The fastest a contact of a chain under a [`ContactLaw`] vibrates in a motion of total
     /// energy `energy`: sqrt(k (1/m_left + 1/m_right)) at the stiffness k the bond has at the
-    /// largest overlap the energy allows ([`ContactLaw::overlap_within`]); a wall counts as
+    /// largest overlap the energy allows ([`Law::stiffness_within`]); a wall counts as
     /// infinitely heavy. 0 for the paper's chain, whose steps are calibrated on it.
     pub fn max_contact_omega(&self, energy: f64) -> f64 {
-        let Some(law) = self.contacts() else {
-            return 0.0;
-        };
+        with_law!(self.law(), |law| self.max_contact_omega_of(law, energy))
+    }
+
+    fn max_contact_omega_of(&self, law: &impl Law, energy: f64) -> f64 {
         let n = self.n_sites;
         let walls = [self.boundary.left_wall(), self.boundary.right_wall()];
         (0..=n)
             .filter(|&bond| (bond > 0 || walls[0]) && (bond < n || walls[1]))
-            .map(|bond| {
+            .map_while(|bond| {
                 let inverse_masses = [bond.checked_sub(1), (bond < n).then_some(bond)]
                     .into_iter()
                     .flatten()
                     .map(|site| 1.0 / self.site_mass(site))
                     .sum::<f64>();
-                let c = law.overlap_within(bond, energy);
-                (law.stiffness(bond, c) * inverse_masses).sqrt()
+                let stiffness = law.stiffness_within(bond, energy)?;
+                Some((stiffness * inverse_masses).sqrt())
             })
             .fold(0.0, f64::max)
     }

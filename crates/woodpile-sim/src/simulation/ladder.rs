@@ -3,6 +3,7 @@
 //! verified ([`Strictness`]) and which order its estimate assumes.
 
 use super::{auto_first_step, run_plan, Outcome, Scenario, MAX_HALVINGS};
+use crate::contact::{with_law, Law};
 use crate::error::{Refusal, SimError};
 use crate::integrate::{CancelOnly, Observer, Plan, BLOW_UP_DRIFT, DRIFT_PER_TOL};
 use crate::model::Model;
@@ -31,7 +32,7 @@ const ROUGH_CONTACT_OBSERVED_ORDER: f64 = 2.0;
 
 /// The order of `auto`'s Richardson estimate for `model` run by `plan`'s method.
 fn assumed_order(model: &Model, plan: &Plan) -> f64 {
-    let rough = model.contacts().is_some_and(|law| law.exponent() < 1.5);
+    let rough = with_law!(model.law(), |law| law.exponent() < 1.5);
     match (model.is_dissipative(), rough) {
         (true, _) => DISSIPATIVE_OBSERVED_ORDER,
         (false, true) => ROUGH_CONTACT_OBSERVED_ORDER.min(plan.method.observed_order()),
@@ -415,7 +416,7 @@ impl Strictness {
         // A chain in gravity is graded (its contacts stiffen with depth): a first pair can
         // agree far better than it is accurate (`auto_audit --gravity`), so its regime is
         // judged on three runs, as a ramped nonlinear chain's is.
-        let graded = model.contacts().is_some_and(|law| law.gravity() > 0.0);
+        let graded = with_law!(model.law(), |law| law.gravity() > 0.0);
         Strictness {
             accept: accepted_estimate(model, tol),
             needs_three_runs: (nonlinear && ramped) || graded,

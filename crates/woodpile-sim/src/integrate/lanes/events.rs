@@ -4,7 +4,7 @@
 //! state is corrected exactly as its scalar run's is.
 
 use super::{lanewise, Lane, LaneMut, Lanes, LANES, S};
-use crate::contact::ContactLaw;
+use crate::contact::{with_law, Law};
 use crate::integrate::contact_scan::{changes_contact, negligible};
 use crate::integrate::event_correction::{
     apply, apply_fast, bond_integrals, bond_path, BondSites, Correction,
@@ -120,10 +120,7 @@ impl LaneEvents {
         self.changed.clear();
         let (lo, hi) = (window.lo, window.hi);
         // Under precompression a bond's overlap is its static overlap plus left − right.
-        let offsets = model
-            .contacts()
-            .map(ContactLaw::static_overlaps)
-            .filter(|delta| delta.iter().any(|&d| d > 0.0));
+        let offsets = with_law!(model.law(), |law| law.static_overlaps());
         let offset = |bond: usize| offsets.map_or(0.0, |delta| delta[bond]);
         for bond in lo + 1..=hi {
             // Some but not all of the S + 1 values say "touching": the largest is positive and

@@ -13,12 +13,11 @@
 //! rather than F0 itself: then a site at rest feels exactly zero force, so the sites ahead of
 //! the wave stay exactly at rest and the driver's active window skips them without changing a
 //! bit. The paper's chain (every a_b = 1, α = 3/2, no precompression) has no `ContactLaw` at
-//! all: it keeps its own loop and its own bits ([`crate::model::Model::contacts`]).
-//!
-//! Bonds are numbered as the recorded bond forces are: bond 0 is the left wall, bond b
-//! (1 ≤ b < S) joins sites b − 1 and b, bond S is the right wall.
+//! all: it runs [`super::PaperHertz`] and keeps its own bits.
 
+use super::{Law, NEGLIGIBLE_FORCE};
 use crate::error::ModelError;
+use crate::integrate::contact_event::{oscillating_path_integrals, path_integrals_of, BondPath};
 
 /// Smallest and largest contact exponent accepted: α = 1 is a one-sided linear spring; above 5
 /// no granular contact law is in use, and the powers of a unit overlap lose precision.
@@ -259,11 +258,6 @@ impl ContactLaw {
         self.static_force[bond]
     }
 
-    /// The static overlaps of every bond (0..=S).
-    pub(crate) fn static_overlaps(&self) -> &[f64] {
-        &self.static_overlap
-    }
-
     /// `[c]_+^α` for a total overlap `c` (the elastic force of a unit coefficient).
     #[inline(always)]
     pub fn power(&self, c: f64) -> f64 {
@@ -309,6 +303,81 @@ impl ContactLaw {
     }
 }
 
+/// The law's facts are its inherent methods' (which other crates read too).
+impl Law for ContactLaw {
+    fn exponent(&self) -> f64 {
+        self.exponent
+    }
+
+    fn gravity(&self) -> f64 {
+        self.gravity
+    }
+
+    #[inline(always)]
+    fn static_overlap(&self, bond: usize) -> f64 {
+        self.static_overlap[bond]
+    }
+
+    #[inline(always)]
+    fn overlap(&self, bond: usize, r: f64) -> f64 {
+        self.static_overlap[bond] + r
+    }
+
+    #[inline(always)]
+    fn elastic(&self, bond: usize, r: f64) -> f64 {
+        ContactLaw::elastic(self, bond, r)
+    }
+
+    #[inline(always)]
+    fn static_force(&self, bond: usize) -> f64 {
+        self.static_force[bond]
+    }
+
+    #[inline(always)]
+    fn net(&self, bond: usize, elastic: f64) -> f64 {
+        elastic - self.static_force[bond]
+    }
+
+    fn potential(&self, bond: usize, r: f64) -> f64 {
+        ContactLaw::potential(self, bond, r)
+    }
+
+    fn static_overlaps(&self) -> Option<&[f64]> {
+        let delta = &self.static_overlap;
+        delta.iter().any(|&d| d > 0.0).then_some(&delta[..])
+    }
+
+    fn path_integrals(&self, bond: usize, path: &BondPath, h: f64) -> (f64, f64) {
+        let a = self.coefficient[bond];
+        let (impulse, moment) = path_integrals_of(path, h, |d| self.power.at(d));
+        (a * impulse, a * moment)
+    }
+
+    fn oscillating_integrals(
+        &self,
+        bond: usize,
+        path: &BondPath,
+        h: f64,
+        theta: f64,
+    ) -> (f64, f64) {
+        let a = self.coefficient[bond];
+        let (impulse, moment) = oscillating_path_integrals(path, h, theta, |d| self.power.at(d));
+        (a * impulse, a * moment)
+    }
+
+    fn force_negligible(&self, bond: usize, c: f64) -> bool {
+        self.coefficient[bond] * self.power.at(c) < NEGLIGIBLE_FORCE
+    }
+
+    fn overlap_within(&self, bond: usize, energy: f64) -> f64 {
+        ContactLaw::overlap_within(self, bond, energy)
+    }
+
+    fn stiffness_within(&self, bond: usize, energy: f64) -> Option<f64> {
+        Some(self.stiffness(bond, self.overlap_within(bond, energy)))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -345,7 +414,7 @@ mod tests {
     fn three_halves_is_the_papers_power() {
         let law = ContactLaw::new(vec![1.0, 1.0], 1.5, 0.0).unwrap();
         for d in [0.0, 0.013, 0.5, 1.7] {
-            assert_eq!(law.elastic(1, d), crate::force::hertz_force(d));
+            assert_eq!(law.elastic(1, d), super::super::hertz_force(d));
         }
         assert_eq!(law.elastic(1, -0.2), 0.0);
     }

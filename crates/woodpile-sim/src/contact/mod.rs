@@ -1,0 +1,172 @@
+//! Contact laws: everything the simulator knows about how two neighbours push on each other,
+//! one type per law behind one trait ([`Law`]).
+//!
+//! - [`hertz`]: the paper's law, `[d]_+^{3/2}` with unit coefficients and no precompression
+//!   ([`PaperHertz`]), a type with no data whose loops compile to the paper's own.
+//! - [`general`]: the experiment's law ([`ContactLaw`]): a coefficient per contact, any
+//!   exponent, a precompression or gravity's weights.
+//!
+//! A model holds at most a [`ContactLaw`] ([`crate::Model::contacts`]); [`crate::Model::law`]
+//! gives its law as [`Contacts`], and [`with_law!`] runs generic code with the law's own type,
+//! so that the choice is made once per call, outside every loop. A new law is a new type that
+//! implements [`Law`], and a new arm of [`Contacts`].
+//!
+//! Bonds are numbered as the recorded bond forces are: bond 0 is the left wall, bond b
+//! (1 ≤ b < S) joins sites b − 1 and b, bond S is the right wall. A bond's relative
+//! displacement r is its left member's minus its right member's (a wall counts as at rest).
+
+pub mod general;
+pub mod hertz;
+
+pub use general::{ContactLaw, LawParts, EXPONENT_RANGE};
+pub use hertz::{hertz_force, hertz_potential, PaperHertz};
+
+use crate::damping::Damping;
+use crate::integrate::contact_event::BondPath;
+
+/// Largest contact force for which an opening or closing is left to the method: the correction
+/// of such a bond is below |force| h, under 1e-15 in a dimensionless chain struck at unit
+/// velocity. Four in five contact changes on the paper's scenes are grazing touches of the
+/// quiet chain behind the wave, with forces below 1e-16; skipping them changes no fraction by
+/// more than 1e-16 and saves most of the correction's cost.
+pub(crate) const NEGLIGIBLE_FORCE: f64 = 1e-14;
+
+/// What a contact law is to the simulator: its forces, its potential, the integrals the
+/// contact-event correction takes along a bond's path, the bounds the scan and the planner
+/// use, and its dissipative part. Each force is computed by the same operations wherever it
+/// is used (the chain loops, the patch after a corrected step, the walls), which is what keeps
+/// every path's bits equal.
+pub(crate) trait Law {
+    /// The contact exponent α.
+    fn exponent(&self) -> f64;
+
+    /// g when the contacts carry the weights above them, 0 otherwise.
+    fn gravity(&self) -> f64;
+
+    /// The static overlap δ_b of bond `bond` (0 without a load).
+    fn static_overlap(&self, bond: usize) -> f64;
+
+    /// The total overlap c of bond `bond` at relative displacement `r`: its static overlap
+    /// plus r.
+    fn overlap(&self, bond: usize, r: f64) -> f64;
+
+    /// The elastic force of bond `bond` at relative displacement `r`: what is recorded, and
+    /// positive exactly while the contact is closed.
+    fn elastic(&self, bond: usize, r: f64) -> f64;
+
+    /// The static force the rest state balances at bond `bond` (0 without a load).
+    fn static_force(&self, bond: usize) -> f64;
+
+    /// The force bond `bond` adds to the rest state's, from its `elastic` force: what pushes.
+    /// Zero, exactly, at rest.
+    fn net(&self, bond: usize, elastic: f64) -> f64;
+
+    /// The potential of bond `bond` at relative displacement `r`, measured from the rest
+    /// state; its derivative in r is the net force.
+    fn potential(&self, bond: usize, r: f64) -> f64;
+
+    /// The static overlap of every bond, or `None` when none is loaded (then a bond's overlap
+    /// is its relative displacement, and the contact scan takes its block test).
+    fn static_overlaps(&self) -> Option<&[f64]>;
+
+    /// `(∫_0^h F ds, ∫_0^h (h − s) F ds)` of bond `bond`'s elastic force along `path` (a path
+    /// of the total overlap), over a step of size `h`.
+    fn path_integrals(&self, bond: usize, path: &BondPath, h: f64) -> (f64, f64);
+
+    /// [`Law::path_integrals`] under the fast-mode weights of an exactly integrated resonator
+    /// (θ = ω h; [`crate::integrate::contact_event::oscillating_path_integrals`]).
+    fn oscillating_integrals(&self, bond: usize, path: &BondPath, h: f64, theta: f64)
+        -> (f64, f64);
+
+    /// Whether bond `bond`'s elastic force at total overlap `c` is below the contact scan's
+    /// negligible force ([`NEGLIGIBLE_FORCE`]).
+    fn force_negligible(&self, bond: usize, c: f64) -> bool;
+
+    /// A bound on the total overlap bond `bond` reaches when it holds all of `energy` on top
+    /// of its static state.
+    fn overlap_within(&self, bond: usize, energy: f64) -> f64;
+
+    /// The stiffness dF/dc of bond `bond` at the largest overlap `energy` allows, which bounds
+    /// an explicit step; `None` for a law the steps are calibrated on (the paper's).
+    fn stiffness_within(&self, bond: usize, energy: f64) -> Option<f64>;
+
+    /// The elastic force of each of `n_bonds` bonds at rest (what a record reads for a bond
+    /// outside the active window).
+    fn forces_at_rest(&self, n_bonds: usize) -> Vec<f64> {
+        (0..n_bonds).map(|b| self.static_force(b)).collect()
+    }
+
+    /// The dissipative part: bond `bond`'s force at relative displacement `r` closing at
+    /// `rate` under `damping`'s contact dashpot (if any), and the dashpot's power.
+    #[inline(always)]
+    fn damped(
+        &self,
+        damping: Option<&Damping>,
+        bond: usize,
+        r: f64,
+        rate: f64,
+    ) -> (BondForce, f64) {
+        let (c, elastic, rest) = (
+            self.overlap(bond, r),
+            self.elastic(bond, r),
+            self.static_force(bond),
+        );
+        // At c = 0 the dashpot already acts: a contact closing from touching (an impulse
+        // given to a site beside one at rest) feels γ ċ from its first instant.
+        let total = match damping {
+            Some(d) if d.contact_at(bond) > 0.0 && c >= 0.0 => {
+                (elastic + d.law.force(d.contact_at(bond), c, rate)).max(0.0)
+            }
+            _ => elastic,
+        };
+        (
+            BondForce {
+                total,
+                elastic,
+                rest,
+            },
+            (total - elastic) * rate,
+        )
+    }
+}
+
+/// One contact's force: the total the sites feel (clipped at zero), its elastic part, and the
+/// static force the rest state balances (0 without precompression).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct BondForce {
+    pub total: f64,
+    pub elastic: f64,
+    pub rest: f64,
+}
+
+/// A chain's contact law, as the simulator dispatches on it ([`with_law!`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Contacts<'a> {
+    /// The paper's law.
+    Paper(&'a PaperHertz),
+    /// The experiment's law.
+    Law(&'a ContactLaw),
+}
+
+impl<'a> Contacts<'a> {
+    /// The law of a chain that holds `law` (the paper's when `None`).
+    pub fn of(law: Option<&'a ContactLaw>) -> Contacts<'a> {
+        match law {
+            None => Contacts::Paper(&PaperHertz),
+            Some(law) => Contacts::Law(law),
+        }
+    }
+}
+
+/// Runs `$body` with `$law` bound to the law of `$contacts` ([`Contacts`]) as a reference to
+/// its own type, so that generic code over [`Law`] is compiled once per law and the choice is
+/// made here, once, outside its loops.
+macro_rules! with_law {
+    ($contacts:expr, |$law:ident| $body:expr) => {
+        match $contacts {
+            $crate::contact::Contacts::Paper($law) => $body,
+            $crate::contact::Contacts::Law($law) => $body,
+        }
+    };
+}
+pub(crate) use with_law;
