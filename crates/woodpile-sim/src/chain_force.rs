@@ -1,7 +1,8 @@
-//! The conservative chain's force kernel, written once: generic over the contact law
-//! ([`Law`]) and over the width of a value ([`Width`]: one scene's `f64`, or the lanes' group
-//! of four scenes), and the patch after a corrected step, generic over the law and over how
-//! one scene's values are read ([`Dofs`]).
+//! The chain's force kernel, written once: generic over the contact law ([`Law`]), over the
+//! width of a value ([`Width`]: one scene's `f64`, or the lanes' group of four scenes) and
+//! over what the chain loses ([`Losses`]: nothing, or the dashpots of a dissipative chain,
+//! [`crate::damped_force`]); and the patch after a corrected step, generic over the law and
+//! over how one scene's values are read ([`Dofs`]).
 //!
 //! Every force is computed by the same operations in the same order in every copy, so that
 //! a scene in a lane, a patched stage and a whole evaluation give the same bits as the scalar
@@ -75,21 +76,92 @@ pub(crate) struct Frame {
     pub n_sites: usize,
     /// Whether a wall lies beyond the first and the last site.
     pub walls: [bool; 2],
-    /// The springs of soft ends (left, right). A soft end's dashpot makes the chain
-    /// dissipative, and its forces then come from [`crate::damped_force`].
-    pub springs: [Option<f64>; 2],
+    /// The spring and dashpot of each soft end (left, right). A dashpot acts only through
+    /// [`Losses::soft_end`]: a chain with one is dissipative.
+    pub soft_ends: [Option<(f64, f64)>; 2],
+}
+
+/// What a chain loses, where the kernel asks: each hook of a conservative chain
+/// ([`Lossless`]) returns the conservative force by the conservative loop's operations, so
+/// that it compiles to that loop; a dissipative chain's adds its dashpots and sums their power.
+pub(crate) trait Losses<V: Width> {
+    /// Bond `bond`'s recorded force and the force it adds to the rest state's, at relative
+    /// displacement `r`, its members being `sites` (left, right; `None` for a wall).
+    fn bond<L: Law>(
+        &mut self,
+        law: &L,
+        bond: usize,
+        r: V,
+        sites: (Option<usize>, Option<usize>),
+    ) -> (V, V);
+
+    /// The force of a soft end (`spring`, `damping`) on its site `site`, at position `u`.
+    fn soft_end(&mut self, end: (f64, f64), site: usize, u: V) -> V;
+
+    /// What acts on the window's sites from outside the chain (ground damping), taken from
+    /// their forces `acc_u`.
+    fn ground(&mut self, acc_u: &mut [V], window: Window);
+
+    /// Resonator `j`'s force on its host `site`, whose elastic part is `elastic`.
+    fn resonator(&mut self, j: usize, site: usize, elastic: V) -> V;
+
+    /// The window's accelerations from its forces `acc_u`.
+    fn inertia(&self, acc_u: &mut [V], window: Window);
+}
+
+/// A conservative chain: no losses, and its sites' masses (`None` for unit masses: no
+/// division).
+pub(crate) struct Lossless<'a, V> {
+    pub masses: Option<&'a [V]>,
+}
+
+impl<V: Width> Losses<V> for Lossless<'_, V> {
+    #[inline(always)]
+    fn bond<L: Law>(
+        &mut self,
+        law: &L,
+        bond: usize,
+        r: V,
+        _: (Option<usize>, Option<usize>),
+    ) -> (V, V) {
+        let elastic = r.map(|r| law.elastic(bond, r));
+        (elastic, elastic.map(|e| law.net(bond, e)))
+    }
+
+    #[inline(always)]
+    fn soft_end(&mut self, (spring, _): (f64, f64), _: usize, u: V) -> V {
+        u.map(|u| spring * u)
+    }
+
+    #[inline(always)]
+    fn ground(&mut self, _: &mut [V], _: Window) {}
+
+    #[inline(always)]
+    fn resonator(&mut self, _: usize, _: usize, elastic: V) -> V {
+        elastic
+    }
+
+    #[inline(always)]
+    fn inertia(&self, acc_u: &mut [V], window: Window) {
+        let (lo, hi) = (window.lo, window.hi);
+        if let Some(masses) = self.masses {
+            for (a, m) in acc_u[lo..=hi].iter_mut().zip(&masses[lo..=hi]) {
+                *a = a.zip(*m, |a, m| a / m);
+            }
+        }
+    }
 }
 
 /// Accelerations of positions `q` (sites, then resonators) on the sites of `window` and of
-/// every resonator, written into `acc`; with `record`, every bond's elastic force of the window
-/// too (entry b: the bond left of site b; 0 and `n_sites` the walls). Entries outside the
-/// window are left untouched: the callers keep them at their exact value while those sites
-/// are at rest. `masses` are the sites' (none: unit masses, and no division).
+/// every resonator, written into `acc`; with `record`, every bond's recorded force of the
+/// window too (entry b: the bond left of site b; 0 and `n_sites` the walls). Entries outside
+/// the window are left untouched: the callers keep them at their exact value while those sites
+/// are at rest.
 #[inline(always)]
 pub(crate) fn chain_accelerations<L: Law, V: Width, K: Fn() -> V>(
     (law, frame): (&L, &Frame),
     resonators: impl Iterator<Item = Coupled<V, K>>,
-    masses: Option<&[V]>,
+    losses: &mut impl Losses<V>,
     (q, acc): (&[V], &mut [V]),
     window: Window,
     record: Option<&mut [V]>,
@@ -99,35 +171,34 @@ pub(crate) fn chain_accelerations<L: Law, V: Width, K: Fn() -> V>(
     debug_assert!(lo <= hi && hi < n);
     let (u, rv) = q.split_at(n);
     let (acc_u, acc_v) = acc.split_at_mut(n);
-    contact_chain(law, frame.walls, u, acc_u, window, record);
-    if frame.springs.iter().any(Option::is_some) {
-        spring_ends(frame.springs, u, acc_u, window);
+    contact_chain((law, frame.walls), losses, u, acc_u, window, record);
+    if frame.soft_ends.iter().any(Option::is_some) {
+        soft_ends(frame.soft_ends, losses, u, acc_u, window);
     }
+    losses.ground(acc_u, window);
     for (j, r) in resonators.enumerate() {
         if r.site < lo || r.site > hi {
             continue;
         }
         let stretch = u[r.site].zip(rv[j], |host, own| host - own);
-        let f = (r.kappa)().zip(stretch, |kappa, x| kappa * odd_power(x, r.p));
+        let elastic = (r.kappa)().zip(stretch, |kappa, x| kappa * odd_power(x, r.p));
+        let f = losses.resonator(j, r.site, elastic);
         acc_u[r.site] = acc_u[r.site].zip(f, |a, f| a - f);
         acc_v[j] = f.zip(r.eps, |f, eps| f / eps);
     }
-    if let Some(masses) = masses {
-        for (a, m) in acc_u[lo..=hi].iter_mut().zip(&masses[lo..=hi]) {
-            *a = a.zip(*m, |a, m| a / m);
-        }
-    }
+    losses.inertia(acc_u, window);
 }
 
 /// The contact forces on the sites of `window`, written into `acc_u`; with `record`, every
-/// bond's elastic force. Each site's force is (left bond) − (right bond), computed in one
+/// bond's recorded force. Each site's force is (left bond) − (right bond), computed in one
 /// pass with the previous bond's force in a register: every acceleration is written once
 /// (no store-to-load chain). The recording loop is a separate copy so that the plain one
-/// carries no extra store.
+/// carries no extra store. The bonds are evaluated left to right, walls included, which is
+/// the order a dissipative chain sums its dashpots' power in.
 #[inline(always)]
 fn contact_chain<L: Law, V: Width>(
-    law: &L,
-    [left_wall, right_wall]: [bool; 2],
+    (law, [left_wall, right_wall]): (&L, [bool; 2]),
+    losses: &mut impl Losses<V>,
     u: &[V],
     acc_u: &mut [V],
     window: Window,
@@ -135,15 +206,21 @@ fn contact_chain<L: Law, V: Width>(
 ) {
     let (lo, hi) = (window.lo, window.hi);
     let n = u.len();
+    let left = (lo == 0 && left_wall).then(|| {
+        let r = u[0].map(|u| -u);
+        losses.bond(law, 0, r, (None, Some(0)))
+    });
     let u_w = &u[lo..=hi];
     let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
-    let elastic = |bond: usize, left: V, right: V| left.zip(right, |l, r| law.elastic(bond, l - r));
-    let net = |bond: usize, elastic: V| elastic.map(|e| law.net(bond, e));
     let mut previous = V::ZERO;
+    let bond = |i: usize, losses: &mut _| {
+        let r = u_w[i - 1].zip(u_w[i], |l, r| l - r);
+        Losses::bond(losses, law, lo + i, r, (Some(lo + i - 1), Some(lo + i)))
+    };
     match record.as_deref_mut() {
         None => {
             for i in 1..u_w.len() {
-                let f = net(lo + i, elastic(lo + i, u_w[i - 1], u_w[i]));
+                let (_, f) = bond(i, losses);
                 acc_w[i - 1] = previous.zip(f, |p, f| p - f);
                 previous = f;
             }
@@ -151,42 +228,48 @@ fn contact_chain<L: Law, V: Width>(
         Some(record) => {
             let record_w = &mut record[lo + 1..=hi][..u_w.len() - 1];
             for i in 1..u_w.len() {
-                let e = elastic(lo + i, u_w[i - 1], u_w[i]);
-                let f = net(lo + i, e);
+                let (recorded, f) = bond(i, losses);
                 acc_w[i - 1] = previous.zip(f, |p, f| p - f);
-                record_w[i - 1] = e;
+                record_w[i - 1] = recorded;
                 previous = f;
             }
         }
     }
     acc_w[u_w.len() - 1] = previous;
-    if lo == 0 && left_wall {
-        let e = u[0].map(|u| law.elastic(0, -u));
+    if let Some((recorded, f)) = left {
         if let Some(record) = record.as_deref_mut() {
-            record[0] = e;
+            record[0] = recorded;
         }
-        acc_u[0] = acc_u[0].zip(net(0, e), |a, f| a + f);
+        acc_u[0] = acc_u[0].zip(f, |a, f| a + f);
     }
     if hi == n - 1 && right_wall {
-        let e = u[n - 1].map(|u| law.elastic(n, u));
+        let (recorded, f) = losses.bond(law, n, u[n - 1], (Some(n - 1), None));
         if let Some(record) = record {
-            record[n] = e;
+            record[n] = recorded;
         }
-        acc_u[n - 1] = acc_u[n - 1].zip(net(n, e), |a, f| a - f);
+        acc_u[n - 1] = acc_u[n - 1].zip(f, |a, f| a - f);
     }
 }
 
-/// The springs of soft ends, added to the window's end sites. Out of line: the force loop of
+/// The soft ends' forces, taken from the window's end sites. Out of line: the force loop of
 /// chains without them should not carry it.
 #[inline(never)]
 #[cold]
-fn spring_ends<V: Width>(springs: [Option<f64>; 2], u: &[V], acc_u: &mut [V], window: Window) {
+fn soft_ends<V: Width>(
+    ends: [Option<(f64, f64)>; 2],
+    losses: &mut impl Losses<V>,
+    u: &[V],
+    acc_u: &mut [V],
+    window: Window,
+) {
     let last = u.len() - 1;
-    if let (0, Some(spring)) = (window.lo, springs[0]) {
-        acc_u[0] = acc_u[0].zip(u[0], |a, u| a - spring * u);
+    if let (0, Some(end)) = (window.lo, ends[0]) {
+        let f = losses.soft_end(end, 0, u[0]);
+        acc_u[0] = acc_u[0].zip(f, |a, f| a - f);
     }
-    if let (true, Some(spring)) = (window.hi == last, springs[1]) {
-        acc_u[last] = acc_u[last].zip(u[last], |a, u| a - spring * u);
+    if let (true, Some(end)) = (window.hi == last, ends[1]) {
+        let f = losses.soft_end(end, last, u[last]);
+        acc_u[last] = acc_u[last].zip(f, |a, f| a - f);
     }
 }
 
@@ -242,10 +325,10 @@ pub(crate) fn patch<L: Law, K: Fn() -> f64, Q: Dofs + ?Sized, A: DofsMut + ?Size
         if k == n - 1 && right_wall {
             a -= right_wall_force().1;
         }
-        if let (0, Some(spring)) = (k, frame.springs[0]) {
+        if let (0, Some((spring, _))) = (k, frame.soft_ends[0]) {
             a -= spring * q.at(0);
         }
-        if let (true, Some(spring)) = (k == n - 1, frame.springs[1]) {
+        if let (true, Some((spring, _))) = (k == n - 1, frame.soft_ends[1]) {
             a -= spring * q.at(n - 1);
         }
         for (j, r) in resonators.clone().enumerate() {

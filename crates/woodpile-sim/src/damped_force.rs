@@ -1,10 +1,12 @@
 //! The forces of a dissipative chain ([`crate::damping`]): accelerations from positions *and*
-//! velocities, with the dissipated power the ledger integrates. Only a scene that declares
-//! dissipation runs this loop; the conservative one ([`crate::force`]) keeps its bits.
+//! velocities, with the dissipated power the ledger integrates. They are the chain's force
+//! kernel ([`crate::chain_force`]) with the chain's losses ([`Dissipating`]); only a scene
+//! that declares dissipation runs them, and the conservative chain keeps its bits.
 
+use crate::chain_force::{chain_accelerations, Losses};
 use crate::contact::{with_law, BondForce, Law};
+use crate::damping::Damping;
 pub use crate::error::Dissipator;
-use crate::force::odd_power;
 use crate::model::{Model, Window};
 
 /// Where a dissipative force loop records each bond's force and dashpot power (indexing of
@@ -35,78 +37,39 @@ impl Model {
     }
 
     /// [`Model::damped_accelerations_in`], recording every bond's force and dashpot power
-    /// into `record` when a contact-event method keeps them.
+    /// into `record` when a contact-event method keeps them: the chain's force kernel
+    /// ([`chain_accelerations`]) with the chain's losses ([`Dissipating`]).
     pub(crate) fn damped_recording(
         &self,
         t: f64,
         (q, v): (&[f64], &[f64]),
         acc: &mut [f64],
         window: Window,
-        mut record: Option<BondRecord<'_>>,
+        record: Option<BondRecord<'_>>,
     ) -> f64 {
-        let n_sites = self.n_sites();
-        let (lo, hi) = (window.lo, window.hi);
-        let (u, w) = q[..self.n_dof()].split_at(n_sites);
-        let (u_dot, w_dot) = v[..self.n_dof()].split_at(n_sites);
-        let (acc_u, acc_w) = acc[..self.n_dof()].split_at_mut(n_sites);
-        acc_u[lo..=hi].fill(0.0);
-        let mut power = 0.0;
-        let boundary = self.boundary();
-        // Bonds b join sites b − 1 and b; a wall is a member at rest.
-        let first = if lo == 0 && boundary.left_wall() {
-            0
-        } else {
-            lo + 1
+        let n_dof = self.n_dof();
+        let (force_record, power_record) = match record {
+            Some(BondRecord { force, power }) => (Some(force), Some(power)),
+            None => (None, None),
         };
-        let last = if hi == n_sites - 1 && boundary.right_wall() {
-            n_sites
-        } else {
-            hi
+        let (u_dot, w_dot) = v[..n_dof].split_at(self.n_sites());
+        let mut losses = Dissipating {
+            damping: self.damping(),
+            velocities: (u_dot, w_dot),
+            inv_mass: self.inv_mass(),
+            power: 0.0,
+            power_record,
         };
-        for bond in first..=last {
-            let left = bond.checked_sub(1);
-            let right = (bond < n_sites).then_some(bond);
-            let at = |x: &[f64], site: Option<usize>| site.map_or(0.0, |i| x[i]);
-            let r = at(u, left) - at(u, right);
-            let rate = at(u_dot, left) - at(u_dot, right);
-            let (force, dashpot_power) = self.contact_force(bond, r, rate);
-            if let Some(rec) = record.as_mut() {
-                rec.force[bond] = force.total;
-                rec.power[bond] = dashpot_power;
-            }
-            power += dashpot_power;
-            let net = force.total - force.rest;
-            if let Some(i) = left {
-                acc_u[i] -= net;
-            }
-            if let Some(i) = right {
-                acc_u[i] += net;
-            }
-        }
-        power += self.soft_ends(u, u_dot, acc_u, window);
-        let damping = self.damping();
-        let ground = damping.map_or(0.0, |d| d.ground);
-        if ground > 0.0 {
-            for i in lo..=hi {
-                acc_u[i] -= ground * u_dot[i];
-                power += ground * u_dot[i] * u_dot[i];
-            }
-        }
-        for (j, r) in self.resonators().iter().enumerate() {
-            if r.site < lo || r.site > hi {
-                continue;
-            }
-            let c = damping.map_or(0.0, |d| d.resonator(j));
-            let slip = u_dot[r.site] - w_dot[j];
-            let f = r.coupling.at(t) * odd_power(u[r.site] - w[j], r.p) + c * slip;
-            power += c * slip * slip;
-            acc_u[r.site] -= f;
-            acc_w[j] = f / r.eps;
-        }
-        for (a, inv_m) in acc_u[lo..=hi].iter_mut().zip(&self.inv_mass()[lo..=hi]) {
-            *a *= inv_m;
-        }
-        power
+        let frame = self.frame();
+        with_law!(self.law(), |law| chain_accelerations(
+            (law, &frame),
+            self.coupled(t),
+            &mut losses,
+            (&q[..n_dof], &mut acc[..n_dof]),
+            window,
+            force_record
+        ));
+        losses.power
     }
 
     /// Bond `bond`'s force at relative displacement `r` (left minus right) closing at `rate`,
@@ -203,22 +166,69 @@ impl Model {
                 Some((Dissipator::SoftEnd { last: site > 0 }, site, soft))
             })
     }
+}
 
-    /// The soft ends' spring and dashpot forces on the window's end sites, added to `acc_u`;
-    /// returns their dashpots' power.
-    fn soft_ends(&self, u: &[f64], u_dot: &[f64], acc_u: &mut [f64], window: Window) -> f64 {
-        let last = self.n_sites() - 1;
-        let ends = [
-            (window.lo == 0, 0, self.boundary().left()),
-            (window.hi == last, last, self.boundary().right()),
-        ];
-        let mut power = 0.0;
-        for (inside, site, end) in ends {
-            if let (true, Some((spring, damping))) = (inside, end.soft()) {
-                acc_u[site] -= spring * u[site] + damping * u_dot[site];
-                power += damping * u_dot[site] * u_dot[site];
+/// The losses of a dissipative chain, as the force kernel adds them: each contact's dashpot
+/// (clipped so that a contact never pulls), each soft end's dashpot, ground damping and each
+/// resonator's dashpot, with the power they dissipate summed in the kernel's order.
+struct Dissipating<'a> {
+    damping: Option<&'a Damping>,
+    /// The sites' and the resonators' velocities.
+    velocities: (&'a [f64], &'a [f64]),
+    inv_mass: &'a [f64],
+    /// The dissipated power summed so far.
+    power: f64,
+    /// Where each bond's dashpot power is kept, for the contact-event correction.
+    power_record: Option<&'a mut [f64]>,
+}
+
+impl Losses<f64> for Dissipating<'_> {
+    #[inline(always)]
+    fn bond<L: Law>(
+        &mut self,
+        law: &L,
+        bond: usize,
+        r: f64,
+        (left, right): (Option<usize>, Option<usize>),
+    ) -> (f64, f64) {
+        let at = |site: Option<usize>| site.map_or(0.0, |i| self.velocities.0[i]);
+        let rate = at(left) - at(right);
+        let (force, dashpot_power) = law.damped(self.damping, bond, r, rate);
+        if let Some(record) = self.power_record.as_deref_mut() {
+            record[bond] = dashpot_power;
+        }
+        self.power += dashpot_power;
+        (force.total, force.total - force.rest)
+    }
+
+    fn soft_end(&mut self, (spring, damping): (f64, f64), site: usize, u: f64) -> f64 {
+        let u_dot = self.velocities.0[site];
+        self.power += damping * u_dot * u_dot;
+        spring * u + damping * u_dot
+    }
+
+    fn ground(&mut self, acc_u: &mut [f64], window: Window) {
+        let ground = self.damping.map_or(0.0, |d| d.ground);
+        if ground > 0.0 {
+            for i in window.lo..=window.hi {
+                let u_dot = self.velocities.0[i];
+                acc_u[i] -= ground * u_dot;
+                self.power += ground * u_dot * u_dot;
             }
         }
-        power
+    }
+
+    fn resonator(&mut self, j: usize, site: usize, elastic: f64) -> f64 {
+        let c = self.damping.map_or(0.0, |d| d.resonator(j));
+        let slip = self.velocities.0[site] - self.velocities.1[j];
+        self.power += c * slip * slip;
+        elastic + c * slip
+    }
+
+    fn inertia(&self, acc_u: &mut [f64], window: Window) {
+        let (lo, hi) = (window.lo, window.hi);
+        for (a, inv_m) in acc_u[lo..=hi].iter_mut().zip(&self.inv_mass[lo..=hi]) {
+            *a *= inv_m;
+        }
     }
 }

@@ -4,7 +4,7 @@
 //! evaluates a power 3/2 only for compressed contacts: at any moment only a handful of the
 //! chain's contacts are closed.
 
-use crate::chain_force::{chain_accelerations, patch, Coupled, Frame};
+use crate::chain_force::{chain_accelerations, patch, Coupled, Frame, Lossless};
 use crate::contact::with_law;
 pub use crate::contact::{hertz_force, hertz_potential};
 use crate::model::{Model, Window};
@@ -71,11 +71,13 @@ impl Model {
         debug_assert_eq!(q.len(), self.n_dof());
         debug_assert_eq!(acc.len(), self.n_dof());
         let frame = self.frame();
-        let (resonators, masses) = (self.coupled(t), self.site_masses());
+        let mut lossless = Lossless {
+            masses: self.site_masses(),
+        };
         with_law!(self.law(), |law| chain_accelerations(
             (law, &frame),
-            resonators,
-            masses,
+            self.coupled(t),
+            &mut lossless,
             (q, acc),
             window,
             bond_force
@@ -110,20 +112,19 @@ impl Model {
 
     /// What the force loops read of the chain besides its law, resonators and masses.
     #[inline(always)]
-    fn frame(&self) -> Frame {
-        let spring = |end: crate::model::End| end.soft().map(|(spring, _)| spring);
+    pub(crate) fn frame(&self) -> Frame {
         let boundary = self.boundary();
         Frame {
             n_sites: self.n_sites(),
             walls: self.walls(),
-            springs: [spring(boundary.left()), spring(boundary.right())],
+            soft_ends: [boundary.left().soft(), boundary.right().soft()],
         }
     }
 
     /// The resonators as the force loops read them at time `t` (a coupling is computed only
     /// where a loop reaches its host).
     #[inline(always)]
-    fn coupled(
+    pub(crate) fn coupled(
         &self,
         t: f64,
     ) -> impl Iterator<Item = Coupled<f64, impl Fn() -> f64 + '_>> + Clone + '_ {

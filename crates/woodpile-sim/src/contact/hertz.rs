@@ -157,9 +157,12 @@ mod tests {
         }
         overlaps.extend((0..20_000).map(|k| 1e-12 * 1.001f64.powi(k)));
         for d in overlaps {
-            assert_eq!(PaperHertz.force_negligible(0, d), by_force(d), "overlap {d:e}");
+            assert_eq!(
+                PaperHertz.force_negligible(0, d),
+                by_force(d),
+                "overlap {d:e}"
+            );
         }
         assert!(by_force(SURELY_NEGLIGIBLE_OVERLAP) && !by_force(SURELY_FELT_OVERLAP));
     }
-
 }

@@ -3,7 +3,7 @@
 //! few sites of one lane.
 
 use super::{Lane, LaneChain, LaneMut, Lanes};
-use crate::chain_force::{chain_accelerations, Coupled, Frame};
+use crate::chain_force::{chain_accelerations, Coupled, Frame, Lossless};
 use crate::contact::{with_law, Contacts};
 use crate::model::Window;
 
@@ -18,7 +18,7 @@ impl LaneChain {
         Frame {
             n_sites: self.n_sites,
             walls: self.walls,
-            springs: self.springs,
+            soft_ends: self.springs.map(|spring| spring.map(|s| (s, 0.0))),
         }
     }
 }
@@ -42,7 +42,9 @@ pub(super) fn accelerations(
     with_law!(chain.law(), |law| chain_accelerations(
         (law, &frame),
         resonators,
-        chain.masses.as_deref(),
+        &mut Lossless {
+            masses: chain.masses.as_deref()
+        },
         (q, acc),
         window,
         Some(record)
