@@ -23,9 +23,6 @@ impl Model {
     /// (and every resonator), written into `acc`, for positions `q` and velocities `v` (each
     /// of length `n_dof`); returns the dissipated power of the window. With `record`, every
     /// bond's force and dashpot power are kept for the contact-event correction.
-    ///
-    /// The conservative loop ([`Model::accelerations_in`]) stays as it is: this one is simple
-    /// rather than fast, and only a scene that declares dissipation runs it.
     pub fn damped_accelerations_in(
         &self,
         t: f64,

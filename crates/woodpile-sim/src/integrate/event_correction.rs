@@ -17,11 +17,56 @@ use crate::model::{Model, Window};
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
 pub(crate) type Quadrature<const S: usize> = fn([f64; S], f64) -> (f64, f64);
 
-/// A bond and its members: (bond, left site or None for a wall, right site or None).
-pub(crate) type BondSites = (usize, Option<usize>, Option<usize>);
+/// A bond and its members (`None` for a wall), in the numbering of [`crate::contact`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Bond {
+    pub index: usize,
+    pub left: Option<usize>,
+    pub right: Option<usize>,
+}
 
-/// A bond's correction: (left site or None for a wall, right site or None, impulse, position).
-pub(super) type Correction = (Option<usize>, Option<usize>, f64, f64);
+impl Bond {
+    /// The bond between sites `index − 1` and `index`.
+    pub fn inner(index: usize) -> Bond {
+        Bond {
+            index,
+            left: Some(index - 1),
+            right: Some(index),
+        }
+    }
+
+    /// The wall left of the first site.
+    pub fn left_wall() -> Bond {
+        Bond {
+            index: 0,
+            left: None,
+            right: Some(0),
+        }
+    }
+
+    /// The wall right of the last of `n_sites` sites.
+    pub fn right_wall(n_sites: usize) -> Bond {
+        Bond {
+            index: n_sites,
+            left: Some(n_sites - 1),
+            right: None,
+        }
+    }
+
+    /// (left, right).
+    pub fn members(self) -> (Option<usize>, Option<usize>) {
+        (self.left, self.right)
+    }
+}
+
+/// A bond's correction: the impulse and the position moment its members receive (the left
+/// one pushed back, the right one on).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Correction {
+    pub bond: Bond,
+    pub impulse: f64,
+    pub moment: f64,
+}
 
 /// Extra passes of a dissipative chain's corrections ([`ContactEvents::refine`]).
 const REFINE_PASSES: usize = 2;
@@ -34,7 +79,12 @@ pub(super) fn apply<D: DofsMut + ?Sized>(
     corrections: &[Correction],
     (new_q, new_v): (&mut D, &mut D),
 ) {
-    for &(left, right, impulse, moment) in corrections {
+    for &Correction {
+        bond: Bond { left, right, .. },
+        impulse,
+        moment,
+    } in corrections
+    {
         if let Some(i) = left {
             new_v.sub(i, impulse * inv_mass[i]);
             new_q.sub(i, moment * inv_mass[i]);
@@ -74,6 +124,42 @@ pub(super) fn bond_integrals(
     (impulse, moment, 0.0)
 }
 
+/// A changed bond's correction over a step of size `h` from the states `start` to `end`
+/// (`(q, v)` each, the end not yet corrected) by a method of quadrature `quadrature` whose
+/// stages gave the bond the forces `stage`: the path integrals less the quadrature, with its
+/// parts along the fast modes of `exact` resonators at its members pushed to `fast`; and the
+/// energy its dashpot dissipated along the path. `None` when its forces are [`negligible`].
+/// One scene's states, or one lane's (`super::lanes`), are read through [`Dofs`].
+pub(super) fn bond_correction<const S: usize, D: Dofs + ?Sized>(
+    model: &Model,
+    (bond, stage): (Bond, [f64; S]),
+    (start, end): ((&D, &D), (&D, &D)),
+    (h, quadrature, exact): (f64, Quadrature<S>, Option<&ExactResonators<S>>),
+    fast: &mut Vec<FastModeCorrection>,
+) -> Option<(Correction, f64)> {
+    let path = bond_path(model, bond.index, start, end, bond.members());
+    if negligible(model, bond.index, stage, &path) {
+        return None;
+    }
+    let (impulse, moment, lost) = bond_integrals(model, bond.index, &path, h);
+    let (q0, q1) = quadrature(stage, h);
+    let plain = (impulse - q0, moment - q1);
+    if let Some(exact) = exact {
+        for (member, sign) in [(bond.left, -1.0), (bond.right, 1.0)] {
+            if let Some(pair) = member.and_then(|site| exact.host(site)) {
+                let on = (bond.index, &path, stage);
+                fast.push(fast_mode_correction(model, on, h, plain, (pair, sign)));
+            }
+        }
+    }
+    let correction = Correction {
+        bond,
+        impulse: plain.0,
+        moment: plain.1,
+    };
+    Some((correction, lost))
+}
+
 /// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the
 /// path integrals and the switch search take them (the path is of the total overlap; the
 /// force law takes the relative displacement, without the static overlap).
@@ -104,9 +190,9 @@ pub(crate) struct ContactEvents<const S: usize> {
     /// Bonds corrected so far.
     events: u64,
     /// Scratch: the bonds that changed contact in this step.
-    changed: Vec<BondSites>,
+    changed: Vec<Bond>,
     /// Bonds the next step corrects whatever its scan finds ([`ContactEvents::correct_next`]).
-    carried: Vec<BondSites>,
+    carried: Vec<Bond>,
 }
 
 impl<const S: usize> ContactEvents<S> {
@@ -156,7 +242,11 @@ impl<const S: usize> ContactEvents<S> {
         acc: &mut [f64],
         mut exact: Option<&mut ExactResonators<S>>,
     ) {
-        for &(left, right, ..) in &self.pending {
+        for &Correction {
+            bond: Bond { left, right, .. },
+            ..
+        } in &self.pending
+        {
             let Some(first) = left.or(right) else {
                 continue;
             };
@@ -206,34 +296,20 @@ impl<const S: usize> ContactEvents<S> {
         let mut dissipated = 0.0;
         let mut corrected = std::mem::take(&mut self.corrected);
         corrected.clear();
-        for &(bond, left, right) in &self.changed {
-            let stage = self.stage_forces(bond);
-            let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(model, bond, stage, &path) {
+        for &bond in &self.changed {
+            let stage = self.stage_forces(bond.index);
+            let states = ((q, v), (&*new_q, &*new_v));
+            let method = (h, quadrature, exact);
+            let found =
+                bond_correction(model, (bond, stage), states, method, &mut self.pending_fast);
+            let Some((correction, lost)) = found else {
                 continue;
-            }
-            let (impulse, moment, lost) = bond_integrals(model, bond, &path, h);
-            let (q0, q1) = quadrature(stage, h);
-            pending.push((left, right, impulse - q0, moment - q1));
-            if let Some(exact) = exact {
-                for (member, sign) in [(left, -1.0), (right, 1.0)] {
-                    if let Some(pair) = member.and_then(|site| exact.host(site)) {
-                        let plain = (impulse - q0, moment - q1);
-                        let fast = (bond, &path, stage);
-                        self.pending_fast.push(fast_mode_correction(
-                            model,
-                            fast,
-                            h,
-                            plain,
-                            (pair, sign),
-                        ));
-                    }
-                }
-            }
+            };
+            pending.push(correction);
             if model.is_dissipative() {
-                let powers = std::array::from_fn(|s| self.stage_power[s][bond]);
+                let powers = std::array::from_fn(|s| self.stage_power[s][bond.index]);
                 dissipated += lost - quadrature(powers, h).0;
-                corrected.push((bond, lost));
+                corrected.push((bond.index, lost));
             }
         }
         if model.is_dissipative() {
@@ -270,17 +346,21 @@ impl<const S: usize> ContactEvents<S> {
             let mut deltas = Vec::with_capacity(pending.len());
             let mut dissipated = 0.0;
             for (applied, (bond, lost_before)) in pending.iter_mut().zip(corrected.iter_mut()) {
-                let (left, right, impulse_before, moment_before) = *applied;
-                let path = bond_path(model, *bond, (q, v), (new_q, new_v), (left, right));
+                let before = *applied;
+                let members = before.bond.members();
+                let path = bond_path(model, *bond, (q, v), (new_q, new_v), members);
                 let (impulse, moment, lost) = bond_integrals(model, *bond, &path, h);
                 let (q0, q1) = (self.quadrature)(self.stage_forces(*bond), h);
-                *applied = (left, right, impulse - q0, moment - q1);
-                deltas.push((
-                    left,
-                    right,
-                    impulse - q0 - impulse_before,
-                    moment - q1 - moment_before,
-                ));
+                *applied = Correction {
+                    impulse: impulse - q0,
+                    moment: moment - q1,
+                    ..before
+                };
+                deltas.push(Correction {
+                    impulse: impulse - q0 - before.impulse,
+                    moment: moment - q1 - before.moment,
+                    ..before
+                });
                 dissipated += lost - *lost_before;
                 *lost_before = lost;
             }
@@ -316,7 +396,7 @@ impl<const S: usize> ContactEvents<S> {
         (start, end): (&[f64], &[f64]),
         h: f64,
         window: Window,
-    ) -> Option<(f64, BondSites)> {
+    ) -> Option<(f64, Bond)> {
         let switch =
             |bond: usize, path: &BondPath| first_switch(path, h, damped_force(model, bond));
         self.earliest(model, (start, end), window, switch)
@@ -330,19 +410,20 @@ impl<const S: usize> ContactEvents<S> {
         (start, end): (&[f64], &[f64]),
         window: Window,
         moment: impl Fn(usize, &BondPath) -> Option<f64>,
-    ) -> Option<(f64, BondSites)> {
+    ) -> Option<(f64, Bond)> {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
         let (q, v) = start.split_at(n);
         let (new_q, new_v) = end.split_at(n);
-        let mut first: Option<(f64, BondSites)> = None;
-        for &(bond, left, right) in &self.changed {
-            let path = bond_path(model, bond, (q, v), (new_q, new_v), (left, right));
-            if negligible(model, bond, self.stage_forces(bond), &path) {
+        let mut first: Option<(f64, Bond)> = None;
+        for &bond in &self.changed {
+            let path = bond_path(model, bond.index, (q, v), (new_q, new_v), bond.members());
+            if negligible(model, bond.index, self.stage_forces(bond.index), &path) {
                 continue;
             }
-            if let Some(x) = moment(bond, &path).filter(|&x| first.is_none_or(|(f, _)| x < f)) {
-                first = Some((x, (bond, left, right)));
+            let earlier = |&x: &f64| first.is_none_or(|(f, _)| x < f);
+            if let Some(x) = moment(bond.index, &path).filter(earlier) {
+                first = Some((x, bond));
             }
         }
         first
@@ -350,7 +431,7 @@ impl<const S: usize> ContactEvents<S> {
 
     /// Makes the next step correct `bond` (as [`ContactEvents::first_switch`] gives it) whether
     /// or not the scan finds it changed: a step that begins just after the bond's force switched.
-    pub(crate) fn correct_next(&mut self, bond: BondSites) {
+    pub(crate) fn correct_next(&mut self, bond: Bond) {
         self.carried.push(bond);
     }
 
@@ -383,7 +464,7 @@ impl<const S: usize> ContactEvents<S> {
         // (standard scene, `rkn4-contact` at dt = 0.1: 2.10 -> 1.65 ms, best of 400).
         let changed = &mut self.changed;
         changed.clear();
-        let inner = |i: usize| (lo + i + 1, Some(lo + i), Some(lo + i + 1));
+        let inner = |i: usize| Bond::inner(lo + i + 1);
         let n_bonds = hi - lo;
         // Under precompression a bond's overlap is its static overlap plus left − right.
         let offsets = with_law!(model.law(), |law| law.static_overlaps());
@@ -429,11 +510,11 @@ impl<const S: usize> ContactEvents<S> {
         };
         let [left_wall, right_wall] = model.walls();
         if lo == 0 && left_wall && wall_changed(0, offset(0) - new_q[0]) {
-            changed.push((0, None, Some(0)));
+            changed.push(Bond::left_wall());
         }
         let last = n_sites - 1;
         if hi == last && right_wall && wall_changed(n_sites, offset(n_sites) + new_q[last]) {
-            changed.push((n_sites, Some(last), None));
+            changed.push(Bond::right_wall(n_sites));
         }
     }
 }

@@ -3,7 +3,8 @@
 //! observer) kept by the scalar driver's own [`Stepping`], and the steps taken together.
 
 use super::step::LaneRkn6;
-use super::{lanewise, LaneChain, Lanes, LANES, ZERO};
+use super::{LaneChain, Lanes, LANES, ZERO};
+use crate::chain_force::Width;
 use crate::error::SimError;
 use crate::integrate::driver::{check_finite_in, intervals, sample_time, validate, Stepping};
 use crate::integrate::{DriveConfig, Method, Observer, Stats, StepControl};
@@ -183,7 +184,7 @@ impl<'m> LaneBatch<'m> {
         let mut sum = ZERO;
         for r in [union.lo..union.hi + 1, n_sites..self.q.len()] {
             for x in self.q[r.clone()].iter().chain(&self.v[r]) {
-                sum = lanewise(sum, *x, |s, x| s + (x - x));
+                sum = sum.zip(*x, |s, x| s + (x - x));
             }
         }
         sum

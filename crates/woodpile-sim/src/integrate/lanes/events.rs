@@ -3,15 +3,12 @@
 //! [`crate::integrate::event_correction`]'s order and with its functions, so that a lane's end
 //! state is corrected exactly as its scalar run's is.
 
-use super::{lanewise, Lane, LaneMut, Lanes, LANES, S};
+use super::{Lane, LaneMut, Lanes, LANES, S};
+use crate::chain_force::Width;
 use crate::contact::{with_law, Law};
-use crate::integrate::contact_scan::{changes_contact, negligible};
-use crate::integrate::event_correction::{
-    apply, apply_fast, bond_integrals, bond_path, BondSites, Correction,
-};
-use crate::integrate::exact_resonator::{
-    fast_mode_correction, ExactResonators, FastModeCorrection,
-};
+use crate::integrate::contact_scan::changes_contact;
+use crate::integrate::event_correction::{apply, apply_fast, bond_correction, Bond, Correction};
+use crate::integrate::exact_resonator::{ExactResonators, FastModeCorrection};
 use crate::integrate::rkn::DPRKN6;
 use crate::model::{Model, Window};
 
@@ -20,7 +17,7 @@ use crate::model::{Model, Window};
 pub(super) struct LaneEvents {
     /// The bonds some live lane saw change in this step, with the mask of those lanes, in the
     /// scalar scan's order (inner bonds rising, then the left wall, then the right).
-    changed: Vec<(BondSites, u32)>,
+    changed: Vec<(Bond, u32)>,
     pending: Vec<Correction>,
     pending_fast: Vec<FastModeCorrection>,
     /// Per lane, the sites the last step's corrections moved.
@@ -52,32 +49,21 @@ impl LaneEvents {
         for (l, model) in models.iter().enumerate() {
             let mut pending = std::mem::take(&mut self.pending);
             pending.clear();
-            for &((bond, left, right), mask) in &self.changed {
+            for &(bond, mask) in &self.changed {
                 if mask >> l & 1 == 0 {
                     continue;
                 }
-                let stage: [f64; S] = std::array::from_fn(|s| stage_force[s][bond][l]);
-                let (start, end) = (
+                let stage: [f64; S] = std::array::from_fn(|s| stage_force[s][bond.index][l]);
+                let states = (
                     (&Lane(q, l), &Lane(v, l)),
                     (&Lane(new_q, l), &Lane(new_v, l)),
                 );
-                let path = bond_path(model, bond, start, end, (left, right));
-                if negligible(model, bond, stage, &path) {
-                    continue;
-                }
-                let (impulse, moment, _) = bond_integrals(model, bond, &path, h);
-                let (q0, q1) = (DPRKN6.quadrature)(stage, h);
-                pending.push((left, right, impulse - q0, moment - q1));
-                if let Some(exact) = &exact[l] {
-                    for (member, sign) in [(left, -1.0), (right, 1.0)] {
-                        if let Some(pair) = member.and_then(|site| exact.host(site)) {
-                            let plain = (impulse - q0, moment - q1);
-                            let fast = (bond, &path, stage);
-                            let correction =
-                                fast_mode_correction(model, fast, h, plain, (pair, sign));
-                            self.pending_fast.push(correction);
-                        }
-                    }
+                let method = (h, DPRKN6.quadrature, exact[l].as_ref());
+                let fast = &mut self.pending_fast;
+                if let Some((correction, _)) =
+                    bond_correction(model, (bond, stage), states, method, fast)
+                {
+                    pending.push(correction);
                 }
             }
             let end = (&mut LaneMut(new_q, l), &mut LaneMut(new_v, l));
@@ -85,7 +71,8 @@ impl LaneEvents {
             let end = (&mut LaneMut(new_q, l), &mut LaneMut(new_v, l));
             apply_fast(self.pending_fast.drain(..), end);
             let touched = &mut self.touched[l];
-            for &(left, right, ..) in &pending {
+            for correction in &pending {
+                let (left, right) = correction.bond.members();
                 touched.extend(left.into_iter().chain(right));
             }
             corrected[l] = !pending.is_empty();
@@ -126,14 +113,14 @@ impl LaneEvents {
             // Some but not all of the S + 1 values say "touching": the largest is positive and
             // the smallest is not (compare-and-select, as the scalar block test).
             let mut low = match offsets {
-                None => lanewise(new_q[bond - 1], new_q[bond], |l, r| l - r),
-                Some(delta) => lanewise(new_q[bond - 1], new_q[bond], |l, r| delta[bond] + (l - r)),
+                None => new_q[bond - 1].zip(new_q[bond], |l, r| l - r),
+                Some(delta) => new_q[bond - 1].zip(new_q[bond], |l, r| delta[bond] + (l - r)),
             };
             let mut high = low;
             for forces in stage_force {
                 let f = forces[bond];
-                low = lanewise(low, f, |low, f| if f < low { f } else { low });
-                high = lanewise(high, f, |high, f| if f > high { f } else { high });
+                low = low.zip(f, |low, f| if f < low { f } else { low });
+                high = high.zip(f, |high, f| if f > high { f } else { high });
             }
             let changed: [bool; LANES] = std::array::from_fn(|l| (high[l] > 0.0) & (low[l] <= 0.0));
             // Nearly every bond changed in no lane: one test of all four (an OR reduction, a
@@ -143,8 +130,7 @@ impl LaneEvents {
             }
             let mask = (0..LANES).fold(0, |m, l| m | (u32::from(changed[l]) << l)) & live_mask;
             if mask != 0 {
-                self.changed
-                    .push(((bond, Some(bond - 1), Some(bond)), mask));
+                self.changed.push((Bond::inner(bond), mask));
             }
         }
         let n_sites = model.n_sites();
@@ -159,13 +145,13 @@ impl LaneEvents {
         if lo == 0 && left_wall {
             let mask = wall(0, new_q[0].map(|x| offset(0) - x));
             if mask != 0 {
-                self.changed.push(((0, None, Some(0)), mask));
+                self.changed.push((Bond::left_wall(), mask));
             }
         }
         if hi == last && right_wall {
             let mask = wall(n_sites, new_q[last].map(|x| offset(n_sites) + x));
             if mask != 0 {
-                self.changed.push(((n_sites, Some(last), None), mask));
+                self.changed.push((Bond::right_wall(n_sites), mask));
             }
         }
     }

@@ -9,7 +9,7 @@ use crate::model::Window;
 
 impl LaneChain {
     /// The contact law the lanes share.
-    fn law(&self) -> Contacts<'_> {
+    pub(super) fn law(&self) -> Contacts<'_> {
         Contacts::of(self.contacts.as_ref())
     }
 

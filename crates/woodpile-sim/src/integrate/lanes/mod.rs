@@ -50,14 +50,6 @@ pub(crate) const S: usize = 6;
 /// Every lane at zero.
 pub(crate) const ZERO: Lanes = [0.0; LANES];
 
-/// `op` on each lane of `x` and `y`. Whole-lane operations on slices borrowed apart are what
-/// the compiler turns into packed instructions; element by element it reloads every pointer
-/// (docs/performance.md).
-#[inline(always)]
-pub(crate) fn lanewise(x: Lanes, y: Lanes, op: impl Fn(f64, f64) -> f64) -> Lanes {
-    std::array::from_fn(|l| op(x[l], y[l]))
-}
-
 /// Lane `l` of a batch's vector, read as one state's vector is ([`Dofs`]).
 pub(crate) struct Lane<'a>(pub &'a [Lanes], pub usize);
 

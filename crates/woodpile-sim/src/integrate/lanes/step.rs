@@ -1,11 +1,13 @@
 //! The batched `rkn6-contact` step (and `erkn6-contact`'s, with each lane's harmonic resonators
 //! integrated exactly): DPRKN6 on four chains in structure-of-arrays form (entry k of a vector
-//! is degree of freedom k, its lanes the four scenes), then each lane's contact corrections. Every lane does the scalar [`crate::integrate::Rkn`]'s operations in its order
-//! (`raw_step_body`, `Model::accelerations_impl`), which is what keeps it bit-identical.
+//! is degree of freedom k, its lanes the four scenes), then each lane's contact corrections. Every lane does the scalar
+//! [`crate::integrate::Rkn`]'s operations in its order (`raw_step_body`, and the one force
+//! kernel, [`crate::chain_force`]), which is what keeps it bit-identical.
 
 use super::events::LaneEvents;
 use super::force::{accelerations, patch};
 use super::{Lane, LaneChain, LaneMut, Lanes, LANES, S, ZERO};
+use crate::contact::{with_law, Law};
 use crate::integrate::erkn_weights::NystromWeights;
 use crate::integrate::exact_resonator::ExactResonators;
 use crate::integrate::rkn::DPRKN6;
@@ -46,10 +48,10 @@ impl LaneRkn6 {
         // A bond outside the window is at rest and carries its static force (0 but under
         // precompression): what its record must read when the window grows over it and a
         // reused stage was recorded before it did (as the scalar `ContactEvents::new`).
-        let at_rest: Vec<Lanes> = match &chain.contacts {
-            None => vec![ZERO; bonds],
-            Some(law) => (0..bonds).map(|b| [law.static_force(b); LANES]).collect(),
-        };
+        let at_rest: Vec<Lanes> = with_law!(chain.law(), |law| law.forces_at_rest(bonds))
+            .into_iter()
+            .map(|f| [f; LANES])
+            .collect();
         let n = chain.n_dof();
         Self {
             q_stage: vec![ZERO; n],
