@@ -207,9 +207,12 @@ impl Losses<f64> for Dissipating<'_> {
     fn ground(&mut self, acc_u: &mut [f64], window: Window) {
         let ground = self.damping.map_or(0.0, |d| d.ground);
         if ground > 0.0 {
-            for i in window.lo..=window.hi {
-                let u_dot = self.velocities.0[i];
-                acc_u[i] -= ground * u_dot;
+            let sites = window.lo..=window.hi;
+            for (a, &u_dot) in acc_u[sites.clone()]
+                .iter_mut()
+                .zip(&self.velocities.0[sites])
+            {
+                *a -= ground * u_dot;
                 self.power += ground * u_dot * u_dot;
             }
         }
