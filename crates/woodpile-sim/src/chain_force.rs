@@ -11,9 +11,8 @@
 //! re-evaluate one site more on each side of what moved, and no more.
 
 use crate::contact::Law;
-use crate::force::odd_power;
 use crate::integrate::exact_resonator::{Dofs, DofsMut};
-use crate::model::Window;
+use crate::model::{odd_power, Window};
 use std::ops::RangeInclusive;
 
 /// A value of the force loops: one scene's (`f64`), or one per scene of a group of lanes

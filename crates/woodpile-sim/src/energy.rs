@@ -12,8 +12,7 @@
 
 use crate::contact::{with_law, Law};
 use crate::error::ModelError;
-use crate::force::odd_power;
-use crate::model::Model;
+use crate::model::{odd_power, Model};
 
 /// A "defect region" of sites [lo, hi] (inclusive, internal 0-based numbering). Energy left of
 /// it is reflected, right of it transmitted, inside it trapped. With a striker (the chain's

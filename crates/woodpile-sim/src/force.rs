@@ -5,19 +5,9 @@
 //! chain's contacts are closed.
 
 use crate::chain_force::{chain_accelerations, patch, Coupled, Frame, Lossless};
-use crate::contact::with_law;
 pub use crate::contact::{hertz_force, hertz_potential};
+use crate::contact::{with_law, Law};
 use crate::model::{Model, Window};
-
-/// `x^p` for the odd coupling exponents (p = 1 is the common case and skips `powi`).
-#[inline(always)]
-pub fn odd_power(x: f64, p: u32) -> f64 {
-    match p {
-        1 => x,
-        3 => x * x * x,
-        _ => x.powi(p as i32),
-    }
-}
 
 impl Model {
     /// Accelerations `q'' = M^{-1} F(t, q)` for positions `q` (length `n_dof`), written into
@@ -134,6 +124,31 @@ impl Model {
             eps: r.eps,
             kappa: move || r.coupling.at(t),
         })
+    }
+
+    /// The fastest a contact of a chain under a [`crate::ContactLaw`] vibrates in a motion of total
+    /// energy `energy`: sqrt(k (1/m_left + 1/m_right)) at the stiffness k the bond has at the
+    /// largest overlap the energy allows ([`Law::stiffness_within`]); a wall counts as
+    /// infinitely heavy. 0 for the paper's chain, whose steps are calibrated on it.
+    pub fn max_contact_omega(&self, energy: f64) -> f64 {
+        with_law!(self.law(), |law| self.max_contact_omega_of(law, energy))
+    }
+
+    fn max_contact_omega_of(&self, law: &impl Law, energy: f64) -> f64 {
+        let n = self.n_sites();
+        let walls = self.walls();
+        (0..=n)
+            .filter(|&bond| (bond > 0 || walls[0]) && (bond < n || walls[1]))
+            .map_while(|bond| {
+                let inverse_masses = [bond.checked_sub(1), (bond < n).then_some(bond)]
+                    .into_iter()
+                    .flatten()
+                    .map(|site| 1.0 / self.site_mass(site))
+                    .sum::<f64>();
+                let stiffness = law.stiffness_within(bond, energy)?;
+                Some((stiffness * inverse_masses).sqrt())
+            })
+            .fold(0.0, f64::max)
     }
 
     /// First-order form `y' = (q', q'')` of the equations of motion, for Runge–Kutta methods.

@@ -326,7 +326,7 @@ pub(crate) struct HostOf<const S: usize> {
 }
 
 /// A conservative bond's impulse and moment along its path under the fast-mode weights of a
-/// host whose resonator is integrated exactly ([`oscillating_path_integrals`]).
+/// host whose resonator is integrated exactly ([`Law::oscillating_integrals`]).
 fn oscillating_bond_integrals(
     model: &Model,
     bond: usize,

@@ -15,6 +15,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 mod active_sites;
+mod bond_correction;
 pub(crate) mod contact_event;
 mod contact_scan;
 mod dop853;

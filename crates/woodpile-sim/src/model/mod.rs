@@ -19,10 +19,10 @@ mod window;
 
 pub use boundary::{Boundary, End};
 pub use parts::ModelParts;
-pub use resonator::{Coupling, Resonator};
+pub use resonator::{odd_power, Coupling, Resonator};
 pub use window::Window;
 
-use crate::contact::{with_law, ContactLaw, Contacts, Law};
+use crate::contact::{ContactLaw, Contacts};
 use crate::damping::Damping;
 use crate::error::ModelError;
 
@@ -322,31 +322,6 @@ impl Model {
             && r.coupling.max_value() > 0.0
             && !self.dissipative
             && alone
-    }
-
-    /// The fastest a contact of a chain under a [`ContactLaw`] vibrates in a motion of total
-    /// energy `energy`: sqrt(k (1/m_left + 1/m_right)) at the stiffness k the bond has at the
-    /// largest overlap the energy allows ([`Law::stiffness_within`]); a wall counts as
-    /// infinitely heavy. 0 for the paper's chain, whose steps are calibrated on it.
-    pub fn max_contact_omega(&self, energy: f64) -> f64 {
-        with_law!(self.law(), |law| self.max_contact_omega_of(law, energy))
-    }
-
-    fn max_contact_omega_of(&self, law: &impl Law, energy: f64) -> f64 {
-        let n = self.n_sites;
-        let walls = [self.boundary.left_wall(), self.boundary.right_wall()];
-        (0..=n)
-            .filter(|&bond| (bond > 0 || walls[0]) && (bond < n || walls[1]))
-            .map_while(|bond| {
-                let inverse_masses = [bond.checked_sub(1), (bond < n).then_some(bond)]
-                    .into_iter()
-                    .flatten()
-                    .map(|site| 1.0 / self.site_mass(site))
-                    .sum::<f64>();
-                let stiffness = law.stiffness_within(bond, energy)?;
-                Some((stiffness * inverse_masses).sqrt())
-            })
-            .fold(0.0, f64::max)
     }
 
     /// A state vector at rest: all displacements and velocities zero.

@@ -95,3 +95,13 @@ impl Resonator {
         (p * kappa * stretch.powf(p - 1.0) * (1.0 / host_mass + 1.0 / self.eps)).sqrt()
     }
 }
+
+/// `x^p` for the odd coupling exponents (p = 1 is the common case and skips `powi`).
+#[inline(always)]
+pub fn odd_power(x: f64, p: u32) -> f64 {
+    match p {
+        1 => x,
+        3 => x * x * x,
+        _ => x.powi(p as i32),
+    }
+}

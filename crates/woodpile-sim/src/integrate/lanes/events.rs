@@ -6,8 +6,8 @@
 use super::{Lane, LaneMut, Lanes, LANES, S};
 use crate::chain_force::Width;
 use crate::contact::{with_law, Law};
+use crate::integrate::bond_correction::{apply, apply_fast, bond_correction, Bond, Correction};
 use crate::integrate::contact_scan::changes_contact;
-use crate::integrate::event_correction::{apply, apply_fast, bond_correction, Bond, Correction};
 use crate::integrate::exact_resonator::{ExactResonators, FastModeCorrection};
 use crate::integrate::rkn::DPRKN6;
 use crate::model::{Model, Window};

@@ -1,0 +1,194 @@
+//! One bond's contact-event correction, shared by the scalar steppers
+//! ([`super::event_correction`]) and the lanes (`super::lanes`): which bond ([`Bond`]), its
+//! path over the step, the integrals of its force along it less the method's quadrature
+//! ([`bond_correction`]), and the correction applied to the end state ([`apply`]).
+
+use super::contact_event::{damped_path_integrals, BondPath};
+use super::contact_scan::negligible;
+use super::exact_resonator::{
+    fast_mode_correction, Dofs, DofsMut, ExactResonators, FastModeCorrection,
+};
+use crate::contact::{with_law, Law};
+use crate::model::Model;
+
+/// A method's quadrature of one bond force from its stage values: (impulse, position change).
+pub(crate) type Quadrature<const S: usize> = fn([f64; S], f64) -> (f64, f64);
+
+/// A bond and its members (`None` for a wall), in the numbering of [`crate::contact`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Bond {
+    pub index: usize,
+    pub left: Option<usize>,
+    pub right: Option<usize>,
+}
+
+impl Bond {
+    /// The bond between sites `index − 1` and `index`.
+    pub fn inner(index: usize) -> Bond {
+        Bond {
+            index,
+            left: Some(index - 1),
+            right: Some(index),
+        }
+    }
+
+    /// The wall left of the first site.
+    pub fn left_wall() -> Bond {
+        Bond {
+            index: 0,
+            left: None,
+            right: Some(0),
+        }
+    }
+
+    /// The wall right of the last of `n_sites` sites.
+    pub fn right_wall(n_sites: usize) -> Bond {
+        Bond {
+            index: n_sites,
+            left: Some(n_sites - 1),
+            right: None,
+        }
+    }
+
+    /// (left, right).
+    pub fn members(self) -> (Option<usize>, Option<usize>) {
+        (self.left, self.right)
+    }
+}
+
+/// A bond's correction: the impulse and the position moment its members receive (the left
+/// one pushed back, the right one on).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Correction {
+    pub bond: Bond,
+    pub impulse: f64,
+    pub moment: f64,
+}
+
+/// Adds each correction to the end state: the bond pushes its left member back and its right
+/// member on.
+/// The end state may be a lane of four (`super::lanes`): it is written through [`DofsMut`].
+pub(super) fn apply<D: DofsMut + ?Sized>(
+    inv_mass: &[f64],
+    corrections: &[Correction],
+    (new_q, new_v): (&mut D, &mut D),
+) {
+    for &Correction {
+        bond: Bond { left, right, .. },
+        impulse,
+        moment,
+    } in corrections
+    {
+        if let Some(i) = left {
+            new_v.sub(i, impulse * inv_mass[i]);
+            new_q.sub(i, moment * inv_mass[i]);
+        }
+        if let Some(i) = right {
+            new_v.add(i, impulse * inv_mass[i]);
+            new_q.add(i, moment * inv_mass[i]);
+        }
+    }
+}
+
+/// Adds the fast-mode parts of the corrections to the end state (host and resonator).
+pub(super) fn apply_fast<D: DofsMut + ?Sized>(
+    fast: impl IntoIterator<Item = FastModeCorrection>,
+    (new_q, new_v): (&mut D, &mut D),
+) {
+    for fast in fast {
+        for k in 0..2 {
+            new_v.add(fast.sites[k], fast.velocity[k]);
+            new_q.add(fast.sites[k], fast.position[k]);
+        }
+    }
+}
+
+/// A bond's impulse and moment along its path, and the energy its dashpot dissipates there
+/// (0 for a conservative chain).
+pub(super) fn bond_integrals(
+    model: &Model,
+    bond: usize,
+    path: &BondPath,
+    h: f64,
+) -> (f64, f64, f64) {
+    if model.is_dissipative() {
+        return damped_path_integrals(path, h, damped_force(model, bond));
+    }
+    let (impulse, moment) = with_law!(model.law(), |law| law.path_integrals(bond, path, h));
+    (impulse, moment, 0.0)
+}
+
+/// A changed bond's correction over a step of size `h` from the states `start` to `end`
+/// (`(q, v)` each, the end not yet corrected) by a method of quadrature `quadrature` whose
+/// stages gave the bond the forces `stage`: the path integrals less the quadrature, with its
+/// parts along the fast modes of `exact` resonators at its members pushed to `fast`; and the
+/// energy its dashpot dissipated along the path. `None` when its forces are [`negligible`].
+/// One scene's states, or one lane's (`super::lanes`), are read through [`Dofs`].
+pub(super) fn bond_correction<const S: usize, D: Dofs + ?Sized>(
+    model: &Model,
+    (bond, stage): (Bond, [f64; S]),
+    (start, end): ((&D, &D), (&D, &D)),
+    (h, quadrature, exact): (f64, Quadrature<S>, Option<&ExactResonators<S>>),
+    fast: &mut Vec<FastModeCorrection>,
+) -> Option<(Correction, f64)> {
+    let path = bond_path(model, bond.index, start, end, bond.members());
+    if negligible(model, bond.index, stage, &path) {
+        return None;
+    }
+    let (impulse, moment, lost) = bond_integrals(model, bond.index, &path, h);
+    let (q0, q1) = quadrature(stage, h);
+    let plain = (impulse - q0, moment - q1);
+    if let Some(exact) = exact {
+        for (member, sign) in [(bond.left, -1.0), (bond.right, 1.0)] {
+            if let Some(pair) = member.and_then(|site| exact.host(site)) {
+                let on = (bond.index, &path, stage);
+                fast.push(fast_mode_correction(model, on, h, plain, (pair, sign)));
+            }
+        }
+    }
+    let correction = Correction {
+        bond,
+        impulse: plain.0,
+        moment: plain.1,
+    };
+    Some((correction, lost))
+}
+
+/// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the
+/// path integrals and the switch search take them (the path is of the total overlap; the
+/// force law takes the relative displacement, without the static overlap).
+pub(super) fn damped_force(model: &Model, bond: usize) -> impl Fn(f64, f64) -> (f64, f64) + '_ {
+    let delta = with_law!(model.law(), |law| law.static_overlap(bond));
+    move |c, rate| {
+        let (force, power) = model.contact_force(bond, c - delta, rate);
+        (force.total, power)
+    }
+}
+
+/// A bond's overlap and rate at both ends of a step, from the states (positions, velocities) at
+/// its start and end: left member minus right member, a wall counting as at rest, plus the
+/// bond's static overlap under a precompressed [`crate::ContactLaw`].
+/// The state may be a lane of four (`super::lanes`): it is read through [`Dofs`].
+pub(super) fn bond_path<D: Dofs + ?Sized>(
+    model: &Model,
+    bond: usize,
+    (q, v): (&D, &D),
+    (new_q, new_v): (&D, &D),
+    (left, right): (Option<usize>, Option<usize>),
+) -> BondPath {
+    let member = |x: &D, site: Option<usize>| site.map_or(0.0, |i| x.at(i));
+    let path = BondPath {
+        d0: member(q, left) - member(q, right),
+        rate0: member(v, left) - member(v, right),
+        d1: member(new_q, left) - member(new_q, right),
+        rate1: member(new_v, left) - member(new_v, right),
+    };
+    match with_law!(model.law(), |law| law.static_overlap(bond)) {
+        delta if delta > 0.0 => BondPath {
+            d0: path.d0 + delta,
+            d1: path.d1 + delta,
+            ..path
+        },
+        _ => path,
+    }
+}
