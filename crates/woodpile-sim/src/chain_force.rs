@@ -212,14 +212,10 @@ fn contact_chain<L: Law, V: Width>(
     let u_w = &u[lo..=hi];
     let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
     let mut previous = V::ZERO;
-    let bond = |i: usize, losses: &mut _| {
-        let r = u_w[i - 1].zip(u_w[i], |l, r| l - r);
-        Losses::bond(losses, law, lo + i, r, (Some(lo + i - 1), Some(lo + i)))
-    };
     match record.as_deref_mut() {
         None => {
             for i in 1..u_w.len() {
-                let (_, f) = bond(i, losses);
+                let (_, f) = inner_bond(law, losses, u_w, (lo, i));
                 acc_w[i - 1] = previous.zip(f, |p, f| p - f);
                 previous = f;
             }
@@ -227,7 +223,7 @@ fn contact_chain<L: Law, V: Width>(
         Some(record) => {
             let record_w = &mut record[lo + 1..=hi][..u_w.len() - 1];
             for i in 1..u_w.len() {
-                let (recorded, f) = bond(i, losses);
+                let (recorded, f) = inner_bond(law, losses, u_w, (lo, i));
                 acc_w[i - 1] = previous.zip(f, |p, f| p - f);
                 record_w[i - 1] = recorded;
                 previous = f;
@@ -248,6 +244,19 @@ fn contact_chain<L: Law, V: Width>(
         }
         acc_u[n - 1] = acc_u[n - 1].zip(f, |a, f| a - f);
     }
+}
+
+/// The forces of the bond between the window's sites `i − 1` and `i` (`u_w`: the window's
+/// positions, starting at site `lo`): its recorded and its net force.
+#[inline(always)]
+fn inner_bond<L: Law, V: Width>(
+    law: &L,
+    losses: &mut impl Losses<V>,
+    u_w: &[V],
+    (lo, i): (usize, usize),
+) -> (V, V) {
+    let r = u_w[i - 1].zip(u_w[i], |l, r| l - r);
+    losses.bond(law, lo + i, r, (Some(lo + i - 1), Some(lo + i)))
 }
 
 /// The soft ends' forces, taken from the window's end sites. Out of line: the force loop of

@@ -4,7 +4,7 @@
 //! that declares dissipation runs them, and the conservative chain keeps its bits.
 
 use crate::chain_force::{chain_accelerations, Losses};
-use crate::contact::{with_law, BondForce, Law};
+use crate::contact::{with_law, Law};
 use crate::damping::Damping;
 pub use crate::error::Dissipator;
 use crate::model::{Model, Window};
@@ -67,13 +67,6 @@ impl Model {
             force_record
         ));
         losses.power
-    }
-
-    /// Bond `bond`'s force at relative displacement `r` (left minus right) closing at `rate`,
-    /// and its dashpot power: the law's dissipative part ([`Law::damped`]).
-    #[inline(always)]
-    pub(crate) fn contact_force(&self, bond: usize, r: f64, rate: f64) -> (BondForce, f64) {
-        with_law!(self.law(), |law| law.damped(self.damping(), bond, r, rate))
     }
 
     /// The fastest rate, 1/time, at which the chain's dashpots and soft ends act in a
@@ -259,7 +252,10 @@ mod tests {
             let (n, n_dof, t) = (model.n_sites(), model.n_dof(), 3.25);
             let q: Vec<f64> = (0..n_dof).map(|_| 0.02 * (rng.uniform() - 0.5)).collect();
             let v: Vec<f64> = (0..n_dof).map(|_| rng.uniform() - 0.5).collect();
-            let window = Window { lo: n / 5, hi: n - 1 };
+            let window = Window {
+                lo: n / 5,
+                hi: n - 1,
+            };
             let (mut plain, mut plain_record) = (vec![0.0; n_dof], vec![0.0; n + 1]);
             model.accelerations_recording(t, &q, &mut plain, window, &mut plain_record);
             let (mut damped, mut damped_record) = (vec![0.0; n_dof], vec![0.0; n + 1]);

@@ -9,6 +9,7 @@ use super::exact_resonator::{
     fast_mode_correction, Dofs, DofsMut, ExactResonators, FastModeCorrection,
 };
 use crate::contact::{with_law, Law};
+use crate::damping::Damping;
 use crate::model::Model;
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
@@ -112,7 +113,10 @@ pub(super) fn bond_integrals(
     h: f64,
 ) -> (f64, f64, f64) {
     if model.is_dissipative() {
-        return damped_path_integrals(path, h, damped_force(model, bond));
+        let damping = model.damping();
+        return with_law!(model.law(), |law| {
+            damped_path_integrals(path, h, damped_force(law, damping, bond))
+        });
     }
     let (impulse, moment) = with_law!(model.law(), |law| law.path_integrals(bond, path, h));
     (impulse, moment, 0.0)
@@ -156,11 +160,18 @@ pub(super) fn bond_correction<const S: usize, D: Dofs + ?Sized>(
 
 /// A damped bond's total force and dashpot power at total overlap c closing at rate ċ, as the
 /// path integrals and the switch search take them (the path is of the total overlap; the
-/// force law takes the relative displacement, without the static overlap).
-pub(super) fn damped_force(model: &Model, bond: usize) -> impl Fn(f64, f64) -> (f64, f64) + '_ {
-    let delta = with_law!(model.law(), |law| law.static_overlap(bond));
+/// force law takes the relative displacement, without the static overlap). Generic over the
+/// law, so that the searches and quadratures that call it are compiled once per law with it
+/// inlined.
+#[inline(always)]
+pub(super) fn damped_force<'a, L: Law>(
+    law: &'a L,
+    damping: Option<&'a Damping>,
+    bond: usize,
+) -> impl Fn(f64, f64) -> (f64, f64) + 'a {
+    let delta = law.static_overlap(bond);
     move |c, rate| {
-        let (force, power) = model.contact_force(bond, c - delta, rate);
+        let (force, power) = law.damped(damping, bond, c - delta, rate);
         (force.total, power)
     }
 }

@@ -245,8 +245,12 @@ impl<const S: usize> ContactEvents<S> {
         h: f64,
         window: Window,
     ) -> Option<(f64, Bond)> {
-        let switch =
-            |bond: usize, path: &BondPath| first_switch(path, h, damped_force(model, bond));
+        let switch = |bond: usize, path: &BondPath| {
+            let damping = model.damping();
+            with_law!(model.law(), |law| {
+                first_switch(path, h, damped_force(law, damping, bond))
+            })
+        };
         self.earliest(model, (start, end), window, switch)
     }
 
