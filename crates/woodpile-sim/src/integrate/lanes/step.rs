@@ -99,12 +99,7 @@ impl LaneRkn6 {
         for x in self.a.iter_mut().flatten() {
             x[l] = 0.0;
         }
-        let rest = |b: usize| {
-            self.chain
-                .contacts
-                .as_ref()
-                .map_or(0.0, |law| law.static_force(b))
-        };
+        let rest = |b: usize| with_law!(self.chain.law(), |law| law.static_force(b));
         for record in &mut self.stage_force {
             for (b, x) in record.iter_mut().enumerate() {
                 x[l] = rest(b);
