@@ -98,7 +98,7 @@ pub(crate) trait Losses<V: Width> {
     fn soft_end(&mut self, end: (f64, f64), site: usize, u: V) -> V;
 
     /// What acts on the window's sites from outside the chain (ground damping), taken from
-    /// their forces `acc_u`.
+    /// their forces `acc_u`. Asked after the soft ends, always.
     fn ground(&mut self, acc_u: &mut [V], window: Window);
 
     /// Resonator `j`'s force on its host `site`, whose elastic part is `elastic`.

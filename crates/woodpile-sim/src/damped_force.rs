@@ -10,7 +10,8 @@ pub use crate::error::Dissipator;
 use crate::model::{Model, Window};
 
 /// Where a dissipative force loop records each bond's force and dashpot power (indexing of
-/// [`Model::accelerations_in`]'s recorded bonds: entry b is bond b, walls at 0 and `n_sites`).
+/// [`Model::accelerations_recording`]'s recorded bonds: entry b is bond b, walls at 0 and
+/// `n_sites`).
 pub(crate) struct BondRecord<'a> {
     /// The bond's total force, clipped at zero (what the contact-event scan reads).
     pub force: &'a mut [f64],
@@ -55,6 +56,7 @@ impl Model {
             velocities: (u_dot, w_dot),
             inv_mass: self.inv_mass(),
             power: 0.0,
+            end_power: 0.0,
             power_record,
         };
         let frame = self.frame();
@@ -168,6 +170,9 @@ struct Dissipating<'a> {
     inv_mass: &'a [f64],
     /// The dissipated power summed so far.
     power: f64,
+    /// The soft ends' dashpots' power, summed apart and added to `power` once, before the
+    /// ground's: the order of the sum, and so its bits, as the dissipated power always had.
+    end_power: f64,
     /// Where each bond's dashpot power is kept, for the contact-event correction.
     power_record: Option<&'a mut [f64]>,
 }
@@ -193,11 +198,14 @@ impl Losses<f64> for Dissipating<'_> {
 
     fn soft_end(&mut self, (spring, damping): (f64, f64), site: usize, u: f64) -> f64 {
         let u_dot = self.velocities.0[site];
-        self.power += damping * u_dot * u_dot;
+        self.end_power += damping * u_dot * u_dot;
         spring * u + damping * u_dot
     }
 
     fn ground(&mut self, acc_u: &mut [f64], window: Window) {
+        // The kernel asks for the ground after the soft ends, always.
+        self.power += self.end_power;
+        self.end_power = 0.0;
         let ground = self.damping.map_or(0.0, |d| d.ground);
         if ground > 0.0 {
             let sites = window.lo..=window.hi;
@@ -264,6 +272,7 @@ mod tests {
                 velocities: v.split_at(n),
                 inv_mass: model.inv_mass(),
                 power: 0.0,
+                end_power: 0.0,
                 power_record: None,
             };
             let frame = model.frame();

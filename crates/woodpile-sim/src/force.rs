@@ -1,8 +1,9 @@
-//! The right-hand side: accelerations from positions (paper Eqs. 3 and 7 with per-site masses).
-//!
-//! This is the hot loop of every integrator. It allocates nothing, calls nothing dynamic, and
-//! evaluates a power 3/2 only for compressed contacts: at any moment only a handful of the
-//! chain's contacts are closed.
+//! The right-hand side: accelerations from positions (paper Eqs. 3 and 7 with per-site masses),
+//! the chain's force kernel ([`crate::chain_force`]) run for a [`Model`] without losses, in
+//! each CPU tier's copy (`crate::simd`). Every integrator's hot loop: it allocates nothing and
+//! calls nothing dynamic. `Model::accelerations` gives the conservative forces of any model:
+//! a dissipative one's dashpots and ground damping act only through
+//! [`Model::damped_accelerations_in`].
 
 use crate::chain_force::{chain_accelerations, patch, Coupled, Frame, Lossless};
 pub use crate::contact::{hertz_force, hertz_potential};
@@ -139,7 +140,7 @@ impl Model {
         let walls = self.walls();
         (0..=n)
             .filter(|&bond| (bond > 0 || walls[0]) && (bond < n || walls[1]))
-            .map_while(|bond| {
+            .filter_map(|bond| {
                 let inverse_masses = [bond.checked_sub(1), (bond < n).then_some(bond)]
                     .into_iter()
                     .flatten()

@@ -1,15 +1,16 @@
 //! Contact laws: everything the simulator knows about how two neighbours push on each other,
-//! one type per law behind one trait ([`Law`]).
+//! one type per law behind one trait (`Law`).
 //!
 //! - [`hertz`]: the paper's law, `[d]_+^{3/2}` with unit coefficients and no precompression
-//!   ([`PaperHertz`]), a type with no data whose loops compile to the paper's own.
+//!   (`PaperHertz`), a type with no data whose loops compile to the paper's own.
 //! - [`general`]: the experiment's law ([`ContactLaw`]): a coefficient per contact, any
 //!   exponent, a precompression or gravity's weights.
 //!
-//! A model holds at most a [`ContactLaw`] ([`crate::Model::contacts`]); [`crate::Model::law`]
-//! gives its law as [`Contacts`], and [`with_law!`] runs generic code with the law's own type,
+//! A model holds at most a [`ContactLaw`] ([`crate::Model::contacts`]); `Model::law`
+//! gives its law as `Contacts`, and `with_law!` runs generic code with the law's own type,
 //! so that the choice is made once per call, outside every loop. A new law is a new type that
-//! implements [`Law`], and a new arm of [`Contacts`].
+//! implements `Law`, an arm of `Contacts` (and of `with_law!`), and the field of a model
+//! that holds it (docs/adding-a-kind.md, "Adding a contact law").
 //!
 //! Bonds are numbered as the recorded bond forces are: bond 0 is the left wall, bond b
 //! (1 ≤ b < S) joins sites b − 1 and b, bond S is the right wall. A bond's relative

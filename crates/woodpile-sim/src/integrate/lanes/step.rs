@@ -1,7 +1,7 @@
 //! The batched `rkn6-contact` step (and `erkn6-contact`'s, with each lane's harmonic resonators
 //! integrated exactly): DPRKN6 on four chains in structure-of-arrays form (entry k of a vector
-//! is degree of freedom k, its lanes the four scenes), then each lane's contact corrections. Every lane does the scalar
-//! [`crate::integrate::Rkn`]'s operations in its order (`raw_step_body`, and the one force
+//! is degree of freedom k, its lanes the four scenes), then each lane's contact corrections.
+//! Every lane does the scalar [`crate::integrate::Rkn`]'s operations in its order (`raw_step_body`, and the one force
 //! kernel, [`crate::chain_force`]), which is what keeps it bit-identical.
 
 use super::events::LaneEvents;
@@ -99,10 +99,11 @@ impl LaneRkn6 {
         for x in self.a.iter_mut().flatten() {
             x[l] = 0.0;
         }
-        let rest = |b: usize| with_law!(self.chain.law(), |law| law.static_force(b));
+        let bonds = self.chain.n_sites + 1;
+        let rest = with_law!(self.chain.law(), |law| law.forces_at_rest(bonds));
         for record in &mut self.stage_force {
-            for (b, x) in record.iter_mut().enumerate() {
-                x[l] = rest(b);
+            for (x, &f) in record.iter_mut().zip(&rest) {
+                x[l] = f;
             }
         }
         self.last_stage_current[l] = true;
