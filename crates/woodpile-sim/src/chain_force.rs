@@ -11,7 +11,7 @@
 //! re-evaluate one site more on each side of what moved, and no more.
 
 use crate::contact::Law;
-use crate::integrate::exact_resonator::{Dofs, DofsMut};
+use crate::dofs::{Dofs, DofsMut};
 use crate::model::{odd_power, Window};
 use std::ops::RangeInclusive;
 

@@ -24,6 +24,7 @@ mod chain_force;
 pub mod contact;
 pub mod damped_force;
 pub mod damping;
+mod dofs;
 pub mod energy;
 mod error;
 pub mod force;

@@ -268,7 +268,7 @@ impl ContactLaw {
     /// (left member minus right member): what the contact-event correction integrates.
     #[inline(always)]
     pub fn elastic(&self, bond: usize, r: f64) -> f64 {
-        self.coefficient[bond] * self.power.at(self.static_overlap[bond] + r)
+        <Self as Law>::elastic(self, bond, r)
     }
 
     /// The force bond `bond` adds to the rest state's: [`ContactLaw::elastic`] − F_b. Zero,
@@ -282,10 +282,7 @@ impl ContactLaw {
     /// a_b/(α+1) ([δ_b + r]_+^{α+1} − δ_b^{α+1}) − F_b r. Its derivative in r is
     /// [`ContactLaw::net_force`].
     pub fn potential(&self, bond: usize, r: f64) -> f64 {
-        let (a, delta) = (self.coefficient[bond], self.static_overlap[bond]);
-        let c = (delta + r).max(0.0);
-        let rise = c * self.power.at(c) - delta * self.power.at(delta);
-        a / (self.exponent + 1.0) * rise - self.static_force[bond] * r
+        <Self as Law>::potential(self, bond, r)
     }
 
     /// The stiffness α a_b c^{α−1} of bond `bond` at total overlap `c` (> 0).
@@ -294,16 +291,14 @@ impl ContactLaw {
     }
 
     /// A bound on the total overlap bond `bond` reaches when it holds all of `energy` on top
-    /// of its static state. Since (δ + r)^α ≥ δ^α + r^α for α ≥ 1, the potential of a
-    /// compression r is at least a r^{α+1}/(α+1), so r ≤ ((α+1) energy / a)^{1/(α+1)}.
+    /// of its static state: see the `Law` implementation below.
     pub fn overlap_within(&self, bond: usize, energy: f64) -> f64 {
-        let alpha1 = self.exponent + 1.0;
-        let r = (alpha1 * energy.max(0.0) / self.coefficient[bond]).powf(1.0 / alpha1);
-        self.static_overlap[bond] + r
+        <Self as Law>::overlap_within(self, bond, energy)
     }
 }
 
-/// The law's facts are its inherent methods' (which other crates read too).
+/// The law's formulas. The inherent methods of the same names call these, for the crates
+/// that cannot name the trait.
 impl Law for ContactLaw {
     fn exponent(&self) -> f64 {
         self.exponent
@@ -325,7 +320,7 @@ impl Law for ContactLaw {
 
     #[inline(always)]
     fn elastic(&self, bond: usize, r: f64) -> f64 {
-        ContactLaw::elastic(self, bond, r)
+        self.coefficient[bond] * self.power.at(self.static_overlap[bond] + r)
     }
 
     #[inline(always)]
@@ -339,7 +334,10 @@ impl Law for ContactLaw {
     }
 
     fn potential(&self, bond: usize, r: f64) -> f64 {
-        ContactLaw::potential(self, bond, r)
+        let (a, delta) = (self.coefficient[bond], self.static_overlap[bond]);
+        let c = (delta + r).max(0.0);
+        let rise = c * self.power.at(c) - delta * self.power.at(delta);
+        a / (self.exponent + 1.0) * rise - self.static_force[bond] * r
     }
 
     fn static_overlaps(&self) -> Option<&[f64]> {
@@ -369,8 +367,12 @@ impl Law for ContactLaw {
         self.coefficient[bond] * self.power.at(c) < NEGLIGIBLE_FORCE
     }
 
+    /// Since (δ + r)^α ≥ δ^α + r^α for α ≥ 1, the potential of a compression r is at least
+    /// a r^{α+1}/(α+1), so r ≤ ((α+1) energy / a)^{1/(α+1)}.
     fn overlap_within(&self, bond: usize, energy: f64) -> f64 {
-        ContactLaw::overlap_within(self, bond, energy)
+        let alpha1 = self.exponent + 1.0;
+        let r = (alpha1 * energy.max(0.0) / self.coefficient[bond]).powf(1.0 / alpha1);
+        self.static_overlap[bond] + r
     }
 
     fn stiffness_within(&self, bond: usize, energy: f64) -> Option<f64> {

@@ -32,45 +32,8 @@
 use super::contact_event::BondPath;
 use super::erkn_weights::{pair_step, NystromWeights, PairStep};
 use crate::contact::{with_law, Law};
+pub(crate) use crate::dofs::{Dofs, DofsMut};
 use crate::model::Model;
-
-/// A vector of degrees of freedom as the pair steps read it: a state's own slice, or one lane
-/// of four (`super::lanes`). Reads and writes are plain loads, stores and additions, so both
-/// give the same bits.
-pub(crate) trait Dofs {
-    /// Entry `k`.
-    fn at(&self, k: usize) -> f64;
-}
-
-/// [`Dofs`] that the pair steps also write.
-pub(crate) trait DofsMut: Dofs {
-    /// Entry `k` becomes `x`.
-    fn set(&mut self, k: usize, x: f64);
-    /// Entry `k` += `x`.
-    #[inline(always)]
-    fn add(&mut self, k: usize, x: f64) {
-        self.set(k, self.at(k) + x);
-    }
-    /// Entry `k` −= `x`.
-    #[inline(always)]
-    fn sub(&mut self, k: usize, x: f64) {
-        self.set(k, self.at(k) - x);
-    }
-}
-
-impl Dofs for [f64] {
-    #[inline(always)]
-    fn at(&self, k: usize) -> f64 {
-        self[k]
-    }
-}
-
-impl DofsMut for [f64] {
-    #[inline(always)]
-    fn set(&mut self, k: usize, x: f64) {
-        self[k] = x;
-    }
-}
 
 /// One host site and its harmonic resonator.
 #[derive(Debug, Clone, Copy)]
