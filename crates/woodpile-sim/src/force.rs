@@ -152,6 +152,18 @@ impl Model {
             .fold(0.0, f64::max)
     }
 
+    /// The static overlap of bond `bond` (numbering of [`crate::contact`]): 0 but under a
+    /// precompression or gravity.
+    pub fn static_overlap(&self, bond: usize) -> f64 {
+        with_law!(self.law(), |law| law.static_overlap(bond))
+    }
+
+    /// The stiffness dF/dc of bond `bond` at total overlap `c` > 0, by the chain's law: the
+    /// linear picture's spring about a static state.
+    pub fn contact_stiffness(&self, bond: usize, c: f64) -> f64 {
+        with_law!(self.law(), |law| law.stiffness(bond, c))
+    }
+
     /// First-order form `y' = (q', q'')` of the equations of motion, for Runge–Kutta methods.
     pub fn rhs(&self, t: f64, y: &[f64], dy: &mut [f64]) {
         self.rhs_in(t, y, dy, Window::full(self));

@@ -77,7 +77,7 @@ pub fn linearise(model: &Model, overlaps: &[f64], time: f64) -> Result<Linearise
 /// as a sonic vacuum).
 pub fn linearise_precompressed(model: &Model, time: f64) -> Result<Linearised, SpectrumError> {
     let overlaps: Vec<f64> = (0..=model.n_sites())
-        .map(|bond| model.contacts().map_or(0.0, |law| law.static_overlap(bond)))
+        .map(|bond| model.static_overlap(bond))
         .collect();
     linearise(model, &overlaps, time)
 }
@@ -87,10 +87,7 @@ fn bonds(model: &Model, overlaps: &[f64]) -> Result<(Vec<f64>, Vec<f64>), Spectr
     let n = model.n_sites();
     let contact = |bond: usize| -> (f64, f64) {
         let delta = overlaps[bond];
-        let stiffness = match model.contacts() {
-            Some(law) => law.stiffness(bond, delta),
-            None => 1.5 * delta.sqrt(),
-        };
+        let stiffness = model.contact_stiffness(bond, delta);
         // The dashpot's force per unit closing rate at the static overlap.
         let damping = model
             .damping()

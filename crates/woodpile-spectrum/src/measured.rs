@@ -91,10 +91,7 @@ pub fn measure(
         let q = lead.wavenumber(omega).unwrap_or(PI);
         lead.mass() * v * omega / (2.0 * lead.stiffness() * q.sin())
     };
-    let delta0 = s
-        .model
-        .contacts()
-        .map_or(0.0, |law| law.static_overlap(t.scatterer.sites.start));
+    let delta0 = s.model.static_overlap(t.scatterer.sites.start);
     Ok(Measured {
         probe: spectrum.paper_site(setup.probe),
         amplitude: v.abs() / (c0 * delta0),

@@ -287,7 +287,7 @@ impl ContactLaw {
 
     /// The stiffness α a_b c^{α−1} of bond `bond` at total overlap `c` (> 0).
     pub fn stiffness(&self, bond: usize, c: f64) -> f64 {
-        self.exponent * self.coefficient[bond] * c.max(0.0).powf(self.exponent - 1.0)
+        <Self as Law>::stiffness(self, bond, c)
     }
 
     /// A bound on the total overlap bond `bond` reaches when it holds all of `energy` on top
@@ -375,9 +375,10 @@ impl Law for ContactLaw {
         self.static_overlap[bond] + r
     }
 
-    fn stiffness_within(&self, bond: usize, energy: f64) -> Option<f64> {
-        Some(self.stiffness(bond, self.overlap_within(bond, energy)))
+    fn stiffness(&self, bond: usize, c: f64) -> f64 {
+        self.exponent * self.coefficient[bond] * c.max(0.0).powf(self.exponent - 1.0)
     }
+
 }
 
 #[cfg(test)]

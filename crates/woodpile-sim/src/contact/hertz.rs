@@ -109,6 +109,11 @@ impl Law for PaperHertz {
         end * end.sqrt() < NEGLIGIBLE_FORCE
     }
 
+    /// (3/2) √c.
+    fn stiffness(&self, _bond: usize, c: f64) -> f64 {
+        1.5 * c.sqrt()
+    }
+
     /// (2/5) c^{5/2} ≤ energy.
     fn overlap_within(&self, _bond: usize, energy: f64) -> f64 {
         (2.5 * energy.max(0.0)).powf(0.4)

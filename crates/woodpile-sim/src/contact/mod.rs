@@ -83,13 +83,20 @@ pub(crate) trait Law {
     /// negligible force ([`NEGLIGIBLE_FORCE`]).
     fn force_negligible(&self, bond: usize, c: f64) -> bool;
 
+    /// The stiffness dF/dc of bond `bond` at total overlap `c` > 0 (the linear picture's
+    /// spring about a static state).
+    fn stiffness(&self, bond: usize, c: f64) -> f64;
+
     /// A bound on the total overlap bond `bond` reaches when it holds all of `energy` on top
     /// of its static state.
     fn overlap_within(&self, bond: usize, energy: f64) -> f64;
 
     /// The stiffness dF/dc of bond `bond` at the largest overlap `energy` allows, which bounds
-    /// an explicit step; `None` for a law the steps are calibrated on (the paper's).
-    fn stiffness_within(&self, bond: usize, energy: f64) -> Option<f64>;
+    /// an explicit step; `None` for a law the steps are calibrated on (the paper's, whose
+    /// methods' first steps were measured on it).
+    fn stiffness_within(&self, bond: usize, energy: f64) -> Option<f64> {
+        Some(self.stiffness(bond, self.overlap_within(bond, energy)))
+    }
 
     /// The elastic force of each of `n_bonds` bonds at rest (what a record reads for a bond
     /// outside the active window).
