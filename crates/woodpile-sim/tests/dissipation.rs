@@ -1,6 +1,7 @@
 //! Dissipation's known answers: a contact's coefficient of restitution, a damped resonator's
 //! ring-down, a soft end absorbing a solitary wave, ground damping's momentum decay, D rising,
-//! the ledger closing, `rk4-contact`'s order on a damped chain, and the methods that refuse.
+//! the ledger closing (with two damped soft ends too), `rk4-contact`'s order on a damped chain,
+//! and the methods that refuse.
 #![allow(clippy::unwrap_used)]
 
 use woodpile_sim::energy::{total_momentum, Region};
@@ -300,4 +301,34 @@ fn zero_damping_and_a_spring_only_end_keep_the_conservative_path() {
     .unwrap();
     let expected = (omega * 9.0).sin() / omega;
     assert!((out.final_state[0] - expected).abs() < 1e-9);
+}
+
+/// Both ends soft, each with a dashpot: the power of both enters D (the force kernel sums the
+/// soft ends' power apart from the bonds'), so the ledger closes, and the chain with both
+/// dashpots has lost more than the same chain with the left one alone.
+#[test]
+fn two_damped_soft_ends_both_enter_the_ledger() {
+    let soft = |damping| End::Soft {
+        spring: 0.05,
+        damping,
+    };
+    let dissipated = |right: f64| {
+        let model = Model::new(21, Boundary::ends(soft(0.4), soft(right)), vec![]).unwrap();
+        let scenario = scene(model, 1, (9, 11), 80.0, tolerance(1e-10));
+        let out = run(&scenario);
+        let f = out.fractions;
+        assert!(
+            (f.sum() - 1.0).abs() <= 1e-9,
+            "right {right}: {}",
+            f.sum() - 1.0
+        );
+        assert!(out.stats.max_energy_drift <= 1e-9, "right {right}");
+        f.dissipated
+    };
+    let (left_only, both) = (dissipated(0.0), dissipated(0.4));
+    assert!(left_only > 0.0, "D = {left_only}");
+    assert!(
+        both > left_only + 0.05,
+        "both {both}, left alone {left_only}"
+    );
 }

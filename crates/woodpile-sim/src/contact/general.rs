@@ -378,7 +378,6 @@ impl Law for ContactLaw {
     fn stiffness(&self, bond: usize, c: f64) -> f64 {
         self.exponent * self.coefficient[bond] * c.max(0.0).powf(self.exponent - 1.0)
     }
-
 }
 
 #[cfg(test)]
