@@ -6,7 +6,6 @@
 //! [`Model::damped_accelerations_in`].
 
 use crate::chain_force::{chain_accelerations, patch, Coupled, Frame, Lossless};
-pub use crate::contact::{hertz_force, hertz_potential};
 use crate::contact::{with_law, Law};
 use crate::model::{Model, Window};
 
