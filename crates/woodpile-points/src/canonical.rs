@@ -11,7 +11,7 @@ use std::fmt;
 
 use serde_json::{json, Map, Value};
 use woodpile_scene::Scene;
-use woodpile_sim::contact::LawParts;
+use woodpile_sim::contact::{LawOf, LawParts};
 use woodpile_sim::energy::RegionParts;
 use woodpile_sim::integrate::{Accuracy, MethodChoice};
 use woodpile_sim::model::ModelParts;
@@ -234,8 +234,18 @@ pub fn scene_json(scene: &Scene) -> Value {
         "dt": dt,
         "sample_every": sample_every,
     });
-    if let Some(law) = contacts {
-        canonical["contacts"] = law_json(law);
+    match contacts {
+        LawOf::Paper => {}
+        LawOf::Experiment(law) => canonical["contacts"] = law_json(law),
+        // A law only the library names: its name and numbers, beside the experiment's keys.
+        LawOf::Named { name, numbers } => {
+            let mut law = Map::new();
+            law.insert("law".into(), json!(name));
+            for (key, values) in numbers {
+                law.insert(key.into(), json!(values));
+            }
+            canonical["contacts"] = Value::Object(law);
+        }
     }
     if striker {
         canonical["striker"] = json!(true);

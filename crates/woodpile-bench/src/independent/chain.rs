@@ -14,6 +14,7 @@
 //! are), and each bond is in one [`Mode`] for a whole step: the driver ends a step where a
 //! bond changes mode, so every step integrates a smooth right-hand side.
 
+use woodpile_sim::contact::LawOf;
 use woodpile_sim::damping::DashpotLaw;
 use woodpile_sim::model::{Coupling, End, Model};
 
@@ -77,9 +78,10 @@ impl Chain {
         let parts = model.parts();
         let sites = parts.n_sites;
         let (coefficients, exponent, precompression) = match parts.contacts {
-            Some(law) if law.gravity > 0.0 => return Err("a chain in gravity".into()),
-            Some(law) => (law.coefficients.to_vec(), law.exponent, law.precompression),
-            None => (vec![1.0; sites + 1], 1.5, 0.0),
+            LawOf::Experiment(law) if law.gravity > 0.0 => return Err("a chain in gravity".into()),
+            LawOf::Experiment(law) => (law.coefficients.to_vec(), law.exponent, law.precompression),
+            LawOf::Paper => (vec![1.0; sites + 1], 1.5, 0.0),
+            LawOf::Named { name, .. } => return Err(format!("the contact law {name}")),
         };
         let damping = parts.damping;
         let gamma = |b: usize| damping.map_or(0.0, |d| d.contact_at(b));

@@ -15,7 +15,7 @@
 //! bit. The paper's chain (every a_b = 1, α = 3/2, no precompression) has no `ContactLaw` at
 //! all: it runs [`super::PaperHertz`] and keeps its own bits.
 
-use super::{Law, NEGLIGIBLE_FORCE};
+use super::{Law, LawOf, NEGLIGIBLE_FORCE};
 use crate::error::ModelError;
 use crate::integrate::contact_event::{oscillating_path_integrals, path_integrals_of, BondPath};
 
@@ -73,7 +73,7 @@ pub struct ContactLaw {
 }
 
 /// The defining parts of a [`ContactLaw`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LawParts<'a> {
     /// a_b for every bond, walls included.
     pub coefficients: &'a [f64],
@@ -300,6 +300,14 @@ impl ContactLaw {
 /// The law's formulas. The inherent methods of the same names call these, for the crates
 /// that cannot name the trait.
 impl Law for ContactLaw {
+    fn n_bonds(&self) -> Option<usize> {
+        Some(self.coefficient.len())
+    }
+
+    fn describe(&self) -> LawOf<'_> {
+        LawOf::Experiment(self.parts())
+    }
+
     fn exponent(&self) -> f64 {
         self.exponent
     }

@@ -2,7 +2,7 @@
 //! unit coefficients, no precompression. [`PaperHertz`] carries no data: the loops generic
 //! over [`Law`] compile, for it, to the paper's own loop, with its bits.
 
-use super::{Law, NEGLIGIBLE_FORCE};
+use super::{Law, LawOf, NEGLIGIBLE_FORCE};
 use crate::integrate::contact_event::{oscillating_path_integrals, path_integrals, BondPath};
 
 /// Hertz contact force for an overlap `d`: `[d]_+^{3/2}`.
@@ -38,6 +38,14 @@ const SURELY_FELT_OVERLAP: f64 = 5e-10;
 pub struct PaperHertz;
 
 impl Law for PaperHertz {
+    fn n_bonds(&self) -> Option<usize> {
+        None
+    }
+
+    fn describe(&self) -> LawOf<'_> {
+        LawOf::Paper
+    }
+
     fn exponent(&self) -> f64 {
         1.5
     }

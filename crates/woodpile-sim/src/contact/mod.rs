@@ -1,26 +1,25 @@
 //! Contact laws: everything the simulator knows about how two neighbours push on each other,
-//! one type per law behind one trait (`Law`).
+//! one type per law behind one trait (`Law`), each in its own file and named once in the
+//! registry at the end of this file ([`ChainLaw`]).
 //!
 //! - [`hertz`]: the paper's law, `[d]_+^{3/2}` with unit coefficients and no precompression
 //!   (`PaperHertz`), a type with no data whose loops compile to the paper's own.
 //! - [`general`]: the experiment's law ([`ContactLaw`]): a coefficient per contact, any
 //!   exponent, a precompression or gravity's weights.
+//! - [`linear_gap`]: a one-sided linear spring across a gap ([`LinearGap`]), the worked example
+//!   of docs/adding-a-law.md.
 //!
-//! A model holds at most a [`ContactLaw`] ([`crate::Model::contacts`]); `Model::law`
-//! gives its law as `Contacts`, and `with_law!` runs generic code with the law's own type,
-//! so that the choice is made once per call, outside every loop. A new law is a new type that
-//! implements `Law`, an arm of `Contacts` (and of `with_law!`), and the field of a model
-//! that holds it (docs/adding-a-kind.md, "Adding a contact law").
+//! A model holds one [`ChainLaw`] ([`crate::Model::chain_law`]), and `with_law!` runs generic
+//! code with the law's own type, so that the choice is made once per call, outside every loop.
+//! A new law is a new file with a type that implements `Law`, and one line in the registry.
 //!
 //! Bonds are numbered as the recorded bond forces are: bond 0 is the left wall, bond b
 //! (1 ≤ b < S) joins sites b − 1 and b, bond S is the right wall. A bond's relative
 //! displacement r is its left member's minus its right member's (a wall counts as at rest).
 
-pub mod general;
-pub mod hertz;
-
 pub use general::{ContactLaw, LawParts, EXPONENT_RANGE};
 pub use hertz::{hertz_force, hertz_potential, PaperHertz};
+pub use linear_gap::LinearGap;
 
 use crate::damping::Damping;
 use crate::integrate::contact_event::BondPath;
@@ -38,6 +37,13 @@ pub(crate) const NEGLIGIBLE_FORCE: f64 = 1e-14;
 /// is used (the chain loops, the patch after a corrected step, the walls), which is what keeps
 /// every path's bits equal.
 pub(crate) trait Law {
+    /// The number of bonds (sites + 1, walls included) the law is written for, or `None` for
+    /// a law that is the same at every bond.
+    fn n_bonds(&self) -> Option<usize>;
+
+    /// What the law was built from, for cache keys ([`crate::model::parts`]).
+    fn describe(&self) -> LawOf<'_>;
+
     /// The contact exponent α.
     fn exponent(&self) -> f64;
 
@@ -147,34 +153,86 @@ pub(crate) struct BondForce {
     pub rest: f64,
 }
 
-/// A chain's contact law, as the simulator dispatches on it ([`with_law!`]).
-#[derive(Debug, Clone, Copy)]
-pub(crate) enum Contacts<'a> {
-    /// The paper's law.
-    Paper(&'a PaperHertz),
-    /// The experiment's law.
-    Law(&'a ContactLaw),
+/// What a law was built from, as a cache key hashes it.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LawOf<'a> {
+    /// The paper's law, which adds nothing to a key.
+    Paper,
+    /// The experiment's law ([`ContactLaw::parts`]).
+    Experiment(LawParts<'a>),
+    /// Any other law: its name, and its defining numbers by name.
+    Named {
+        /// The law's name, unique in the registry.
+        name: &'static str,
+        /// Each defining array, by name.
+        numbers: Vec<(&'static str, &'a [f64])>,
+    },
 }
 
-impl<'a> Contacts<'a> {
-    /// The law of a chain that holds `law` (the paper's when `None`).
-    pub fn of(law: Option<&'a ContactLaw>) -> Contacts<'a> {
-        match law {
-            None => Contacts::Paper(&PaperHertz),
-            Some(law) => Contacts::Law(law),
+/// Declares the registry: the modules of the laws, [`ChainLaw`] with one variant per law, its
+/// conversions, and `with_law!`, which dispatches on it. `$d` is a `$` passed in, so that the
+/// inner macro can name its own metavariables.
+macro_rules! registry {
+    ($d:tt $( $(#[$doc:meta])* $variant:ident => $module:ident :: $law:ident, )*) => {
+        $( pub mod $module; )*
+
+        /// A chain's contact law: one variant per law in the registry.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum ChainLaw {
+            $( $(#[$doc])* $variant($module::$law), )*
         }
-    }
-}
 
-/// Runs `$body` with `$law` bound to the law of `$contacts` ([`Contacts`]) as a reference to
-/// its own type, so that generic code over [`Law`] is compiled once per law and the choice is
-/// made here, once, outside its loops.
-macro_rules! with_law {
-    ($contacts:expr, |$law:ident| $body:expr) => {
-        match $contacts {
-            $crate::contact::Contacts::Paper($law) => $body,
-            $crate::contact::Contacts::Law($law) => $body,
+        $(
+            impl From<$module::$law> for ChainLaw {
+                fn from(law: $module::$law) -> ChainLaw {
+                    ChainLaw::$variant(law)
+                }
+            }
+        )*
+
+        /// Runs `$body` with `$law` bound to the law of `$contacts` (a `&ChainLaw`) as a
+        /// reference to its own type, so that generic code over [`Law`] is compiled once per
+        /// law and the choice is made here, once, outside its loops.
+        macro_rules! with_law {
+            ($d contacts:expr, |$d law:ident| $d body:expr) => {
+                match $d contacts {
+                    $( $crate::contact::ChainLaw::$variant($d law) => $d body, )*
+                }
+            };
         }
     };
 }
+
+// The registry: every law the simulator runs, one line each.
+registry! { $
+    /// The paper's law.
+    Paper => hertz::PaperHertz,
+    /// The experiment's law.
+    Experiment => general::ContactLaw,
+    /// A one-sided linear spring across a gap.
+    LinearGap => linear_gap::LinearGap,
+}
 pub(crate) use with_law;
+
+impl ChainLaw {
+    /// The law's exponent α.
+    pub fn exponent(&self) -> f64 {
+        with_law!(self, |law| Law::exponent(law))
+    }
+
+    /// The number of bonds the law is written for (`None`: the same law at every bond).
+    pub fn n_bonds(&self) -> Option<usize> {
+        with_law!(self, |law| Law::n_bonds(law))
+    }
+
+    /// What the law was built from, for cache keys.
+    pub fn describe(&self) -> LawOf<'_> {
+        with_law!(self, |law| Law::describe(law))
+    }
+}
+
+impl Default for ChainLaw {
+    fn default() -> ChainLaw {
+        ChainLaw::Paper(PaperHertz)
+    }
+}

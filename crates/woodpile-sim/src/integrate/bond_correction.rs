@@ -178,7 +178,7 @@ pub(super) fn damped_force<'a, L: Law>(
 
 /// A bond's overlap and rate at both ends of a step, from the states (positions, velocities) at
 /// its start and end: left member minus right member, a wall counting as at rest, plus the
-/// bond's static overlap under a precompressed [`crate::ContactLaw`].
+/// bond's static overlap (a precompression's, or a gap's, negative).
 /// The state may be a lane of four (`super::lanes`): it is read through [`Dofs`].
 pub(super) fn bond_path<D: Dofs + ?Sized>(
     model: &Model,
@@ -195,7 +195,9 @@ pub(super) fn bond_path<D: Dofs + ?Sized>(
         rate1: member(new_v, left) - member(new_v, right),
     };
     match with_law!(model.law(), |law| law.static_overlap(bond)) {
-        delta if delta > 0.0 => BondPath {
+        // A precompression's overlap (δ > 0), or a gap (δ < 0): never −0.0, so `!= 0.0`
+        // leaves every paper bond's path as it was.
+        delta if delta != 0.0 => BondPath {
             d0: path.d0 + delta,
             d1: path.d1 + delta,
             ..path

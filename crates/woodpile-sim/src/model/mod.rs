@@ -22,7 +22,7 @@ pub use parts::ModelParts;
 pub use resonator::{odd_power, Coupling, Resonator};
 pub use window::Window;
 
-use crate::contact::{ContactLaw, Contacts};
+use crate::contact::{ChainLaw, ContactLaw};
 use crate::damping::Damping;
 use crate::error::ModelError;
 
@@ -37,9 +37,9 @@ pub struct Model {
     site_masses: Option<Vec<f64>>,
     /// 1/mass for every degree of freedom (sites then resonators).
     inv_mass: Vec<f64>,
-    /// Contacts beyond the paper's (per-contact coefficients, an exponent, precompression);
-    /// `None` for the paper's chain, which keeps its own force loop and bits.
-    contacts: Option<Box<ContactLaw>>,
+    /// The contact law ([`crate::contact`]): the paper's, a zero-sized type whose loops keep
+    /// the paper's bits, unless the chain declares another.
+    law: ChainLaw,
     /// Dashpots and ground damping ([`crate::damping`]); `None` when nothing dissipates
     /// (soft ends keep their own dashpots), so a conservative scene pays nothing for them.
     damping: Option<Box<Damping>>,
@@ -104,7 +104,7 @@ impl Model {
             resonators,
             site_masses,
             inv_mass,
-            contacts: None,
+            law: ChainLaw::default(),
             damping: None,
             dissipative: boundary.dissipates(),
             walls: [boundary.left_wall(), boundary.right_wall()],
@@ -189,31 +189,49 @@ impl Model {
     /// The same chain with the contact law `law` instead of the paper's: one coefficient per
     /// bond (sites + 1, walls included), its exponent and its precompression. A
     /// precompression needs walls at both ends.
-    pub fn with_contacts(mut self, law: ContactLaw) -> Result<Self, ModelError> {
-        if law.n_bonds() != self.n_sites + 1 {
-            return Err(ModelError::BondCount {
-                n_bonds: law.n_bonds(),
-                n_sites: self.n_sites,
-            });
-        }
+    pub fn with_contacts(self, law: ContactLaw) -> Result<Self, ModelError> {
         if law.precompression() > 0.0 && self.boundary != Boundary::Fixed {
             return Err(ModelError::PrecompressionWithoutWalls);
         }
-        self.contacts = Some(Box::new(law));
-        Ok(self)
+        self.with_law(law)
     }
 
-    /// The contact law, when the chain is not the paper's.
+    /// The same chain with the contact law `law` (any law of the registry,
+    /// [`crate::contact::ChainLaw`]), written for as many bonds as the chain has.
+    pub fn with_law(mut self, law: impl Into<ChainLaw>) -> Result<Self, ModelError> {
+        let law = law.into();
+        match law.n_bonds() {
+            Some(n_bonds) if n_bonds != self.n_sites + 1 => Err(ModelError::BondCount {
+                n_bonds,
+                n_sites: self.n_sites,
+            }),
+            _ => {
+                self.law = law;
+                Ok(self)
+            }
+        }
+    }
+
+    /// The experiment's contact law ([`ContactLaw`]), when the chain runs it.
     #[inline(always)]
     pub fn contacts(&self) -> Option<&ContactLaw> {
-        self.contacts.as_deref()
+        match &self.law {
+            ChainLaw::Experiment(law) => Some(law),
+            _ => None,
+        }
     }
 
-    /// The contact law the simulator runs, the paper's or the chain's, to dispatch on once per
-    /// call ([`crate::contact::with_law!`]).
+    /// The contact law the simulator runs, to dispatch on once per call
+    /// ([`crate::contact::with_law!`]).
     #[inline(always)]
-    pub(crate) fn law(&self) -> Contacts<'_> {
-        Contacts::of(self.contacts.as_deref())
+    pub fn chain_law(&self) -> &ChainLaw {
+        &self.law
+    }
+
+    /// [`Model::chain_law`], for the simulator's own dispatch.
+    #[inline(always)]
+    pub(crate) fn law(&self) -> &ChainLaw {
+        &self.law
     }
 
     /// Number of chain sites S.

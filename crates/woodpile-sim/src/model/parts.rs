@@ -5,11 +5,11 @@
 //! reason).
 
 use super::{Boundary, Model, Resonator};
-use crate::contact::{ContactLaw, LawParts};
+use crate::contact::LawOf;
 use crate::damping::Damping;
 
 /// The defining parts of a [`Model`].
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct ModelParts<'a> {
     /// The number of sites S.
     pub n_sites: usize,
@@ -19,8 +19,8 @@ pub struct ModelParts<'a> {
     pub resonators: &'a [Resonator],
     /// Every site's mass; `None` when all are 1.
     pub site_masses: Option<&'a [f64]>,
-    /// The contacts beyond the paper's, if any.
-    pub contacts: Option<LawParts<'a>>,
+    /// The contact law.
+    pub contacts: LawOf<'a>,
     /// The dashpots and ground damping, if any.
     pub damping: Option<&'a Damping>,
 }
@@ -33,7 +33,7 @@ impl Model {
             boundary,
             resonators,
             site_masses,
-            contacts,
+            law,
             damping,
             // Derived: the masses' inverses, from `site_masses` and the resonators' eps.
             inv_mass: _,
@@ -48,7 +48,7 @@ impl Model {
             boundary: *boundary,
             resonators,
             site_masses: site_masses.as_deref(),
-            contacts: contacts.as_deref().map(ContactLaw::parts),
+            contacts: law.describe(),
             damping: damping.as_deref(),
         }
     }

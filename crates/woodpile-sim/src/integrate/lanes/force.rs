@@ -4,13 +4,13 @@
 
 use super::{Lane, LaneChain, LaneMut, Lanes};
 use crate::chain_force::{chain_accelerations, Coupled, Frame, Lossless};
-use crate::contact::{with_law, Contacts};
+use crate::contact::{with_law, ChainLaw};
 use crate::model::Window;
 
 impl LaneChain {
     /// The contact law the lanes share.
-    pub(super) fn law(&self) -> Contacts<'_> {
-        Contacts::of(self.contacts.as_ref())
+    pub(super) fn law(&self) -> &ChainLaw {
+        &self.law
     }
 
     /// What the force loops read of the chain besides its law, resonators and masses.

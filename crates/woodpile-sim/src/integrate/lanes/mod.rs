@@ -35,7 +35,7 @@ mod step;
 pub use drive::drive_lanes;
 
 use super::exact_resonator::{Dofs, DofsMut};
-use crate::contact::ContactLaw;
+use crate::contact::ChainLaw;
 use crate::model::{Coupling, Model};
 
 /// Scenes per batch: the f64 lanes of an AVX2 register.
@@ -93,9 +93,8 @@ pub(crate) struct LaneChain {
     pub n_sites: usize,
     pub walls: [bool; 2],
     pub resonators: Vec<LaneResonator>,
-    /// The contacts beyond the paper's (coefficients, exponent, precompression), the same in
-    /// every lane; `None` for the paper's Hertz law.
-    pub contacts: Option<ContactLaw>,
+    /// The contact law, the same in every lane.
+    pub law: ChainLaw,
     /// The springs of soft ends (left, right), the same in every lane.
     pub springs: [Option<f64>; 2],
     /// Each lane's site masses (1 in a lane whose model has none: dividing by 1 changes no
@@ -113,7 +112,7 @@ impl LaneChain {
             takes_lanes(m)
                 && m.n_sites() == first.n_sites()
                 && m.boundary() == first.boundary()
-                && m.contacts() == first.contacts()
+                && m.chain_law() == first.chain_law()
                 && m.resonators().len() == first.resonators().len()
                 && m.resonators()
                     .iter()
@@ -146,7 +145,7 @@ impl LaneChain {
             n_sites: first.n_sites(),
             walls: first.walls(),
             resonators,
-            contacts: first.contacts().cloned(),
+            law: first.chain_law().clone(),
             springs: [soft(boundary.left()), soft(boundary.right())],
             masses,
         })
