@@ -115,13 +115,14 @@ unused-cost: build ## What features a scene does not use cost it: COST_BASE's bi
 	cd $(BASELINE)/old-src && CARGO_TARGET_DIR=$(OLD_TARGET) $(CARGO) build --release -q -p woodpile-cli
 	$(CARGO) run --release -q -p woodpile-bench --example unused_cost -- $(OLD_TARGET)/release/woodpile $(WOODPILE)
 
-audit: ## auto against an independent reference: 200 random scenes at 1e-5..1e-8, the same with linear resonators only, 100 of the experiment's chain, 100 with damping, 100 with linear losses only, 100 standing in gravity; and scenes in SIMD lanes against their scalar runs
+audit: ## auto against an independent reference: 200 random scenes at 1e-5..1e-8, the same with linear resonators only, 100 of the experiment's chain, 100 with damping, 100 with linear losses only, 100 standing in gravity, 100 with gapped linear contacts; and scenes in SIMD lanes against their scalar runs
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --linear 200 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --chain 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --damped 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --linear-losses 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --gravity 100 2026 1e-5,1e-6,1e-7,1e-8
+	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --gap 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example lanes_audit -- 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example lanes_audit -- --chain 40 2026 1e-5,1e-6,1e-7,1e-8
 

@@ -33,7 +33,7 @@
 //! without the stricter rules of a nonlinear or ramped resonator.
 //!
 //! ```text
-//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear-losses | --linear | --gravity] SCENES [SEED [TOLERANCES [ONLY]]]]
+//! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear-losses | --linear | --gravity | --gap] SCENES [SEED [TOLERANCES [ONLY]]]]
 //! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
@@ -44,8 +44,8 @@ use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::model::Coupling;
 use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{
-    audit_scene, chain_audit_scene, damped_audit_scene, fixed_dt, gravity_audit_scene,
-    linear_audit_scene, linear_losses_audit_scene, tolerance, Lcg,
+    audit_scene, chain_audit_scene, damped_audit_scene, fixed_dt, gap_audit_scene,
+    gravity_audit_scene, linear_audit_scene, linear_losses_audit_scene, tolerance, Lcg,
     AUDIT_REFERENCE_DT as REFERENCE_DT,
 };
 use woodpile_sim::SimError;
@@ -187,6 +187,10 @@ fn main() {
         Some("--gravity") => {
             args.next();
             gravity_audit_scene
+        }
+        Some("--gap") => {
+            args.next();
+            gap_audit_scene
         }
         _ => audit_scene,
     };

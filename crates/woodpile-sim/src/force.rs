@@ -241,11 +241,9 @@ mod tests {
         let masses = (0..n).map(|i| model.site_mass(i)).collect();
         let ends = Boundary::ends(soft(0.07), soft(0.03));
         let soft_model = Model::with_masses(n, ends, model.resonators().to_vec(), Some(masses));
-        match (soft_model, model.contacts()) {
-            (Ok(m), None) => m,
-            (Ok(m), Some(law)) => m.with_contacts(law.clone()).unwrap_or(model),
-            (Err(_), _) => model,
-        }
+        soft_model
+            .and_then(|m| m.with_law(model.chain_law().clone()))
+            .unwrap_or(model)
     }
 
     #[test]

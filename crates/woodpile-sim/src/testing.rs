@@ -17,7 +17,8 @@ use crate::simulation::{simulate, Scenario};
 mod audit_kinds;
 mod lanes;
 pub use audit_kinds::{
-    chain_audit_scene, damped_audit_scene, gravity_audit_scene, linear_losses_audit_scene,
+    chain_audit_scene, damped_audit_scene, gap_audit_scene, gravity_audit_scene,
+    linear_losses_audit_scene,
 };
 pub use lanes::{
     by_lanes_and_alone, lane_neighbours, with_resonator_masses_scaled, RecordedRun,

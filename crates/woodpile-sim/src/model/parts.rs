@@ -1,5 +1,5 @@
 //! What a model was built from, and nothing it derived: what a cache key must hash. Each
-//! `parts` ([`Model::parts`], [`ContactLaw::parts`], [`Region::parts`](crate::energy::Region::parts))
+//! `parts` ([`Model::parts`], [`ContactLaw::parts`](crate::ContactLaw::parts), [`Region::parts`](crate::energy::Region::parts))
 //! takes its type apart with no `..`, so a field added to one fails to compile there until it
 //! is sorted into a defining part (hashed) or a derived one (named and dropped, with the
 //! reason).

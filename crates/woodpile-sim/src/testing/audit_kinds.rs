@@ -1,6 +1,6 @@
 //! The audit's scenes beyond the plain ones ([`super::audit_scene`]): the experiment's chain,
-//! a chain standing in gravity, and chains that lose energy, with every kind of damping or
-//! with the linear losses alone.
+//! a chain standing in gravity, a chain with gaps between its beads, and chains that lose
+//! energy, with every kind of damping or with the linear losses alone.
 
 use super::{audit_scene, linear_audit_scene, Lcg};
 use crate::energy::Region;
@@ -103,6 +103,29 @@ pub fn gravity_audit_scene(rng: &mut Lcg) -> Scenario {
     Scenario { model, ..base }
 }
 
+/// One scene of the audit of gapped contacts (`auto_audit --gap`): an audit scene
+/// ([`audit_scene`]) whose contacts are one-sided linear springs across gaps
+/// ([`crate::contact::LinearGap`]): stiffness from 0.5 to 2 and gap from 1e-3 to 0.3, each
+/// drawn once for the inner contacts and once for the walls.
+pub fn gap_audit_scene(rng: &mut Lcg) -> Scenario {
+    let base = audit_scene(rng);
+    let (inner, wall) = (rng.log_uniform(0.5, 2.0), rng.log_uniform(0.5, 2.0));
+    let (inner_gap, wall_gap) = (rng.log_uniform(1e-3, 0.3), rng.log_uniform(1e-3, 0.3));
+    let n_sites = base.model.n_sites();
+    let at_wall = |b: usize| b == 0 || b == n_sites;
+    let bonds = 0..=n_sites;
+    let stiffness = bonds.clone().map(|b| if at_wall(b) { wall } else { inner });
+    let gap = bonds.map(|b| if at_wall(b) { wall_gap } else { inner_gap });
+    let law = crate::contact::LinearGap::new(stiffness.collect(), gap.collect())
+        .expect("a valid survey contact law");
+    let model = base
+        .model
+        .clone()
+        .with_law(law)
+        .expect("a valid survey model");
+    Scenario { model, ..base }
+}
+
 /// One scene of the audit of losses `auto` splits from its step (`auto_audit --linear-losses`):
 /// a damped audit scene ([`damped_audit_scene`]) without its contact dashpot, so that every
 /// loss acts on velocities alone: ground damping, resonator dashpots and soft ends. Those
@@ -115,13 +138,9 @@ pub fn linear_losses_audit_scene(rng: &mut Lcg) -> Scenario {
         crate::Damping::new(0.0, d.law, d.ground, d.resonator.clone()).expect("valid damping");
     let n = old.n_sites();
     let masses = (0..n).map(|i| old.site_mass(i)).collect();
-    let mut model = Model::with_masses(n, old.boundary(), old.resonators().to_vec(), Some(masses))
+    let model = Model::with_masses(n, old.boundary(), old.resonators().to_vec(), Some(masses))
+        .and_then(|m| m.with_law(old.chain_law().clone()))
         .expect("a valid survey model");
-    if let Some(law) = old.contacts() {
-        model = model
-            .with_contacts(law.clone())
-            .expect("a valid survey law");
-    }
     Scenario {
         model: model.with_damping(damping).expect("a valid damped model"),
         ..scene
@@ -177,13 +196,9 @@ pub fn damped_audit_scene(rng: &mut Lcg) -> Scenario {
             ..*r
         })
         .collect();
-    let mut model =
-        Model::with_masses(n, boundary, resonators, Some(masses)).expect("a valid survey model");
-    if let Some(law) = old.contacts() {
-        model = model
-            .with_contacts(law.clone())
-            .expect("a valid survey contact law");
-    }
+    let model = Model::with_masses(n, boundary, resonators, Some(masses))
+        .and_then(|m| m.with_law(old.chain_law().clone()))
+        .expect("a valid survey model");
     let damping = crate::Damping::new(contact, law, ground, resonator).expect("valid damping");
     Scenario {
         model: model.with_damping(damping).expect("a valid damped model"),

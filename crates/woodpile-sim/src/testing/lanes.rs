@@ -54,12 +54,8 @@ pub fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
         .collect();
     let masses = (0..m.n_sites()).map(|i| m.site_mass(i)).collect();
     let mut model = Model::with_masses(m.n_sites(), m.boundary(), resonators, Some(masses))
+        .and_then(|model| model.with_law(m.chain_law().clone()))
         .expect("the base's chain, valid");
-    if let Some(law) = m.contacts() {
-        model = model
-            .with_contacts(law.clone())
-            .expect("the base's contacts, valid");
-    }
     if let Some(damping) = m.damping() {
         model = model
             .with_damping(damping.clone())
