@@ -234,18 +234,8 @@ pub fn scene_json(scene: &Scene) -> Value {
         "dt": dt,
         "sample_every": sample_every,
     });
-    match contacts {
-        LawOf::Paper => {}
-        LawOf::Experiment(law) => canonical["contacts"] = law_json(law),
-        // A law only the library names: its name and numbers, beside the experiment's keys.
-        LawOf::Named { name, numbers } => {
-            let mut law = Map::new();
-            law.insert("law".into(), json!(name));
-            for (key, values) in numbers {
-                law.insert(key.into(), json!(values));
-            }
-            canonical["contacts"] = Value::Object(law);
-        }
+    if let Some(law) = contacts_json(contacts) {
+        canonical["contacts"] = law;
     }
     if striker {
         canonical["striker"] = json!(true);
@@ -287,6 +277,23 @@ fn boundary_json(boundary: Boundary) -> Value {
         Boundary::Fixed => json!("fixed"),
         Boundary::Free => json!("free"),
         Boundary::Ends { left, right } => json!({"left": end(left), "right": end(right)}),
+    }
+}
+
+/// The key's `contacts`: nothing for the paper's law (whose chain keeps the paper's key), the
+/// experiment's parts, or a law only the library names by its name and numbers.
+fn contacts_json(contacts: LawOf<'_>) -> Option<Value> {
+    match contacts {
+        LawOf::Paper => None,
+        LawOf::Experiment(law) => Some(law_json(law)),
+        LawOf::Named { name, numbers } => {
+            let mut law = Map::new();
+            law.insert("law".into(), json!(name));
+            for (key, values) in numbers {
+                law.insert(key.into(), json!(values));
+            }
+            Some(Value::Object(law))
+        }
     }
 }
 
@@ -355,6 +362,21 @@ mod tests {
                 "scene.run.dt: (absent) -> 0.1".to_string()
             ]
         );
+    }
+
+    #[test]
+    fn a_named_law_is_keyed_by_its_name_and_every_number() {
+        use woodpile_sim::contact::ChainLaw;
+        let key = |stiffness: f64, gap: f64| {
+            let law = woodpile_sim::contact::LinearGap::new(vec![stiffness; 3], vec![gap; 3]);
+            let law = ChainLaw::from(law.unwrap());
+            Key::of(&contacts_json(law.describe()).unwrap())
+        };
+        assert_eq!(key(1.0, 0.1), key(1.0, 0.1));
+        assert_ne!(key(1.0, 0.1), key(1.0, 0.2));
+        assert_ne!(key(1.0, 0.1), key(2.0, 0.1));
+        let paper = ChainLaw::default();
+        assert_eq!(contacts_json(paper.describe()), None);
     }
 
     #[test]

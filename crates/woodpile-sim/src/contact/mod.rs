@@ -215,6 +215,11 @@ registry! { $
 pub(crate) use with_law;
 
 impl ChainLaw {
+    /// Whether this is the paper's law (unit coefficients, exponent 3/2, no static force).
+    pub fn is_papers(&self) -> bool {
+        matches!(self, ChainLaw::Paper(_))
+    }
+
     /// The law's exponent α.
     pub fn exponent(&self) -> f64 {
         with_law!(self, |law| Law::exponent(law))
