@@ -105,3 +105,16 @@ fn own_dashpots_are_refused_where_they_cannot_be_read() {
         assert_eq!(invalid_key(text), key, "{text}");
     }
 }
+
+#[test]
+fn a_step_budget_refusal_names_the_dashpot_that_sets_the_step() {
+    let stiff_segment = "[chain]\nsites = [-20, 20]\nboundary = \"free\"\n[impulse]\nsite = -20\n\
+        [damping]\ncontact = 0.01\n[[segment]]\nsites = [0, 5]\ndamping = 1e7\n";
+    assert_eq!(invalid_key(stiff_segment), "segment[0].damping");
+    let stiff_striker = "[chain]\nsites = [0, 30]\nboundary = \"free\"\n\
+        [striker]\nmass = 2.0\ndamping = 1e7\n[damping]\ncontact = 0.01\n";
+    assert_eq!(invalid_key(stiff_striker), "striker.damping");
+    let stiff_chain = "[chain]\nsites = [-20, 20]\nboundary = \"free\"\n[impulse]\nsite = -20\n\
+        [damping]\ncontact = 1e7\n[[segment]]\nsites = [0, 5]\ndamping = 0.01\n";
+    assert_eq!(invalid_key(stiff_chain), "damping.contact");
+}

@@ -119,7 +119,7 @@ impl Model {
                 let pair = inv(bond.checked_sub(1)) + inv((bond < n).then_some(bond));
                 let overlap = with_law!(self.law(), |law| law.overlap_within(bond, energy));
                 rates.push((
-                    Dissipator::Contact,
+                    Dissipator::Contact { bond },
                     d.law.force(d.contact_at(bond), overlap, 1.0) * pair,
                 ));
             }

@@ -239,8 +239,11 @@ pub enum Dissipator {
     Ground,
     /// The dashpot inside resonator `j`.
     Resonator(usize),
-    /// The contacts' dashpots.
-    Contact,
+    /// The dashpot of contact `bond` (the bond numbering of [`crate::contact`]).
+    Contact {
+        /// The bond whose dashpot is the fastest.
+        bond: usize,
+    },
 }
 
 /// A run refused before it starts.

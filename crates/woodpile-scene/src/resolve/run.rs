@@ -183,7 +183,7 @@ pub(crate) fn within_budget(
             StepSetBy::Tolerance => "run.tolerance".to_string(),
             StepSetBy::Resonator(i) => format!("defect[{i}]"),
             StepSetBy::Contacts => "chain".to_string(),
-            StepSetBy::Dissipation(which) => dissipator_key(*which, keys.defects),
+            StepSetBy::Dissipation(which) => dissipator_key(*which, keys),
             StepSetBy::DashpotOnsets => keys.contact_dashpot.clone(),
         },
     };
@@ -196,6 +196,51 @@ pub(crate) struct StepKeys<'a> {
     pub defects: &'a [raw::Defect],
     /// The key that declares a contact dashpot ([`contact_dashpot_key`]).
     pub contact_dashpot: String,
+    /// The key that declares each bond's dashpot ([`contact_dashpot_keys`]).
+    pub contact_dashpot_at: Vec<String>,
+}
+
+/// The key that declares each bond's dashpot (walls included): a segment's own on the contacts
+/// between its sites, the striker's own on its contact with the first site, `[damping]`'s
+/// elsewhere, as `resolve::damping` gives each bond its γ (later segments over earlier ones,
+/// the striker last).
+pub(crate) fn contact_dashpot_keys(file: &raw::SceneFile, layout: &Layout) -> Vec<String> {
+    let chain = match file
+        .damping
+        .as_ref()
+        .is_some_and(|d| d.restitution.is_some())
+    {
+        true => "damping.restitution",
+        false => "damping.contact",
+    };
+    let mut keys = vec![chain.to_string(); layout.n_sites() + 1];
+    let own = |damping: Option<f64>, restitution: bool, key: &str| match (damping, restitution) {
+        (_, true) => Some(format!("{key}.restitution")),
+        (Some(_), false) => Some(format!("{key}.damping")),
+        (None, false) => None,
+    };
+    for (i, segment) in file.segment.iter().enumerate() {
+        let key = format!("segment[{i}]");
+        let sites = segment
+            .sites
+            .as_deref()
+            .and_then(|s| <[i64; 2]>::try_from(s).ok());
+        let own = own(segment.damping, segment.restitution.is_some(), &key);
+        let (Some([lo, hi]), Some(own)) = (sites, own) else {
+            continue;
+        };
+        if let (Ok(start), Ok(end)) = (layout.index(&key, lo), layout.index(&key, hi)) {
+            for bond in keys.iter_mut().take(end + 1).skip(start + 1) {
+                bond.clone_from(&own);
+            }
+        }
+    }
+    if let Some(striker) = &file.striker {
+        if let Some(own) = own(striker.damping, striker.restitution.is_some(), "striker") {
+            keys[1] = own;
+        }
+    }
+    keys
 }
 
 /// The first key that declares a contact dashpot: the chain's, then the striker's, then a
@@ -241,12 +286,17 @@ pub(crate) fn contact_dashpot_key(file: &raw::SceneFile) -> String {
 }
 
 /// The key that declares `which` dashpot or soft end.
-fn dissipator_key(which: Dissipator, defects: &[raw::Defect]) -> String {
+fn dissipator_key(which: Dissipator, keys: &StepKeys<'_>) -> String {
+    let defects = keys.defects;
     match which {
         Dissipator::SoftEnd { last: false } => "chain.boundary.left".into(),
         Dissipator::SoftEnd { last: true } => "chain.boundary.right".into(),
         Dissipator::Ground => "damping.ground".into(),
-        Dissipator::Contact => "damping.contact".into(),
+        Dissipator::Contact { bond } => keys
+            .contact_dashpot_at
+            .get(bond)
+            .unwrap_or(&keys.contact_dashpot)
+            .clone(),
         Dissipator::Resonator(j) => match defects.get(j).and_then(|d| d.quality_factor) {
             Some(_) => format!("defect[{j}].quality_factor"),
             None => format!("defect[{j}].damping"),
