@@ -15,7 +15,7 @@
 //! bit. The paper's chain (every a_b = 1, α = 3/2, no precompression) has no `ContactLaw` at
 //! all: it runs [`super::PaperHertz`] and keeps its own bits.
 
-use super::{Law, LawOf, NEGLIGIBLE_FORCE};
+use super::{scaled, Law, LawOf, NEGLIGIBLE_FORCE};
 use crate::error::ModelError;
 use crate::integrate::contact_event::{oscillating_path_integrals, path_integrals_of, BondPath};
 
@@ -321,10 +321,6 @@ impl Law for ContactLaw {
         self.static_overlap[bond]
     }
 
-    #[inline(always)]
-    fn overlap(&self, bond: usize, r: f64) -> f64 {
-        self.static_overlap[bond] + r
-    }
 
     #[inline(always)]
     fn elastic(&self, bond: usize, r: f64) -> f64 {
@@ -354,9 +350,7 @@ impl Law for ContactLaw {
     }
 
     fn path_integrals(&self, bond: usize, path: &BondPath, h: f64) -> (f64, f64) {
-        let a = self.coefficient[bond];
-        let (impulse, moment) = path_integrals_of(path, h, |d| self.power.at(d));
-        (a * impulse, a * moment)
+        scaled(self.coefficient[bond], path_integrals_of(path, h, |d| self.power.at(d)))
     }
 
     fn oscillating_integrals(
@@ -366,9 +360,7 @@ impl Law for ContactLaw {
         h: f64,
         theta: f64,
     ) -> (f64, f64) {
-        let a = self.coefficient[bond];
-        let (impulse, moment) = oscillating_path_integrals(path, h, theta, |d| self.power.at(d));
-        (a * impulse, a * moment)
+        scaled(self.coefficient[bond], oscillating_path_integrals(path, h, theta, |d| self.power.at(d)))
     }
 
     fn force_negligible(&self, bond: usize, c: f64) -> bool {

@@ -12,7 +12,7 @@
 //! the worked example of docs/adding-a-law.md; its known answer is the period of a pair of
 //! beads bouncing between two walls.
 
-use super::{Law, LawOf, NEGLIGIBLE_FORCE};
+use super::{scaled, Law, LawOf, NEGLIGIBLE_FORCE};
 use crate::error::ModelError;
 use crate::integrate::contact_event::{oscillating_path_integrals, path_integrals_of, BondPath};
 
@@ -89,10 +89,6 @@ impl Law for LinearGap {
         self.rest_overlap[bond]
     }
 
-    #[inline(always)]
-    fn overlap(&self, bond: usize, r: f64) -> f64 {
-        self.rest_overlap[bond] + r
-    }
 
     #[inline(always)]
     fn elastic(&self, bond: usize, r: f64) -> f64 {
@@ -118,9 +114,7 @@ impl Law for LinearGap {
     }
 
     fn path_integrals(&self, bond: usize, path: &BondPath, h: f64) -> (f64, f64) {
-        let k = self.stiffness[bond];
-        let (impulse, moment) = path_integrals_of(path, h, |c| c.max(0.0));
-        (k * impulse, k * moment)
+        scaled(self.stiffness[bond], path_integrals_of(path, h, |c| c.max(0.0)))
     }
 
     fn oscillating_integrals(
@@ -130,9 +124,7 @@ impl Law for LinearGap {
         h: f64,
         theta: f64,
     ) -> (f64, f64) {
-        let k = self.stiffness[bond];
-        let (impulse, moment) = oscillating_path_integrals(path, h, theta, |c| c.max(0.0));
-        (k * impulse, k * moment)
+        scaled(self.stiffness[bond], oscillating_path_integrals(path, h, theta, |c| c.max(0.0)))
     }
 
     fn force_negligible(&self, bond: usize, c: f64) -> bool {

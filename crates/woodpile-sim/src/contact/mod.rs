@@ -55,7 +55,10 @@ pub(crate) trait Law {
 
     /// The total overlap c of bond `bond` at relative displacement `r`: its static overlap
     /// plus r.
-    fn overlap(&self, bond: usize, r: f64) -> f64;
+    #[inline(always)]
+    fn overlap(&self, bond: usize, r: f64) -> f64 {
+        self.static_overlap(bond) + r
+    }
 
     /// The elastic force of bond `bond` at relative displacement `r`: what is recorded, and
     /// positive exactly while the contact is closed.
@@ -142,6 +145,13 @@ pub(crate) trait Law {
             (total - elastic) * rate,
         )
     }
+}
+
+/// `a` times both of a path's integrals `(∫ F ds, ∫ (h − s) F ds)`: a law's coefficient taken
+/// out of its quadrature.
+#[inline(always)]
+pub(crate) fn scaled(a: f64, (impulse, moment): (f64, f64)) -> (f64, f64) {
+    (a * impulse, a * moment)
 }
 
 /// One contact's force: the total the sites feel (clipped at zero), its elastic part, and the
