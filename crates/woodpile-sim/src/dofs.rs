@@ -39,3 +39,47 @@ impl DofsMut for [f64] {
         self[k] = x;
     }
 }
+
+/// A state's positions and velocities, each read through [`Dofs`]: a step's start or end as
+/// the contact corrections read it.
+pub(crate) struct Phase<'a, D: ?Sized> {
+    pub q: &'a D,
+    pub v: &'a D,
+}
+
+impl<D: ?Sized> Clone for Phase<'_, D> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<D: ?Sized> Copy for Phase<'_, D> {}
+
+impl<'a> Phase<'a, [f64]> {
+    /// The positions and velocities of a state `[q, q', …]` of `n_dof` degrees of freedom.
+    #[inline(always)]
+    pub fn of(state: &'a [f64], n_dof: usize) -> Self {
+        let (q, rest) = state.split_at(n_dof);
+        Phase {
+            q,
+            v: &rest[..n_dof],
+        }
+    }
+}
+
+/// [`Phase`], written through [`DofsMut`]: a step's end as the corrections change it.
+pub(crate) struct PhaseMut<'a, D: ?Sized> {
+    pub q: &'a mut D,
+    pub v: &'a mut D,
+}
+
+impl<D: ?Sized> PhaseMut<'_, D> {
+    /// The same state, borrowed again for one more writer.
+    #[inline(always)]
+    pub fn reborrow(&mut self) -> PhaseMut<'_, D> {
+        PhaseMut {
+            q: &mut *self.q,
+            v: &mut *self.v,
+        }
+    }
+}

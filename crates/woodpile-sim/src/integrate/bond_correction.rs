@@ -10,6 +10,7 @@ use super::exact_resonator::{
 };
 use crate::contact::{with_law, Law};
 use crate::damping::Damping;
+use crate::dofs::{Phase, PhaseMut};
 use crate::model::Model;
 
 /// A method's quadrature of one bond force from its stage values: (impulse, position change).
@@ -51,10 +52,26 @@ impl Bond {
         }
     }
 
-    /// (left, right).
-    pub fn members(self) -> (Option<usize>, Option<usize>) {
-        (self.left, self.right)
+    /// Its members' sites (one or two).
+    pub fn sites(self) -> impl Iterator<Item = usize> {
+        self.left.into_iter().chain(self.right)
     }
+}
+
+/// A bond that changed contact during a step, with the forces the method's stages gave it.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Changed<const S: usize> {
+    pub bond: Bond,
+    pub stage: [f64; S],
+}
+
+/// A step as a correction reads it: its size, the method's quadrature of a bond force, and
+/// the exactly integrated resonators, if any.
+#[derive(Clone, Copy)]
+pub(crate) struct Rule<'a, const S: usize> {
+    pub h: f64,
+    pub quadrature: Quadrature<S>,
+    pub exact: Option<&'a ExactResonators<S>>,
 }
 
 /// A bond's correction: the impulse and the position moment its members receive (the left
@@ -72,8 +89,9 @@ pub(super) struct Correction {
 pub(super) fn apply<D: DofsMut + ?Sized>(
     inv_mass: &[f64],
     corrections: &[Correction],
-    (new_q, new_v): (&mut D, &mut D),
+    end: PhaseMut<'_, D>,
 ) {
+    let PhaseMut { q: new_q, v: new_v } = end;
     for &Correction {
         bond: Bond { left, right, .. },
         impulse,
@@ -94,8 +112,9 @@ pub(super) fn apply<D: DofsMut + ?Sized>(
 /// Adds the fast-mode parts of the corrections to the end state (host and resonator).
 pub(super) fn apply_fast<D: DofsMut + ?Sized>(
     fast: impl IntoIterator<Item = FastModeCorrection>,
-    (new_q, new_v): (&mut D, &mut D),
+    end: PhaseMut<'_, D>,
 ) {
+    let PhaseMut { q: new_q, v: new_v } = end;
     for fast in fast {
         for k in 0..2 {
             new_v.add(fast.sites[k], fast.velocity[k]);
@@ -122,20 +141,24 @@ pub(super) fn bond_integrals(
     (impulse, moment, 0.0)
 }
 
-/// A changed bond's correction over a step of size `h` from the states `start` to `end`
-/// (`(q, v)` each, the end not yet corrected) by a method of quadrature `quadrature` whose
-/// stages gave the bond the forces `stage`: the path integrals less the quadrature, with its
-/// parts along the fast modes of `exact` resonators at its members pushed to `fast`; and the
-/// energy its dashpot dissipated along the path. `None` when its forces are [`negligible`].
-/// One scene's states, or one lane's (`super::lanes`), are read through [`Dofs`].
+/// A changed bond's correction over a step (`rule`) from the state `start` to `end` (the end
+/// not yet corrected): the path integrals less the method's quadrature of the forces its
+/// stages gave the bond, with its parts along the fast modes of exact resonators at its
+/// members pushed to `fast`; and the energy its dashpot dissipated along the path. `None` when
+/// its forces are [`negligible`]. One scene's states, or one lane's (`super::lanes`), are read
+/// through [`Dofs`].
 pub(super) fn bond_correction<const S: usize, D: Dofs + ?Sized>(
     model: &Model,
-    (bond, stage): (Bond, [f64; S]),
-    (start, end): ((&D, &D), (&D, &D)),
-    (h, quadrature, exact): (f64, Quadrature<S>, Option<&ExactResonators<S>>),
+    Changed { bond, stage }: Changed<S>,
+    (start, end): (Phase<'_, D>, Phase<'_, D>),
+    Rule {
+        h,
+        quadrature,
+        exact,
+    }: Rule<'_, S>,
     fast: &mut Vec<FastModeCorrection>,
 ) -> Option<(Correction, f64)> {
-    let path = bond_path(model, bond.index, start, end, bond.members());
+    let path = bond_path(model, bond, start, end);
     if negligible(model, bond.index, stage, &path) {
         return None;
     }
@@ -176,25 +199,25 @@ pub(super) fn damped_force<'a, L: Law>(
     }
 }
 
-/// A bond's overlap and rate at both ends of a step, from the states (positions, velocities) at
-/// its start and end: left member minus right member, a wall counting as at rest, plus the
-/// bond's static overlap (a precompression's, or a gap's, negative).
+/// A bond's overlap and rate at both ends of a step, from the states at its `start` and `end`:
+/// left member minus right member, a wall counting as at rest, plus the bond's static overlap
+/// (a precompression's, or a gap's, negative).
 /// The state may be a lane of four (`super::lanes`): it is read through [`Dofs`].
 pub(super) fn bond_path<D: Dofs + ?Sized>(
     model: &Model,
-    bond: usize,
-    (q, v): (&D, &D),
-    (new_q, new_v): (&D, &D),
-    (left, right): (Option<usize>, Option<usize>),
+    bond: Bond,
+    start: Phase<'_, D>,
+    end: Phase<'_, D>,
 ) -> BondPath {
     let member = |x: &D, site: Option<usize>| site.map_or(0.0, |i| x.at(i));
+    let (left, right) = (bond.left, bond.right);
     let path = BondPath {
-        d0: member(q, left) - member(q, right),
-        rate0: member(v, left) - member(v, right),
-        d1: member(new_q, left) - member(new_q, right),
-        rate1: member(new_v, left) - member(new_v, right),
+        d0: member(start.q, left) - member(start.q, right),
+        rate0: member(start.v, left) - member(start.v, right),
+        d1: member(end.q, left) - member(end.q, right),
+        rate1: member(end.v, left) - member(end.v, right),
     };
-    match with_law!(model.law(), |law| law.static_overlap(bond)) {
+    match with_law!(model.law(), |law| law.static_overlap(bond.index)) {
         // A precompression's overlap (δ > 0), or a gap (δ < 0): never −0.0, so `!= 0.0`
         // leaves every paper bond's path as it was.
         delta if delta != 0.0 => BondPath {

@@ -8,12 +8,14 @@
 
 pub(crate) use super::bond_correction::Quadrature;
 use super::bond_correction::{
-    apply, apply_fast, bond_correction, bond_integrals, bond_path, damped_force, Bond, Correction,
+    apply, apply_fast, bond_correction, bond_integrals, bond_path, damped_force, Bond, Changed,
+    Correction, Rule,
 };
 use super::contact_event::{first_crossing, first_switch, BondPath};
 use super::contact_scan::{block_changes, block_of, changes_contact, negligible};
 use super::exact_resonator::{ExactResonators, FastModeCorrection};
 use crate::contact::{with_law, Law};
+use crate::dofs::{Phase, PhaseMut};
 use crate::model::{Model, Window};
 
 /// Extra passes of a dissipative chain's corrections ([`ContactEvents::refine`]).
@@ -136,20 +138,28 @@ impl<const S: usize> ContactEvents<S> {
                 }
             }
         }
-        let (q, v) = start.split_at(n);
+        let begun = Phase::of(start, n);
         let (new_q, new_v) = end.split_at_mut(n);
         let quadrature = self.quadrature;
+        let rule = Rule {
+            h,
+            quadrature,
+            exact,
+        };
         let mut pending = std::mem::take(&mut self.pending);
         pending.clear();
         let mut dissipated = 0.0;
         let mut corrected = std::mem::take(&mut self.corrected);
         corrected.clear();
+        let ended = Phase {
+            q: &*new_q,
+            v: &new_v[..n],
+        };
         for &bond in &self.changed {
             let stage = self.stage_forces(bond.index);
-            let states = ((q, v), (&*new_q, &*new_v));
-            let method = (h, quadrature, exact);
+            let changed = Changed { bond, stage };
             let found =
-                bond_correction(model, (bond, stage), states, method, &mut self.pending_fast);
+                bond_correction(model, changed, (begun, ended), rule, &mut self.pending_fast);
             let Some((correction, lost)) = found else {
                 continue;
             };
@@ -164,8 +174,12 @@ impl<const S: usize> ContactEvents<S> {
             // D follows the velocities, at index n_dof of them.
             new_v[n] += dissipated;
         }
-        apply(model.inv_mass(), &pending, (&mut *new_q, &mut *new_v));
-        apply_fast(self.pending_fast.drain(..), (&mut *new_q, &mut *new_v));
+        let mut ended = PhaseMut {
+            q: new_q,
+            v: &mut new_v[..],
+        };
+        apply(model.inv_mass(), &pending, ended.reborrow());
+        apply_fast(self.pending_fast.drain(..), ended);
         if model.is_dissipative() {
             self.refine(model, (start, end), h, (&mut pending, &mut corrected));
         }
@@ -188,15 +202,18 @@ impl<const S: usize> ContactEvents<S> {
         (pending, corrected): (&mut [Correction], &mut [(usize, f64)]),
     ) {
         let n = model.n_dof();
-        let (q, v) = start.split_at(n);
+        let begun = Phase::of(start, n);
         for _ in 0..REFINE_PASSES {
             let (new_q, new_v) = end.split_at_mut(n);
             let mut deltas = Vec::with_capacity(pending.len());
             let mut dissipated = 0.0;
             for (applied, (bond, lost_before)) in pending.iter_mut().zip(corrected.iter_mut()) {
                 let before = *applied;
-                let members = before.bond.members();
-                let path = bond_path(model, *bond, (q, v), (new_q, new_v), members);
+                let ended = Phase {
+                    q: &*new_q,
+                    v: &new_v[..n],
+                };
+                let path = bond_path(model, before.bond, begun, ended);
                 let (impulse, moment, lost) = bond_integrals(model, *bond, &path, h);
                 let (q0, q1) = (self.quadrature)(self.stage_forces(*bond), h);
                 *applied = Correction {
@@ -213,7 +230,7 @@ impl<const S: usize> ContactEvents<S> {
                 *lost_before = lost;
             }
             new_v[n] += dissipated;
-            apply(model.inv_mass(), &deltas, (new_q, new_v));
+            apply(model.inv_mass(), &deltas, PhaseMut { q: new_q, v: new_v });
         }
     }
 
@@ -265,11 +282,10 @@ impl<const S: usize> ContactEvents<S> {
     ) -> Option<(f64, Bond)> {
         let n = model.n_dof();
         self.scan(model, &end[..n], window);
-        let (q, v) = start.split_at(n);
-        let (new_q, new_v) = end.split_at(n);
+        let (begun, ended) = (Phase::of(start, n), Phase::of(end, n));
         let mut first: Option<(f64, Bond)> = None;
         for &bond in &self.changed {
-            let path = bond_path(model, bond.index, (q, v), (new_q, new_v), bond.members());
+            let path = bond_path(model, bond, begun, ended);
             if negligible(model, bond.index, self.stage_forces(bond.index), &path) {
                 continue;
             }

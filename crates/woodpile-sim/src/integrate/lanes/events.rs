@@ -6,7 +6,10 @@
 use super::{Lane, LaneMut, Lanes, LANES, S};
 use crate::chain_force::Width;
 use crate::contact::{with_law, Law};
-use crate::integrate::bond_correction::{apply, apply_fast, bond_correction, Bond, Correction};
+use crate::dofs::{Phase, PhaseMut};
+use crate::integrate::bond_correction::{
+    apply, apply_fast, bond_correction, Bond, Changed, Correction, Rule,
+};
 use crate::integrate::contact_scan::changes_contact;
 use crate::integrate::exact_resonator::{ExactResonators, FastModeCorrection};
 use crate::integrate::rkn::DPRKN6;
@@ -54,26 +57,37 @@ impl LaneEvents {
                     continue;
                 }
                 let stage: [f64; S] = std::array::from_fn(|s| stage_force[s][bond.index][l]);
-                let states = (
-                    (&Lane(q, l), &Lane(v, l)),
-                    (&Lane(new_q, l), &Lane(new_v, l)),
-                );
-                let method = (h, DPRKN6.quadrature, exact[l].as_ref());
+                let begun = Phase {
+                    q: &Lane(q, l),
+                    v: &Lane(v, l),
+                };
+                let ended = Phase {
+                    q: &Lane(new_q, l),
+                    v: &Lane(new_v, l),
+                };
+                let rule = Rule {
+                    h,
+                    quadrature: DPRKN6.quadrature,
+                    exact: exact[l].as_ref(),
+                };
                 let fast = &mut self.pending_fast;
+                let changed = Changed { bond, stage };
                 if let Some((correction, _)) =
-                    bond_correction(model, (bond, stage), states, method, fast)
+                    bond_correction(model, changed, (begun, ended), rule, fast)
                 {
                     pending.push(correction);
                 }
             }
-            let end = (&mut LaneMut(new_q, l), &mut LaneMut(new_v, l));
-            apply(model.inv_mass(), &pending, end);
-            let end = (&mut LaneMut(new_q, l), &mut LaneMut(new_v, l));
-            apply_fast(self.pending_fast.drain(..), end);
+            let (mut lane_q, mut lane_v) = (LaneMut(new_q, l), LaneMut(new_v, l));
+            let mut ended = PhaseMut {
+                q: &mut lane_q,
+                v: &mut lane_v,
+            };
+            apply(model.inv_mass(), &pending, ended.reborrow());
+            apply_fast(self.pending_fast.drain(..), ended);
             let touched = &mut self.touched[l];
             for correction in &pending {
-                let (left, right) = correction.bond.members();
-                touched.extend(left.into_iter().chain(right));
+                touched.extend(correction.bond.sites());
             }
             corrected[l] = !pending.is_empty();
             self.pending = pending;
