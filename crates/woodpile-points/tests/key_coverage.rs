@@ -1,7 +1,7 @@
-//! The point key sees every key a scene can set: for a handful of scenes that between them use
-//! every key in docs/scene.md's table, each leaf value is changed in turn, and the changed
-//! scene must hash to a different key (or fail to load, naming why). Spellings that mean the
-//! same scene must hash alike.
+//! The point key sees every key a scene can set: every key the parser accepts is in
+//! docs/scene.md's table; for a handful of scenes that between them use every key in that
+//! table, each leaf value is changed in turn, and the changed scene must hash to a different key
+//! (or fail to load, naming why). Spellings that mean the same scene must hash alike.
 
 #![allow(clippy::unwrap_used)]
 
@@ -378,4 +378,68 @@ fn spellings_of_one_scene_hash_alike() {
             "{short}\nagainst\n{long}"
         );
     }
+}
+
+/// The keys the scene parser accepts (`woodpile-scene/src/raw.rs`), as `section.key` without
+/// indices: each field of `SceneFile`, and of every raw struct a field holds, walked from the
+/// file's text. A field of another type (a number, a list, a table read by hand) is a leaf.
+fn parsed_keys() -> BTreeSet<String> {
+    let raw = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../woodpile-scene/src/raw.rs"),
+    )
+    .unwrap();
+    let mut structs: std::collections::BTreeMap<String, Vec<(String, String)>> = Default::default();
+    let mut current: Option<String> = None;
+    for line in raw.lines() {
+        if let Some(rest) = line.strip_prefix("pub(crate) struct ") {
+            current = rest.strip_suffix(" {").map(str::to_string);
+        } else if line == "}" {
+            current = None;
+        } else if let (Some(name), Some(field)) = (&current, line.strip_prefix("    pub ")) {
+            let (key, ty) = field.trim_end_matches(',').split_once(": ").unwrap();
+            let inner = ty.trim_start_matches("Option<").trim_start_matches("Vec<");
+            let inner = inner.trim_end_matches('>').to_string();
+            structs
+                .entry(name.clone())
+                .or_default()
+                .push((key.to_string(), inner));
+        }
+    }
+    let mut keys = BTreeSet::new();
+    let mut stack = vec![(String::new(), "SceneFile".to_string())];
+    while let Some((prefix, name)) = stack.pop() {
+        for (key, ty) in &structs[&name] {
+            let path = format!("{prefix}{key}");
+            match structs.contains_key(ty) {
+                true => stack.push((format!("{path}."), ty.clone())),
+                false => {
+                    keys.insert(path);
+                }
+            }
+        }
+    }
+    keys
+}
+
+#[test]
+fn every_key_the_parser_accepts_is_documented() {
+    let parsed = parsed_keys();
+    assert!(
+        parsed.len() > 40 && parsed.contains("damping.restitution.e"),
+        "raw.rs was not read: {parsed:?}"
+    );
+    let documented = documented_keys();
+    // A documented key names a leaf, or a table whose keys the table's row lists.
+    let undocumented: Vec<&String> = parsed
+        .iter()
+        .filter(|key| {
+            !documented.iter().any(|d| {
+                d == *key || key.starts_with(&format!("{d}.")) || d.starts_with(&format!("{key}."))
+            })
+        })
+        .collect();
+    assert!(
+        undocumented.is_empty(),
+        "keys the parser accepts that docs/scene.md's table does not document: {undocumented:?}"
+    );
 }
