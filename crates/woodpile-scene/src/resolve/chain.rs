@@ -155,8 +155,6 @@ pub(crate) fn boundary(chain: Option<&raw::Chain>, si: Option<&Si>) -> Result<Bo
 pub(crate) struct Sites {
     pub masses: Vec<f64>,
     pub contacts: Vec<f64>,
-    /// Whether any key set a contact coefficient (then the chain needs a `ContactLaw`).
-    pub contacts_set: bool,
     /// The defect whose SI `mass` set a site's mass, to refuse a segment that sets it too.
     pub mass_from_defect: Vec<Option<usize>>,
 }
@@ -168,7 +166,6 @@ impl Sites {
         Sites {
             masses: vec![1.0; n],
             contacts: vec![1.0; n + 1],
-            contacts_set: false,
             mass_from_defect: vec![None; n],
         }
     }
@@ -176,7 +173,6 @@ impl Sites {
     /// Sets the coefficient of `bond`.
     pub fn set_contact(&mut self, bond: usize, a: f64) {
         self.contacts[bond] = a;
-        self.contacts_set = true;
     }
 }
 
@@ -278,14 +274,6 @@ pub(crate) fn contact_law(
     let (exponent, precompression, wall_contact) = chain.map_or((None, None, None), |c| {
         (c.exponent, c.precompression, c.wall_contact)
     });
-    let declared = exponent.is_some()
-        || precompression.is_some()
-        || wall_contact.is_some()
-        || gravity.is_some()
-        || sites.contacts_set;
-    if !declared {
-        return Ok(None);
-    }
     let exponent = match exponent {
         None => 1.5,
         Some(alpha) if !(1.0..=5.0).contains(&alpha) => {
@@ -330,18 +318,13 @@ pub(crate) fn contact_law(
         sites.set_contact(0, a);
         sites.set_contact(last, a);
     }
-    // Keys spelling out the paper's law (α = 3/2, unit coefficients, no static force) build
-    // the paper's chain: its code path, its bits and its cache key, however they are written.
-    let papers = exponent == 1.5
-        && precompression == 0.0
-        && gravity.is_none()
-        && sites.contacts.iter().all(|&a| a == 1.0);
-    if papers {
-        return Ok(None);
-    }
     let law = match gravity {
         None => ContactLaw::new(sites.contacts.clone(), exponent, precompression),
         Some(g) => ContactLaw::under_gravity(sites.contacts.clone(), exponent, carried, g),
     };
-    law.map(Some).map_err(|e| invalid("chain", e.to_string()))
+    let law = law.map_err(|e| invalid("chain", e.to_string()))?;
+    // Keys spelling out the paper's law (no keys at all, or α = 3/2, unit coefficients and no
+    // static force written out) build the paper's chain: its code path, its bits and its cache
+    // key, however they are written.
+    Ok((!law.is_papers()).then_some(law))
 }

@@ -221,6 +221,26 @@ impl ContactLaw {
         }
     }
 
+    /// Whether this law is the paper's: exponent 3/2, unit coefficients, no precompression
+    /// and no gravity. Taken apart with no `..`, so that a field added to the law must say
+    /// whether it keeps a chain the paper's.
+    pub fn is_papers(&self) -> bool {
+        let ContactLaw {
+            exponent,
+            precompression,
+            gravity,
+            coefficient,
+            // Derived from the parts above.
+            power: _,
+            static_overlap: _,
+            static_force: _,
+        } = self;
+        *exponent == 1.5
+            && *precompression == 0.0
+            && *gravity == 0.0
+            && coefficient.iter().all(|&a| a == 1.0)
+    }
+
     /// Number of bonds, walls included (sites + 1).
     pub fn n_bonds(&self) -> usize {
         self.coefficient.len()
