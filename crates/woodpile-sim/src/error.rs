@@ -198,7 +198,8 @@ pub enum SimError {
 /// imports nothing.)
 #[derive(Debug, Clone, PartialEq)]
 pub struct Unverified {
-    /// Its R, T, E_tr, S and D at `t_end`, as `energy::Fractions` has them.
+    /// Its shares at `t_end`, in `Share::ALL`'s order (a share added there no longer fits
+    /// here, and fails to compile until this type takes it).
     pub shares: [f64; 5],
     /// The step it took.
     pub dt: f64,

@@ -203,13 +203,7 @@ impl<'a> Ladder<'a> {
         let finest = self.coarse.take().map(|run| {
             let f = run.fractions;
             Box::new(crate::error::Unverified {
-                shares: [
-                    f.reflected,
-                    f.transmitted,
-                    f.trapped,
-                    f.striker,
-                    f.dissipated,
-                ],
+                shares: crate::Share::ALL.map(|share| share.of(&f)),
                 dt: run.stats.max_step,
                 estimate: self.estimate,
             })
