@@ -1,6 +1,7 @@
 //! `[chain]` and `[[segment]]`: which sites there are, what lies beyond the ends, each site's
 //! mass and each contact's coefficient, the exponent and the precompression.
 
+use woodpile_sim::contact::LawParts;
 use woodpile_sim::model::{Boundary, End};
 use woodpile_sim::ContactLaw;
 
@@ -318,13 +319,22 @@ pub(crate) fn contact_law(
         sites.set_contact(0, a);
         sites.set_contact(last, a);
     }
+    // Keys spelling out the paper's law (no keys at all, or α = 3/2, unit coefficients and no
+    // static force written out) build the paper's chain: its code path, its bits and its cache
+    // key, however they are written. Asked of the parts, before a law of a million sites is
+    // built for nothing.
+    let parts = LawParts {
+        coefficients: &sites.contacts,
+        exponent,
+        precompression,
+        gravity: gravity.unwrap_or(0.0),
+    };
+    if parts.is_papers() {
+        return Ok(None);
+    }
     let law = match gravity {
         None => ContactLaw::new(sites.contacts.clone(), exponent, precompression),
         Some(g) => ContactLaw::under_gravity(sites.contacts.clone(), exponent, carried, g),
     };
-    let law = law.map_err(|e| invalid("chain", e.to_string()))?;
-    // Keys spelling out the paper's law (no keys at all, or α = 3/2, unit coefficients and no
-    // static force written out) build the paper's chain: its code path, its bits and its cache
-    // key, however they are written.
-    Ok((!law.is_papers()).then_some(law))
+    law.map(Some).map_err(|e| invalid("chain", e.to_string()))
 }

@@ -117,7 +117,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     let built = model(&file, &layout, si.as_ref())?;
     // Named before `run` and `fractions` are taken from the file.
     let contact_dashpot = run::contact_dashpot_key(&file);
-    let contact_dashpot_at = run::contact_dashpot_keys(&file, &layout);
+    let contact_dashpots = run::ContactDashpots::of(&file, &layout);
     let settings = run::settings(file.run, si.as_ref())?;
     let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
     let mut region = Region::new(lo as i64, hi as i64, layout.n_sites())
@@ -140,7 +140,7 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     let keys = run::StepKeys {
         defects: &file.defect,
         contact_dashpot,
-        contact_dashpot_at,
+        contact_dashpots,
     };
     run::within_budget(&scenario, settings.sample_every_given, &keys)?;
     let physical = si.map(|si| {

@@ -196,51 +196,71 @@ pub(crate) struct StepKeys<'a> {
     pub defects: &'a [raw::Defect],
     /// The key that declares a contact dashpot ([`contact_dashpot_key`]).
     pub contact_dashpot: String,
-    /// The key that declares each bond's dashpot ([`contact_dashpot_keys`]).
-    pub contact_dashpot_at: Vec<String>,
+    /// The keys that declare the contacts' own dashpots ([`ContactDashpots::of`]).
+    pub contact_dashpots: ContactDashpots,
 }
 
-/// The key that declares each bond's dashpot (walls included): a segment's own on the contacts
-/// between its sites, the striker's own on its contact with the first site, `[damping]`'s
-/// elsewhere, as `resolve::damping` gives each bond its γ (later segments over earlier ones,
-/// the striker last).
-pub(crate) fn contact_dashpot_keys(file: &raw::SceneFile, layout: &Layout) -> Vec<String> {
-    let chain = match file
-        .damping
-        .as_ref()
-        .is_some_and(|d| d.restitution.is_some())
-    {
-        true => "damping.restitution",
-        false => "damping.contact",
-    };
-    let mut keys = vec![chain.to_string(); layout.n_sites() + 1];
-    let own = |damping: Option<f64>, restitution: bool, key: &str| match (damping, restitution) {
-        (_, true) => Some(format!("{key}.restitution")),
-        (Some(_), false) => Some(format!("{key}.damping")),
-        (None, false) => None,
-    };
-    for (i, segment) in file.segment.iter().enumerate() {
-        let key = format!("segment[{i}]");
-        let sites = segment
-            .sites
-            .as_deref()
-            .and_then(|s| <[i64; 2]>::try_from(s).ok());
-        let own = own(segment.damping, segment.restitution.is_some(), &key);
-        let (Some([lo, hi]), Some(own)) = (sites, own) else {
-            continue;
+/// Which key declares each contact's dashpot: a segment's own on the contacts between its
+/// sites, the striker's own on its contact with the first site, `[damping]`'s elsewhere, as
+/// `resolve::damping` gives each bond its γ (later segments over earlier ones, the striker
+/// last). Kept as the few bond ranges that have their own, not a key per bond: a chain may
+/// have millions.
+pub(crate) struct ContactDashpots {
+    /// `damping.contact` or `damping.restitution`.
+    chain: &'static str,
+    /// Bond ranges with their own dashpot, in the order they are applied.
+    own: Vec<(std::ops::RangeInclusive<usize>, String)>,
+}
+
+impl ContactDashpots {
+    /// The keys of `file`'s dashpots on the chain `layout` lays out.
+    pub fn of(file: &raw::SceneFile, layout: &Layout) -> ContactDashpots {
+        let chain = match file
+            .damping
+            .as_ref()
+            .is_some_and(|d| d.restitution.is_some())
+        {
+            true => "damping.restitution",
+            false => "damping.contact",
         };
-        if let (Ok(start), Ok(end)) = (layout.index(&key, lo), layout.index(&key, hi)) {
-            for bond in keys.iter_mut().take(end + 1).skip(start + 1) {
-                bond.clone_from(&own);
+        let own = |damping: Option<f64>, restitution: bool, key: &str| match (damping, restitution)
+        {
+            (_, true) => Some(format!("{key}.restitution")),
+            (Some(_), false) => Some(format!("{key}.damping")),
+            (None, false) => None,
+        };
+        let mut ranges = Vec::new();
+        for (i, segment) in file.segment.iter().enumerate() {
+            let key = format!("segment[{i}]");
+            let sites = segment
+                .sites
+                .as_deref()
+                .and_then(|s| <[i64; 2]>::try_from(s).ok());
+            let own = own(segment.damping, segment.restitution.is_some(), &key);
+            let (Some([lo, hi]), Some(own)) = (sites, own) else {
+                continue;
+            };
+            if let (Ok(start), Ok(end)) = (layout.index(&key, lo), layout.index(&key, hi)) {
+                ranges.push((start + 1..=end, own));
             }
         }
-    }
-    if let Some(striker) = &file.striker {
-        if let Some(own) = own(striker.damping, striker.restitution.is_some(), "striker") {
-            keys[1] = own;
+        if let Some(striker) = &file.striker {
+            if let Some(own) = own(striker.damping, striker.restitution.is_some(), "striker") {
+                ranges.push((1..=1, own));
+            }
         }
+        ContactDashpots { chain, own: ranges }
     }
-    keys
+
+    /// The key that declares bond `bond`'s dashpot.
+    pub fn key_of(&self, bond: usize) -> String {
+        let own = self
+            .own
+            .iter()
+            .rev()
+            .find(|(range, _)| range.contains(&bond));
+        own.map_or_else(|| self.chain.to_string(), |(_, key)| key.clone())
+    }
 }
 
 /// The first key that declares a contact dashpot: the chain's, then the striker's, then a
@@ -292,11 +312,7 @@ fn dissipator_key(which: Dissipator, keys: &StepKeys<'_>) -> String {
         Dissipator::SoftEnd { last: false } => "chain.boundary.left".into(),
         Dissipator::SoftEnd { last: true } => "chain.boundary.right".into(),
         Dissipator::Ground => "damping.ground".into(),
-        Dissipator::Contact { bond } => keys
-            .contact_dashpot_at
-            .get(bond)
-            .unwrap_or(&keys.contact_dashpot)
-            .clone(),
+        Dissipator::Contact { bond } => keys.contact_dashpots.key_of(bond),
         Dissipator::Resonator(j) => match defects.get(j).and_then(|d| d.quality_factor) {
             Some(_) => format!("defect[{j}].quality_factor"),
             None => format!("defect[{j}].damping"),

@@ -85,6 +85,24 @@ pub struct LawParts<'a> {
     pub gravity: f64,
 }
 
+impl LawParts<'_> {
+    /// Whether these parts make the paper's law: exponent 3/2, unit coefficients, no
+    /// precompression and no gravity. Taken apart with no `..`, so that a part added to the law
+    /// must say whether it keeps a chain the paper's.
+    pub fn is_papers(&self) -> bool {
+        let LawParts {
+            coefficients,
+            exponent,
+            precompression,
+            gravity,
+        } = self;
+        *exponent == 1.5
+            && *precompression == 0.0
+            && *gravity == 0.0
+            && coefficients.iter().all(|&a| a == 1.0)
+    }
+}
+
 impl ContactLaw {
     /// The parts this law was built from, taken apart with no `..` (see
     /// [`crate::model::parts`]).
@@ -219,26 +237,6 @@ impl ContactLaw {
             static_overlap,
             static_force,
         }
-    }
-
-    /// Whether this law is the paper's: exponent 3/2, unit coefficients, no precompression
-    /// and no gravity. Taken apart with no `..`, so that a field added to the law must say
-    /// whether it keeps a chain the paper's.
-    pub fn is_papers(&self) -> bool {
-        let ContactLaw {
-            exponent,
-            precompression,
-            gravity,
-            coefficient,
-            // Derived from the parts above.
-            power: _,
-            static_overlap: _,
-            static_force: _,
-        } = self;
-        *exponent == 1.5
-            && *precompression == 0.0
-            && *gravity == 0.0
-            && coefficient.iter().all(|&a| a == 1.0)
     }
 
     /// Number of bonds, walls included (sites + 1).
