@@ -156,7 +156,10 @@ fn held_bytes(points: usize, scene: &crate::Scene, planned: f64) -> f64 {
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     let running = points.min(threads.saturating_mul(batch_size(points)));
     let in_flight = (running * s.model.n_sites()) as f64 * RUNNING_BYTES_PER_SITE;
-    let columns = 5 + u64::from(s.region.has_striker());
+    // A point's series: its times and energies, and each share it reports (S with a striker,
+    // D with losses).
+    let shares = woodpile_sim::ShareSet::of(&s.model, &s.region).iter().count();
+    let columns = 2 + shares as u64;
     points as f64 * (1400.0 + (samples(scene) * columns * 8 * 2) as f64) + in_flight + planned
 }
 
