@@ -125,6 +125,7 @@ audit: ## auto against an independent reference: 200 random scenes at 1e-5..1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example auto_audit -- --gap 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example lanes_audit -- 100 2026 1e-5,1e-6,1e-7,1e-8
 	$(CARGO) run --release -q -p woodpile-bench --example lanes_audit -- --chain 40 2026 1e-5,1e-6,1e-7,1e-8
+	$(CARGO) run --release -q -p woodpile-bench --example lanes_audit -- --gap 40 2026 1e-5,1e-6,1e-7,1e-8
 
 work-precision: ## Error in E_tr against wall time for every method and step (README table)
 	$(CARGO) run --release -p woodpile-sim --example work_precision

@@ -32,6 +32,12 @@
 //! constant (`woodpile_sim::testing::linear_audit_scene`): the paper's kind of scene, judged
 //! without the stricter rules of a nonlinear or ramped resonator.
 //!
+//! With `--gravity` first, linear scenes stood upright in gravity
+//! (`woodpile_sim::testing::gravity_audit_scene`). With `--gap` first, the plain scenes with
+//! every contact a one-sided linear spring across a gap
+//! (`woodpile_sim::testing::gap_audit_scene`); their reference runs the law's own code, so the
+//! law itself is checked by its known answer (docs/adding-a-law.md).
+//!
 //! ```text
 //! cargo run --release -p woodpile-bench --example auto_audit [-- [--chain | --damped | --linear-losses | --linear | --gravity | --gap] SCENES [SEED [TOLERANCES [ONLY]]]]
 //! cargo run --release -p woodpile-bench --example auto_audit -- 200 2026 1e-5,1e-6,1e-7,1e-8

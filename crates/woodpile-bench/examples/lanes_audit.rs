@@ -2,13 +2,14 @@
 //! (`woodpile_sim::simulation::simulate_batch`) gives its scalar run's result bit for bit.
 //! Random groups of four neighbouring points (`woodpile_sim::testing::lane_neighbours`:
 //! the impulse's site two apart, one group in four with one lane's resonators a thousandth
-//! lighter) around the `auto` audit's scenes, or with `--chain` the experiment's chain's
-//! (striker, precompression, alternating masses and contacts, any exponent), at the given
+//! lighter) around the `auto` audit's scenes, with `--chain` the experiment's chain's
+//! (striker, precompression, alternating masses and contacts, any exponent), or with `--gap`
+//! chains of gapped linear contacts (`woodpile_sim::testing::gap_audit_scene`), at the given
 //! tolerances, each run by `simulate_batch` and by `simulate` alone. A group whose outcome or
 //! samples differ in any bit is a `MISS`, and the exit status is 1.
 //!
 //! ```text
-//! cargo run --release -p woodpile-bench --example lanes_audit [-- [--chain] GROUPS [SEED [TOLERANCES]]]
+//! cargo run --release -p woodpile-bench --example lanes_audit [-- [--chain | --gap] GROUPS [SEED [TOLERANCES]]]
 //! cargo run --release -p woodpile-bench --example lanes_audit -- 100 2026 1e-5,1e-6,1e-7,1e-8
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
@@ -18,7 +19,8 @@ use woodpile_sim::integrate::lanes::shares_a_chain;
 use woodpile_sim::integrate::{MethodChoice, Plan};
 use woodpile_sim::simulation::{auto_first_step, Scenario};
 use woodpile_sim::testing::{
-    audit_scene, by_lanes_and_alone, chain_audit_scene, lane_neighbours, tolerance, Lcg,
+    audit_scene, by_lanes_and_alone, chain_audit_scene, gap_audit_scene, lane_neighbours,
+    tolerance, Lcg,
 };
 use woodpile_sim::Model;
 
@@ -68,8 +70,12 @@ fn audit(k: usize, scenes: &[Scenario]) -> Group {
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
-    let chain = args.first().is_some_and(|a| a == "--chain");
-    if chain {
+    let (draw, kind): (fn(&mut Lcg) -> Scenario, _) = match args.first().map(String::as_str) {
+        Some("--chain") => (chain_audit_scene, "the experiment's chain"),
+        Some("--gap") => (gap_audit_scene, "gapped linear contacts"),
+        _ => (audit_scene, "audit scenes"),
+    };
+    if args.first().is_some_and(|a| a.starts_with("--")) {
         args.remove(0);
     }
     let groups: usize = args.first().map_or(40, |a| a.parse().unwrap());
@@ -80,10 +86,7 @@ fn main() {
     let mut rng = Lcg(seed);
     let cases: Vec<Vec<Scenario>> = (0..groups)
         .map(|k| {
-            let base = match chain {
-                true => chain_audit_scene(&mut rng),
-                false => audit_scene(&mut rng),
-            };
+            let base = draw(&mut rng);
             let base = Scenario {
                 accuracy: tolerance(tolerances[k % tolerances.len()]),
                 ..base
@@ -99,8 +102,7 @@ fn main() {
     let in_lanes = results.iter().filter(|r| r.in_lanes).count();
     let misses = results.iter().filter(|r| !r.identical).count();
     println!(
-        "\n{groups} groups of four ({}, seed {seed}): {in_lanes} took lanes; {misses} differ from their scenes run alone",
-        if chain { "the experiment's chain" } else { "audit scenes" }
+        "\n{groups} groups of four ({kind}, seed {seed}): {in_lanes} took lanes; {misses} differ from their scenes run alone"
     );
     if misses > 0 {
         std::process::exit(1);

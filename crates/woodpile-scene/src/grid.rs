@@ -158,7 +158,9 @@ fn held_bytes(points: usize, scene: &crate::Scene, planned: f64) -> f64 {
     let in_flight = (running * s.model.n_sites()) as f64 * RUNNING_BYTES_PER_SITE;
     // A point's series: its times and energies, and each share it reports (S with a striker,
     // D with losses).
-    let shares = woodpile_sim::ShareSet::of(&s.model, &s.region).iter().count();
+    let shares = woodpile_sim::ShareSet::of(&s.model, &s.region)
+        .iter()
+        .count();
     let columns = 2 + shares as u64;
     points as f64 * (1400.0 + (samples(scene) * columns * 8 * 2) as f64) + in_flight + planned
 }

@@ -152,7 +152,7 @@ impl Model {
     }
 
     /// The static overlap of bond `bond` (numbering of [`crate::contact`]): 0 but under a
-    /// precompression or gravity.
+    /// precompression or gravity (positive) or across a gap (negative).
     pub fn static_overlap(&self, bond: usize) -> f64 {
         with_law!(self.law(), |law| law.static_overlap(bond))
     }
@@ -222,13 +222,14 @@ mod tests {
     }
 
     /// A chain of the audit's kinds (walls or free ends, resonators of every exponent, the
-    /// experiment's contact laws, masses, precompression), given soft ends without dashpots on
-    /// every third.
+    /// experiment's contact laws, masses, precompression, gapped linear contacts), given soft
+    /// ends without dashpots on every third.
     fn patch_test_model(rng: &mut crate::testing::Lcg, k: usize) -> Model {
-        use crate::testing::{audit_scene, chain_audit_scene};
-        let model = match k % 2 {
-            0 => chain_audit_scene(rng).model,
-            _ => audit_scene(rng).model,
+        use crate::testing::{audit_scene, chain_audit_scene, gap_audit_scene};
+        let model = match k % 4 {
+            0 | 2 => chain_audit_scene(rng).model,
+            1 => audit_scene(rng).model,
+            _ => gap_audit_scene(rng).model,
         };
         if !k.is_multiple_of(3) {
             return model;

@@ -156,6 +156,9 @@ pub(crate) fn boundary(chain: Option<&raw::Chain>, si: Option<&Si>) -> Result<Bo
 pub(crate) struct Sites {
     pub masses: Vec<f64>,
     pub contacts: Vec<f64>,
+    /// Whether any key set a contact coefficient ([`Sites::set_contact`]): without one, every
+    /// coefficient is 1 and needs no pass over a long chain to say so.
+    pub contacts_set: bool,
     /// The defect whose SI `mass` set a site's mass, to refuse a segment that sets it too.
     pub mass_from_defect: Vec<Option<usize>>,
 }
@@ -167,6 +170,7 @@ impl Sites {
         Sites {
             masses: vec![1.0; n],
             contacts: vec![1.0; n + 1],
+            contacts_set: false,
             mass_from_defect: vec![None; n],
         }
     }
@@ -174,6 +178,7 @@ impl Sites {
     /// Sets the coefficient of `bond`.
     pub fn set_contact(&mut self, bond: usize, a: f64) {
         self.contacts[bond] = a;
+        self.contacts_set = true;
     }
 }
 
@@ -324,7 +329,11 @@ pub(crate) fn contact_law(
     // key, however they are written. Asked of the parts, before a law of a million sites is
     // built for nothing.
     let parts = LawParts {
-        coefficients: &sites.contacts,
+        coefficients: if sites.contacts_set {
+            &sites.contacts
+        } else {
+            &[]
+        },
         exponent,
         precompression,
         gravity: gravity.unwrap_or(0.0),

@@ -231,6 +231,9 @@ impl ContactDashpots {
         };
         let mut ranges = Vec::new();
         for (i, segment) in file.segment.iter().enumerate() {
+            if segment.damping.is_none() && segment.restitution.is_none() {
+                continue;
+            }
             let key = format!("segment[{i}]");
             let sites = segment
                 .sites

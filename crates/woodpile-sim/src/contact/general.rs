@@ -322,6 +322,10 @@ impl Law for ContactLaw {
         Some(self.coefficient.len())
     }
 
+    fn held_by_walls(&self) -> bool {
+        self.precompression > 0.0
+    }
+
     fn describe(&self) -> LawOf<'_> {
         LawOf::Experiment(self.parts())
     }

@@ -44,13 +44,19 @@ pub(crate) trait Law {
     /// What the law was built from, for cache keys ([`crate::model::parts`]).
     fn describe(&self) -> LawOf<'_>;
 
+    /// Whether walls at both ends must hold the law's static forces (a precompression).
+    fn held_by_walls(&self) -> bool {
+        false
+    }
+
     /// The contact exponent α.
     fn exponent(&self) -> f64;
 
     /// g when the contacts carry the weights above them, 0 otherwise.
     fn gravity(&self) -> f64;
 
-    /// The static overlap δ_b of bond `bond` (0 without a load).
+    /// The static overlap δ_b of bond `bond`: 0 without a load, positive under one, negative
+    /// across a gap.
     fn static_overlap(&self, bond: usize) -> f64;
 
     /// The total overlap c of bond `bond` at relative displacement `r`: its static overlap
@@ -75,8 +81,8 @@ pub(crate) trait Law {
     /// state; its derivative in r is the net force.
     fn potential(&self, bond: usize, r: f64) -> f64;
 
-    /// The static overlap of every bond, or `None` when none is loaded (then a bond's overlap
-    /// is its relative displacement, and the contact scan takes its block test).
+    /// The static overlap of every bond, or `None` when all are 0 (then a bond's overlap is its
+    /// relative displacement, and the contact scan takes its block test).
     fn static_overlaps(&self) -> Option<&[f64]>;
 
     /// `(∫_0^h F ds, ∫_0^h (h − s) F ds)` of bond `bond`'s elastic force along `path` (a path
@@ -238,6 +244,11 @@ impl ChainLaw {
     /// The number of bonds the law is written for (`None`: the same law at every bond).
     pub fn n_bonds(&self) -> Option<usize> {
         with_law!(self, |law| Law::n_bonds(law))
+    }
+
+    /// Whether walls at both ends must hold the law's static forces (a precompression).
+    pub fn held_by_walls(&self) -> bool {
+        with_law!(self, |law| Law::held_by_walls(law))
     }
 
     /// What the law was built from, for cache keys.

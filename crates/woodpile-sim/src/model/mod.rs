@@ -190,26 +190,25 @@ impl Model {
     /// bond (sites + 1, walls included), its exponent and its precompression. A
     /// precompression needs walls at both ends.
     pub fn with_contacts(self, law: ContactLaw) -> Result<Self, ModelError> {
-        if law.precompression() > 0.0 && self.boundary != Boundary::Fixed {
-            return Err(ModelError::PrecompressionWithoutWalls);
-        }
         self.with_law(law)
     }
 
     /// The same chain with the contact law `law` (any law of the registry,
-    /// [`crate::contact::ChainLaw`]), written for as many bonds as the chain has.
+    /// [`crate::contact::ChainLaw`]), written for as many bonds as the chain has; a law with a
+    /// static force held by walls needs walls at both ends.
     pub fn with_law(mut self, law: impl Into<ChainLaw>) -> Result<Self, ModelError> {
         let law = law.into();
-        match law.n_bonds() {
-            Some(n_bonds) if n_bonds != self.n_sites + 1 => Err(ModelError::BondCount {
+        if let Some(n_bonds) = law.n_bonds().filter(|&n| n != self.n_sites + 1) {
+            return Err(ModelError::BondCount {
                 n_bonds,
                 n_sites: self.n_sites,
-            }),
-            _ => {
-                self.law = law;
-                Ok(self)
-            }
+            });
         }
+        if law.held_by_walls() && self.boundary != Boundary::Fixed {
+            return Err(ModelError::PrecompressionWithoutWalls);
+        }
+        self.law = law;
+        Ok(self)
     }
 
     /// The experiment's contact law ([`ContactLaw`]), when the chain runs it.
