@@ -119,3 +119,37 @@ fn the_simulator_agrees_with_the_independent_reference_on_damped_audit_scenes() 
         assert!(error < tol, "scene {k}: auto is {error:e} off at {tol:e}");
     }
 }
+
+/// The reference models gapped linear contacts (`LinearGap`) as the simulator's own known
+/// answer has them: two unit beads between walls, every contact of stiffness k across a gap g,
+/// the left one struck at v, repeat after T = 6g/v + π/√(2k) + 2π/√k
+/// (`contact::linear_gap`'s test, where the period is derived).
+#[test]
+fn a_bouncing_pair_across_gaps_repeats_with_its_closed_form_period() {
+    use std::f64::consts::PI;
+    let (k, g, v) = (2.0, 1.0, 0.5);
+    let law = woodpile_sim::contact::LinearGap::new(vec![k; 3], vec![g; 3]).unwrap();
+    let model = Model::new(2, Boundary::Fixed, vec![])
+        .and_then(|m| m.with_law(law))
+        .unwrap();
+    let period = 6.0 * g / v + PI / (2.0 * k).sqrt() + 2.0 * PI / k.sqrt();
+    let scene = Scenario {
+        model,
+        impulse_site: 0,
+        impulse_velocity: v,
+        t_end: period,
+        region: Region::new(1, 1, 2).unwrap(),
+        method: MethodChoice::Auto,
+        accuracy: tolerance(1e-8),
+        sample_every: period,
+    };
+    let r = reference(&scene, 1e-13).unwrap();
+    for (got, want) in r.state.iter().zip([0.0, 0.0, v, 0.0]) {
+        assert!(
+            (got - want).abs() < 1e-9,
+            "{:?} after T = {period}",
+            r.state
+        );
+    }
+    assert!(r.ledger_drift < 1e-12, "ledger {:e}", r.ledger_drift);
+}

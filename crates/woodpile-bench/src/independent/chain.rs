@@ -29,6 +29,32 @@ pub enum Mode {
     Clipped,
 }
 
+/// Each bond's coefficient, the exponent and each bond's overlap at rest, read from the law's
+/// defining parts: the paper's, the experiment's (δ_b = (F0 / a_b)^{1/α} under a
+/// precompression F0), or the linear law across gaps `linear-gap` (α = 1, δ_b = −g_b).
+/// Refuses a chain in gravity and any other law, which the reference does not model.
+fn contact_law(law: &LawOf<'_>, sites: usize) -> Result<(Vec<f64>, f64, Vec<f64>), String> {
+    match law {
+        LawOf::Experiment(law) if law.gravity > 0.0 => Err("a chain in gravity".into()),
+        LawOf::Experiment(law) => {
+            let rest = law.coefficients.iter().map(|&a| match law.precompression {
+                0.0 => 0.0,
+                f0 => (f0 / a).powf(1.0 / law.exponent),
+            });
+            Ok((law.coefficients.to_vec(), law.exponent, rest.collect()))
+        }
+        LawOf::Paper => Ok((vec![1.0; sites + 1], 1.5, vec![0.0; sites + 1])),
+        LawOf::Named { name, numbers } if *name == "linear-gap" => {
+            let named = |key: &str| numbers.iter().find(|(k, _)| *k == key).map(|(_, v)| *v);
+            match (named("stiffness"), named("gap")) {
+                (Some(k), Some(g)) => Ok((k.to_vec(), 1.0, g.iter().map(|&g| -g).collect())),
+                _ => Err("a linear-gap law without its stiffness and gap".into()),
+            }
+        }
+        LawOf::Named { name, .. } => Err(format!("the contact law {name}")),
+    }
+}
+
 /// One contact: the bodies on each side (`None`: a wall), its law and its dashpot.
 #[derive(Debug, Clone, Copy)]
 struct Bond {
@@ -36,7 +62,8 @@ struct Bond {
     right: Option<usize>,
     coefficient: f64,
     exponent: f64,
-    /// The overlap at rest, δ_b = (F0 / a_b)^{1/α} under a precompression F0.
+    /// The overlap at rest: δ_b = (F0 / a_b)^{1/α} under a precompression F0, −g_b across a
+    /// gap g_b.
     rest_overlap: f64,
     gamma: f64,
 }
@@ -77,12 +104,7 @@ impl Chain {
     pub fn of(model: &Model) -> Result<Chain, String> {
         let parts = model.parts();
         let sites = parts.n_sites;
-        let (coefficients, exponent, precompression) = match parts.contacts {
-            LawOf::Experiment(law) if law.gravity > 0.0 => return Err("a chain in gravity".into()),
-            LawOf::Experiment(law) => (law.coefficients.to_vec(), law.exponent, law.precompression),
-            LawOf::Paper => (vec![1.0; sites + 1], 1.5, 0.0),
-            LawOf::Named { name, .. } => return Err(format!("the contact law {name}")),
-        };
+        let (coefficients, exponent, rest) = contact_law(&parts.contacts, sites)?;
         let damping = parts.damping;
         let gamma = |b: usize| damping.map_or(0.0, |d| d.contact_at(b));
         let walls = [
@@ -96,10 +118,7 @@ impl Chain {
                 right: (b < sites).then_some(b),
                 coefficient: coefficients[b],
                 exponent,
-                rest_overlap: match precompression {
-                    0.0 => 0.0,
-                    f0 => (f0 / coefficients[b]).powf(1.0 / exponent),
-                },
+                rest_overlap: rest[b],
                 gamma: gamma(b),
             })
             .collect();
@@ -251,7 +270,8 @@ impl Chain {
             let s = self.bond_state(bond, y);
             let (a, alpha, delta) = (bond.coefficient, bond.exponent, bond.rest_overlap);
             let rise = |c: f64| a / (alpha + 1.0) * c.max(0.0).powf(alpha + 1.0);
-            let held_at_rest = a * delta.powf(alpha);
+            // A gap (δ < 0) holds nothing at rest.
+            let held_at_rest = a * delta.max(0.0).powf(alpha);
             let potential = rise(s.overlap) - rise(delta) - held_at_rest * (s.overlap - delta);
             match (bond.left, bond.right) {
                 (Some(l), Some(r)) => {
