@@ -73,7 +73,7 @@ const INDEPENDENT_RTOL: f64 = 1e-13;
 /// at the same step, or, on a dissipative chain or one of gapped contacts, the independent
 /// reference (which shares no force code) checked by itself at a looser tolerance.
 fn reference(k: usize, scene: &Scenario) -> (Fractions, f64) {
-    let gapped = matches!(scene.model.chain_law(), ChainLaw::LinearGap(_));
+    let gapped = matches!(scene.model.law(), ChainLaw::LinearGap(_));
     if scene.model.is_dissipative() || gapped {
         let run = |rtol: f64| match independent::reference(scene, rtol) {
             Ok(r) => r.fractions,

@@ -240,7 +240,7 @@ pub fn numba_scene(scene: &Scenario, dt: f64) -> Result<Value, String> {
     let model = &scene.model;
     let plain_ends = matches!(model.boundary(), Boundary::Fixed | Boundary::Free);
     let unit_masses = (0..model.n_sites()).all(|i| model.site_mass(i) == 1.0);
-    if !plain_ends || !unit_masses || !model.chain_law().is_papers() || model.is_dissipative() {
+    if !plain_ends || !unit_masses || !model.law().is_papers() || model.is_dissipative() {
         return Err("the numba baseline takes the paper's chain only".to_string());
     }
     let res = model

@@ -243,7 +243,7 @@ mod tests {
         let ends = Boundary::ends(soft(0.07), soft(0.03));
         let soft_model = Model::with_masses(n, ends, model.resonators().to_vec(), Some(masses));
         soft_model
-            .and_then(|m| m.with_law(model.chain_law().clone()))
+            .and_then(|m| m.with_law(model.law().clone()))
             .unwrap_or(model)
     }
 

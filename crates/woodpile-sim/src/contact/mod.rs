@@ -9,7 +9,7 @@
 //! - [`linear_gap`]: a one-sided linear spring across a gap ([`LinearGap`]), the worked example
 //!   of docs/adding-a-law.md.
 //!
-//! A model holds one [`ChainLaw`] ([`crate::Model::chain_law`]), and `with_law!` runs generic
+//! A model holds one [`ChainLaw`] ([`crate::Model::law`]), and `with_law!` runs generic
 //! code with the law's own type, so that the choice is made once per call, outside every loop.
 //! A new law is a new file with a type that implements `Law`, and one line in the registry.
 //!

@@ -223,13 +223,7 @@ impl Model {
     /// The contact law the simulator runs, to dispatch on once per call
     /// ([`crate::contact::with_law!`]).
     #[inline(always)]
-    pub fn chain_law(&self) -> &ChainLaw {
-        &self.law
-    }
-
-    /// [`Model::chain_law`], for the simulator's own dispatch.
-    #[inline(always)]
-    pub(crate) fn law(&self) -> &ChainLaw {
+    pub fn law(&self) -> &ChainLaw {
         &self.law
     }
 

@@ -139,7 +139,7 @@ pub fn linear_losses_audit_scene(rng: &mut Lcg) -> Scenario {
     let n = old.n_sites();
     let masses = (0..n).map(|i| old.site_mass(i)).collect();
     let model = Model::with_masses(n, old.boundary(), old.resonators().to_vec(), Some(masses))
-        .and_then(|m| m.with_law(old.chain_law().clone()))
+        .and_then(|m| m.with_law(old.law().clone()))
         .expect("a valid survey model");
     Scenario {
         model: model.with_damping(damping).expect("a valid damped model"),
@@ -197,7 +197,7 @@ pub fn damped_audit_scene(rng: &mut Lcg) -> Scenario {
         })
         .collect();
     let model = Model::with_masses(n, boundary, resonators, Some(masses))
-        .and_then(|m| m.with_law(old.chain_law().clone()))
+        .and_then(|m| m.with_law(old.law().clone()))
         .expect("a valid survey model");
     let damping = crate::Damping::new(contact, law, ground, resonator).expect("valid damping");
     Scenario {

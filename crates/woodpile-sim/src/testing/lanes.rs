@@ -54,7 +54,7 @@ pub fn with_resonator_masses_scaled(base: &Scenario, factor: f64) -> Scenario {
         .collect();
     let masses = (0..m.n_sites()).map(|i| m.site_mass(i)).collect();
     let mut model = Model::with_masses(m.n_sites(), m.boundary(), resonators, Some(masses))
-        .and_then(|model| model.with_law(m.chain_law().clone()))
+        .and_then(|model| model.with_law(m.law().clone()))
         .expect("the base's chain, valid");
     if let Some(damping) = m.damping() {
         model = model

@@ -112,7 +112,7 @@ impl LaneChain {
             takes_lanes(m)
                 && m.n_sites() == first.n_sites()
                 && m.boundary() == first.boundary()
-                && m.chain_law() == first.chain_law()
+                && m.law() == first.law()
                 && m.resonators().len() == first.resonators().len()
                 && m.resonators()
                     .iter()
@@ -145,7 +145,7 @@ impl LaneChain {
             n_sites: first.n_sites(),
             walls: first.walls(),
             resonators,
-            law: first.chain_law().clone(),
+            law: first.law().clone(),
             springs: [soft(boundary.left()), soft(boundary.right())],
             masses,
         })
