@@ -1,4 +1,4 @@
-//! Tables handed to Python: rows (`woodpile_points::rows::Row`) as a dict of NumPy arrays and
+//! Tables handed to Python: rows (`woodpile_files::rows::Row`) as a dict of NumPy arrays and
 //! lists, and the rows of `simulate_many`, one per scene as `simulate` reports it.
 
 use std::panic::AssertUnwindSafe;
@@ -7,7 +7,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use numpy::IntoPyArray;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use woodpile_points::rows::{columns, sweep, Cell, Column, Row};
+use woodpile_files::rows::{columns, Cell, Column, Row};
+use woodpile_points::rows::sweep;
 use woodpile_scene::units_out::SiFactors;
 use woodpile_scene::Scene;
 use woodpile_sim::observe::SiteField;

@@ -75,7 +75,7 @@ impl Source {
         let text = match self {
             Source::Table(table) => return Ok(table),
             Source::Text(text) => text,
-            Source::File(path) => woodpile_scene::read_input(&path).map_err(|reason| {
+            Source::File(path) => woodpile_files::input::read_input(&path).map_err(|reason| {
                 SceneError::new_err(format!("{}: cannot read: {reason}", path.display()))
             })?,
         };
@@ -83,7 +83,7 @@ impl Source {
             SceneError::new_err(format!(
                 "{}: {}",
                 label.display(),
-                woodpile_scene::syntax_reason(&e, &text)
+                woodpile_files::input::syntax_reason(&e, &text)
             ))
         })
     }

@@ -12,8 +12,9 @@ use pyo3::exceptions::{PyOSError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
+use woodpile_files::Key;
 use woodpile_points::rows::{SweepPoint, SweepShape};
-use woodpile_points::{point_key, simulate_points_until, Key, PointResult, PointStore, Shares};
+use woodpile_points::{point_key, simulate_points_until, PointResult, PointStore, Shares};
 use woodpile_scene::grid::{parse_axes, AxisValue, MAX_SWEEP_BYTES, PLANNED_BYTES_PER_SITE};
 use woodpile_scene::sweep_grid::{GridError, SceneGrid};
 use woodpile_scene::template::Template;
@@ -84,7 +85,7 @@ pub(crate) fn sweep<'py>(
 /// The point store in `dir`, refused (as the pipeline refuses its own) when it is a symbolic
 /// link or not a folder.
 fn point_store(dir: PathBuf) -> PyResult<PointStore> {
-    woodpile_points::layout::check_tree_folder(&dir)
+    woodpile_files::layout::check_tree_folder(&dir)
         .map_err(|reason| PyValueError::new_err(format!("cache: {}: {reason}", dir.display())))?;
     Ok(PointStore::new(dir))
 }

@@ -15,11 +15,11 @@ use std::time::Instant;
 
 use serde_json::{json, Value};
 use woodpile_pipeline::events::Silent;
-use woodpile_pipeline::grid::{point, point_count};
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::Pipeline;
 use woodpile_sim::model::{Boundary, Coupling};
 use woodpile_sim::simulation::Scenario;
+use woodpile_stages::grid::{point, point_count};
 use woodpile_stages::sampling::SURVEY_SWEEPS;
 use woodpile_stages::sweep::Sweep;
 use woodpile_stages::KINDS;

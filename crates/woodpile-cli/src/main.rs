@@ -17,7 +17,7 @@ macro_rules! say {
         // Line by line: the text's own line breaks stay (a status table, indented JSON).
         let text = format!($($arg)*)
             .split('\n')
-            .map(woodpile_scene::escape_controls)
+            .map(woodpile_files::input::escape_controls)
             .collect::<Vec<_>>()
             .join("\n");
         let mut out = std::io::stdout().lock();
@@ -83,7 +83,7 @@ fn version() -> &'static str {
     static VERSION: std::sync::OnceLock<String> = std::sync::OnceLock::new();
     VERSION
         .get_or_init(|| {
-            woodpile_points::canonical::code_version()
+            woodpile_files::key::code_version()
                 .trim_start_matches("woodpile ")
                 .to_string()
         })
@@ -148,7 +148,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(f) => {
-            let line = woodpile_scene::escape_controls(&one_line(&f.error));
+            let line = woodpile_files::input::escape_controls(&one_line(&f.error));
             eprintln!("error: {line}");
             ExitCode::from(f.code)
         }

@@ -141,5 +141,5 @@ pub(crate) fn run(args: &Args) -> Result<(), Failure> {
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Failure> {
-    woodpile_points::atomic::write(path, text.as_bytes()).map_err(Failure::input)
+    woodpile_files::atomic::write(path, text.as_bytes()).map_err(Failure::input)
 }

@@ -3,14 +3,14 @@
 use std::path::PathBuf;
 use woodpile_stages::KINDS;
 
+use woodpile_files::atomic;
+use woodpile_files::layout::output_path;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::shard::{merge, run_shard, Shard};
 use woodpile_pipeline::slurm::SlurmJob;
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::{variant_name, Set};
 use woodpile_pipeline::{Pipeline, PipelineError};
-use woodpile_points::atomic;
-use woodpile_points::layout::output_path;
 
 use crate::project::Dirs;
 
@@ -147,7 +147,7 @@ fn stage_failure(e: PipelineError) -> Failure {
         PipelineError::Definition { .. }
         | PipelineError::Syntax { .. }
         | PipelineError::UnknownStage { .. }
-        | PipelineError::File(woodpile_points::FileError::Refused { .. }) => Failure::input(e),
+        | PipelineError::File(woodpile_files::FileError::Refused { .. }) => Failure::input(e),
         _ => Failure::simulation(e),
     }
 }

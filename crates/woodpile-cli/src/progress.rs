@@ -43,7 +43,7 @@ impl Progress {
 
     /// Prints `text` (control characters escaped: it may quote a stage file) above the bar.
     fn line(&self, text: &str) {
-        let text = &woodpile_scene::escape_controls(text);
+        let text = &woodpile_files::input::escape_controls(text);
         let sweep = self.sweep.lock().ok();
         match sweep
             .as_ref()

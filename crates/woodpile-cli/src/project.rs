@@ -81,7 +81,7 @@ fn find_project_file() -> anyhow::Result<Option<(PathBuf, toml::Table)>> {
                 None => return Ok(Some((root_of(folder), read_project_file(&path)?))),
                 Some(why) => eprintln!(
                     "warning: ignoring {}: {why}",
-                    woodpile_scene::escape_controls(&path.display().to_string())
+                    woodpile_files::input::escape_controls(&path.display().to_string())
                 ),
             }
         }
@@ -117,13 +117,13 @@ fn untrusted(path: &Path) -> Option<&'static str> {
 
 /// The table of the `woodpile.toml` at `path`, its keys checked.
 fn read_project_file(path: &Path) -> anyhow::Result<toml::Table> {
-    let text = woodpile_scene::read_input(path)
+    let text = woodpile_files::input::read_input(path)
         .map_err(|e| anyhow!("{}: cannot read: {e}", path.display()))?;
     let table: toml::Table = toml::from_str(&text).map_err(|e| {
         anyhow!(
             "{}: {}",
             path.display(),
-            woodpile_scene::syntax_reason(&e, &text)
+            woodpile_files::input::syntax_reason(&e, &text)
         )
     })?;
     if let Some(key) = table

@@ -7,9 +7,10 @@ use std::time::Instant;
 
 use anyhow::{anyhow, Context};
 use serde_json::{json, Value};
+use woodpile_files::key::{code_version, Key};
 use woodpile_pipeline::manifest::Manifest;
 use woodpile_pipeline::table::{self, Columns};
-use woodpile_points::canonical::{code_version, scene_json, Key};
+use woodpile_points::canonical::scene_json;
 use woodpile_scene::report::{cost_note, simulate_report, unverified_report, wall_note};
 use woodpile_scene::units_out::{SiFactors, Units};
 use woodpile_scene::Scene;

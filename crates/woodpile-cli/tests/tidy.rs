@@ -225,6 +225,31 @@ fn the_layering_table_is_the_crate_graph() {
     assert!(wrong.is_empty(), "{wrong:#?}");
 }
 
+/// The engine caches, seals, shards and diffs a results tree without linking the simulator:
+/// none of the crates it reaches, directly or through another, is the simulator, the scene
+/// format or the point simulation (ARCHITECTURE.md's bird's-eye view says so).
+#[test]
+fn the_engine_links_no_simulator() {
+    let table = layering_table();
+    let mut reached = BTreeSet::new();
+    let mut todo = vec!["pipeline".to_string()];
+    while let Some(krate) = todo.pop() {
+        for dep in table.get(&krate).into_iter().flatten() {
+            if reached.insert(dep.clone()) {
+                todo.push(dep.clone());
+            }
+        }
+    }
+    let simulating: Vec<_> = ["sim", "scene", "points"]
+        .into_iter()
+        .filter(|k| reached.contains(*k))
+        .collect();
+    assert!(
+        simulating.is_empty(),
+        "the engine reaches {simulating:?} (through {reached:?})"
+    );
+}
+
 /// A module's path in its crate (`report::markdown`), from its file.
 fn module_of(root: &Path, file: &Path) -> Vec<String> {
     let mut parts: Vec<String> = file

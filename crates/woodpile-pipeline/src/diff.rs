@@ -224,7 +224,7 @@ fn compare_files(
         }
     }
     if let (Some(ma), Some(mb)) = (&ca.manifest, &cb.manifest) {
-        for change in woodpile_points::canonical::changed_paths(&ma.params, &mb.params) {
+        for change in woodpile_files::key::changed_paths(&ma.params, &mb.params) {
             report.parameters.push(format!("{name}: {change}"));
         }
     }

@@ -2,10 +2,9 @@
 //! keeping the error behind it (the OS's, polars', the TOML parser's, an embedded scene's
 //! `SceneError`) as its `source`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use woodpile_points::FileError;
-use woodpile_scene::SceneError;
+use woodpile_files::FileError;
 
 /// A pipeline failure.
 #[derive(Debug, thiserror::Error)]
@@ -76,24 +75,6 @@ impl PipelineError {
         Self::File(FileError::io(path, e))
     }
 
-    /// A scene embedded in stage `file` under key `prefix` (`scene`, `scene[2]`) that
-    /// woodpile-scene rejects: the scene's own key is appended to the prefix, and `context`
-    /// (say, the grid point) to the reason. One mapping for every kind that embeds scenes.
-    pub fn scene(file: &Path, prefix: &str, e: SceneError, context: &str) -> Self {
-        let (key, reason) = match &e {
-            SceneError::Invalid { key, reason, .. } => (format!("{prefix}.{key}"), reason.clone()),
-            SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
-                (prefix.to_string(), reason.clone())
-            }
-        };
-        Self::Definition {
-            file: file.to_path_buf(),
-            key,
-            reason: reason + context,
-            source: Some(Box::new(e)),
-        }
-    }
-
     /// A stage failure.
     pub fn stage(stage: &str, reason: impl Into<String>) -> Self {
         Self::Stage {
@@ -103,7 +84,7 @@ impl PipelineError {
     }
 }
 
-pub use woodpile_points::error::BoxError;
+pub use woodpile_files::error::BoxError;
 
 /// Result alias of this crate.
 pub type Result<T, E = PipelineError> = std::result::Result<T, E>;

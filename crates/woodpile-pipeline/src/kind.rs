@@ -15,8 +15,8 @@ use crate::events::Events;
 use crate::fields::Fields;
 use crate::manifest::Manifest;
 use crate::table;
-use woodpile_points::layout::output_path;
-use woodpile_points::{PointStats, PointStore};
+use woodpile_files::layout::output_path;
+use woodpile_files::{PointStats, PointsDir};
 
 /// A stage kind: its parameters, and what it does with them.
 pub trait Kind: std::fmt::Debug + Send + Sync + Any {
@@ -59,22 +59,22 @@ pub trait Kind: std::fmt::Debug + Send + Sync + Any {
 pub struct PointsAt<'a> {
     /// The stage's name.
     pub stage: &'a str,
-    /// The point cache the points are loaded from and saved to.
-    pub store: &'a PointStore,
+    /// The point directory the points are loaded from and saved to.
+    pub points: &'a PointsDir,
     /// Progress and warnings.
     pub events: &'a dyn Events,
 }
 
 /// A kind whose table is a block of rows per point of a grid, each point computed on its own
-/// and cached in the [`PointStore`].
+/// and cached in the [`PointsDir`].
 pub trait PointGrid {
     /// How many points.
     fn count(&self) -> usize;
 
-    /// How many of them `store` already holds.
-    fn cached(&self, store: &PointStore) -> Result<usize>;
+    /// How many of them `points` already holds.
+    fn cached(&self, points: &PointsDir) -> Result<usize>;
 
-    /// Computes what the store lacks among the points `indices` (increasing) and returns their
+    /// Computes what the directory lacks among the points `indices` (increasing) and returns their
     /// rows (with a `point` column) and statistics: the whole table, or one shard's part.
     fn run_points(&self, at: PointsAt<'_>, indices: &[usize]) -> Result<(DataFrame, PointStats)>;
 
@@ -184,7 +184,7 @@ pub struct Context<'a> {
     /// Where figures go.
     pub figures: &'a Path,
     /// The point cache.
-    pub store: &'a PointStore,
+    pub points: &'a PointsDir,
     /// Progress.
     pub events: &'a dyn Events,
 }
@@ -226,7 +226,7 @@ impl Context<'_> {
     /// Where upstream stage `name` (an optimiser or a design) wrote its best scene.
     pub fn best_scene(&self, name: &str) -> Result<PathBuf> {
         self.upstream(name)?;
-        Ok(woodpile_points::layout::best_path(self.results, name))
+        Ok(woodpile_files::layout::best_path(self.results, name))
     }
 
     /// This stage's own output manifest from its previous run, if a readable one is there:
@@ -248,7 +248,7 @@ impl Context<'_> {
         if !declared.iter().any(|p| p == path) {
             return None;
         }
-        let mut bytes = woodpile_points::regular::read(path, 1 << 26).ok()?;
+        let mut bytes = woodpile_files::regular::read(path, 1 << 26).ok()?;
         bytes.truncate(limit);
         Some(bytes)
     }
@@ -279,7 +279,7 @@ impl Context<'_> {
                 ),
             ));
         }
-        Ok(woodpile_points::atomic::write(path, bytes)?)
+        Ok(woodpile_files::atomic::write(path, bytes)?)
     }
 
     /// The first folder between the tree `path` lies in (the results, the figures, or the

@@ -8,8 +8,8 @@
 //! - [`stage`], [`pipeline`], [`variant`]: parse stage files (and `--set` variants), check the
 //!   DAG, compute the keys.
 //! - [`status`], [`run`]: decide what is stale and why; run it upstream first.
-//! - [`grid`], [`template`]: the grids of scenes a kind declares. Turning a scene into a
-//!   cached point is `woodpile_points`' job, below this crate, shared with the Python module.
+//! - The point directory ([`woodpile_files::PointsDir`]) is handed to the kinds; turning a
+//!   scene into a cached point is theirs (`woodpile_points`), so this crate links no simulator.
 //! - [`shard`], [`slurm`]: sweeps split across a cluster and merged.
 //! - [`lock`]: one writer of a results tree at a time.
 //! - [`diff`]: compare two result trees with tolerances (CI's regression check).
@@ -23,7 +23,6 @@ pub mod diff;
 pub mod error;
 pub mod events;
 pub mod fields;
-pub mod grid;
 pub mod kind;
 pub mod lock;
 pub mod manifest;
@@ -41,4 +40,3 @@ pub mod variant;
 pub use error::{PipelineError, Result};
 pub use kind::Output;
 pub use pipeline::Pipeline;
-pub use woodpile_scene::template;

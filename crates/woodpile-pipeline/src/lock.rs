@@ -14,8 +14,8 @@ use std::path::Path;
 
 use crate::error::{PipelineError, Result};
 use crate::events::Events;
-use woodpile_points::layout::lock_path;
-use woodpile_points::regular;
+use woodpile_files::layout::lock_path;
+use woodpile_files::regular;
 
 /// Held while a run writes; dropping it releases the lock.
 #[derive(Debug)]

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use serde_json::Value;
-use woodpile_points::canonical::toml_to_json;
+use woodpile_files::key::toml_to_json;
 
 /// `table` as JSON, without `description` (free text, not part of the key).
 pub(crate) fn own_params(table: &toml::Table) -> Value {

@@ -12,7 +12,7 @@ use crate::error::{PipelineError, Result};
 use crate::kind::{Inputs, Registry};
 use crate::stage::{Defaults, Stage};
 use crate::variant::Set;
-use woodpile_points::canonical::{code_version, Key};
+use woodpile_files::key::{code_version, Key};
 
 /// A loaded, validated pipeline.
 #[derive(Debug, Clone)]

@@ -14,10 +14,10 @@ use crate::pipeline::Pipeline;
 use crate::stage::Stage;
 use crate::status::{state, State};
 use crate::{sealed_files, table};
-use woodpile_points::atomic;
-use woodpile_points::canonical::code_version;
-use woodpile_points::layout::{output_path, points_dir};
-use woodpile_points::PointStore;
+use woodpile_files::atomic;
+use woodpile_files::key::code_version;
+use woodpile_files::layout::{output_path, points_dir};
+use woodpile_files::PointsDir;
 
 /// How to run.
 #[derive(Debug, Clone, Default)]
@@ -66,19 +66,19 @@ pub struct Step {
 pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Result<Vec<Step>> {
     let results = &options.results;
     for folder in [points_dir(results), results.join("parts")] {
-        woodpile_points::layout::check_tree_folder(&folder)
+        woodpile_files::layout::check_tree_folder(&folder)
             .map_err(|e| PipelineError::refused(&folder, e))?;
     }
-    let store = PointStore::new(points_dir(results));
+    let points = PointsDir::new(points_dir(results));
     let selection = pipeline.selection(&options.targets)?;
     if options.dry_run {
         return selection
             .into_iter()
-            .map(|stage| Ok(decide(pipeline, stage, options, &store, events)?.0))
+            .map(|stage| Ok(decide(pipeline, stage, options, &points, events)?.0))
             .collect();
     }
     let _lock = lock_results(results, events)?;
-    let removed = store.sweep_stale_temps()
+    let removed = points.sweep_stale_temps()
         + atomic::sweep_stale_temps(results)
         + atomic::sweep_stale_temps(&options.figures);
     if removed > 0 {
@@ -94,9 +94,9 @@ pub fn run(pipeline: &Pipeline, options: &RunOptions, events: &dyn Events) -> Re
             scope.spawn(|| {
                 while let Some(i) = next_job(&board, &changed, events) {
                     let stage = selection[i];
-                    let work = || match decide(pipeline, stage, options, &store, events) {
+                    let work = || match decide(pipeline, stage, options, &points, events) {
                         Ok((step, true)) => {
-                            match run_stage(pipeline, stage, &step.why, options, &store, events) {
+                            match run_stage(pipeline, stage, &step.why, options, &points, events) {
                                 Ok((partial, simulated)) => {
                                     (Some(Step { simulated, ..step }), Ok(partial))
                                 }
@@ -145,7 +145,7 @@ fn decide(
     pipeline: &Pipeline,
     stage: &Stage,
     options: &RunOptions,
-    store: &PointStore,
+    points: &PointsDir,
     events: &dyn Events,
 ) -> Result<(Step, bool)> {
     let forced =
@@ -179,7 +179,7 @@ fn decide(
         (other, _) => format!("{}: {}", other.label(), other.why()),
     };
     let points = match stage.spec.points() {
-        Some(grid) => Some((grid.count(), grid.cached(store)?)),
+        Some(grid) => Some((grid.count(), grid.cached(points)?)),
         None => None,
     };
     let step = Step {
@@ -199,11 +199,11 @@ fn run_stage(
     stage: &Stage,
     why: &str,
     options: &RunOptions,
-    store: &PointStore,
+    points: &PointsDir,
     events: &dyn Events,
 ) -> Result<(Vec<String>, usize)> {
     events.stage_started(&stage.name, why);
-    let (summary, partial, simulated) = execute(pipeline, stage, options, store, events)?;
+    let (summary, partial, simulated) = execute(pipeline, stage, options, points, events)?;
     for failure in &partial {
         events.warn(&format!("stage `{}`: {failure}", stage.name));
     }
@@ -377,7 +377,7 @@ fn execute(
     pipeline: &Pipeline,
     stage: &Stage,
     options: &RunOptions,
-    store: &PointStore,
+    points: &PointsDir,
     events: &dyn Events,
 ) -> Result<(String, Vec<String>, usize)> {
     let results = &options.results;
@@ -393,7 +393,7 @@ fn execute(
         root: &root,
         results,
         figures: &options.figures,
-        store,
+        points,
         events,
     })?;
     let mut manifest = manifest_for(pipeline, stage, output.summary.clone());

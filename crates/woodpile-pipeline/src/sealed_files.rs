@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use crate::error::{PipelineError, Result};
-use woodpile_points::regular;
+use woodpile_files::regular;
 
 /// Most bytes a stage's file may have (figures are a few MB).
 const MAX_FILE_BYTES: u64 = 1 << 30;

@@ -5,7 +5,7 @@
 //!
 //! Parts live in `results/parts/<stage>/<key>.shard-<I>-of-<N>.parquet`. The key in the name
 //! ties a part to one definition of the stage: editing the stage orphans old parts instead of
-//! mixing them in. Points go through the shared [`PointStore`], so a shard re-run after a crash
+//! mixing them in. Points go through the shared [`PointsDir`], so a shard re-run after a crash
 //! skips every point it had finished.
 
 use std::path::{Path, PathBuf};
@@ -21,8 +21,8 @@ use crate::pipeline::Pipeline;
 use crate::run::manifest_for;
 use crate::stage::Stage;
 use crate::table::{self, f64_column};
-use woodpile_points::layout::{output_path, parts_dir, points_dir};
-use woodpile_points::{PointStats, PointStore};
+use woodpile_files::layout::{output_path, parts_dir, points_dir};
+use woodpile_files::{PointStats, PointsDir};
 
 /// Shard `index` of `count` (0 <= index < count).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -93,7 +93,7 @@ impl std::fmt::Display for Shard {
 }
 
 fn part_path(results: &Path, stage: &str, key: &str, shard: Shard) -> PathBuf {
-    woodpile_points::layout::part_path(results, stage, key, shard.index, shard.count)
+    woodpile_files::layout::part_path(results, stage, key, shard.index, shard.count)
 }
 
 /// `(key, shard)` from a part file name.
@@ -172,16 +172,16 @@ pub fn run_shard(
         results.join("parts"),
         parts_dir(results, name),
     ] {
-        woodpile_points::layout::check_tree_folder(&folder)
+        woodpile_files::layout::check_tree_folder(&folder)
             .map_err(|e| PipelineError::refused(&folder, e))?;
     }
-    let store = PointStore::new(points_dir(results));
-    store.sweep_stale_temps();
-    woodpile_points::atomic::sweep_stale_temps(&parts_dir(results, name));
+    let points = PointsDir::new(points_dir(results));
+    points.sweep_stale_temps();
+    woodpile_files::atomic::sweep_stale_temps(&parts_dir(results, name));
     events.stage_started(name, &format!("shard {shard}"));
     let at = PointsAt {
         stage: name,
-        store: &store,
+        points: &points,
         events,
     };
     let (frame, stats) = sweep.run_points(at, &indices)?;

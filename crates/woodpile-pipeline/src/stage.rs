@@ -20,7 +20,7 @@ use crate::error::{PipelineError, Result};
 use crate::fields::Fields;
 use crate::kind::Registry;
 use crate::params::{own_params, Params};
-use woodpile_points::canonical::toml_to_json;
+use woodpile_files::key::toml_to_json;
 
 pub use crate::kind::Stage;
 
@@ -185,7 +185,7 @@ impl Defaults {
 
 /// The text of the TOML file at `file`, or a syntax error naming it.
 pub(crate) fn read_text(file: &Path) -> Result<String> {
-    woodpile_scene::read_input(file).map_err(|e| PipelineError::Syntax {
+    woodpile_files::input::read_input(file).map_err(|e| PipelineError::Syntax {
         file: file.to_path_buf(),
         reason: format!("cannot read: {e}"),
         source: None,
@@ -196,7 +196,7 @@ pub(crate) fn read_text(file: &Path) -> Result<String> {
 pub(crate) fn parse_table(text: &str, file: &Path) -> Result<toml::Table> {
     toml::from_str(text).map_err(|e| PipelineError::Syntax {
         file: file.to_path_buf(),
-        reason: woodpile_scene::syntax_reason(&e, text),
+        reason: woodpile_files::input::syntax_reason(&e, text),
         source: None,
     })
 }
@@ -251,9 +251,9 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
         },
         _ => return Ok(()),
     };
-    let path = woodpile_points::layout::contained(root, &reference)
+    let path = woodpile_files::layout::contained(root, &reference)
         .map_err(|reason| definition(file, key, &reason))?;
-    let text = woodpile_scene::read_input(&path)
+    let text = woodpile_files::input::read_input(&path)
         .map_err(|e| definition(file, key, &format!("{}: cannot read: {e}", path.display())))?;
     let mut scene: toml::Table = toml::from_str(&text).map_err(|e| {
         definition(
@@ -262,7 +262,7 @@ fn include_scene_file(table: &mut toml::Table, file: &Path, root: &Path) -> Resu
             &format!(
                 "{}: {}",
                 path.display(),
-                woodpile_scene::syntax_reason(&e, &text)
+                woodpile_files::input::syntax_reason(&e, &text)
             ),
         )
     })?;
@@ -288,7 +288,7 @@ fn include_data_digest(table: &mut toml::Table, file: &Path, root: &Path) -> Res
             Some(_) => return Err(definition(file, key, "expected the path of a data file")),
             None => continue,
         };
-        let path = woodpile_points::layout::contained(root, &reference)
+        let path = woodpile_files::layout::contained(root, &reference)
             .map_err(|reason| definition(file, key, &reason))?;
         let bytes = std::fs::read(&path)
             .map_err(|e| definition(file, key, &format!("{}: cannot read: {e}", path.display())))?;

@@ -6,8 +6,8 @@ use std::path::Path;
 use crate::pipeline::Pipeline;
 use crate::stage::Stage;
 use crate::table::{self, Integrity};
-use woodpile_points::canonical::{changed_paths, code_version};
-use woodpile_points::layout::output_path;
+use woodpile_files::key::{changed_paths, code_version};
+use woodpile_files::layout::output_path;
 
 /// Freshness of one stage output.
 #[derive(Debug, Clone, PartialEq)]

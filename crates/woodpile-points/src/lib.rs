@@ -1,29 +1,22 @@
-//! Scene to cached point, in one place and with no polars, so that the pipeline engine, the
-//! stage kinds and the Python module turn a scene into the same point, under the same key, in
-//! the same file, with the same table columns.
+//! Scene to cached point, with no polars, so that the stage kinds and the Python module turn
+//! a scene into the same point, under the same key, in the same file, with the same table
+//! columns. The files themselves (atomic writes, the tree's layout, the point directory, key
+//! hashing) are `woodpile_files`', which the engine links without the simulator.
 //!
-//! - [`canonical`]: a scene's canonical JSON and the blake3 [`canonical::Key`] of it.
+//! - [`canonical`]: a scene's canonical JSON, which its key hashes.
 //! - [`point`]: one scene simulated into a [`point::PointData`] (or why it failed), its key,
-//!   and the [`point::PointStats`] a set of points reports.
+//!   and the statistics a set of points reports.
 //! - [`store`]: the [`store::PointStore`], one checksummed file per point.
-//! - [`rows`]: a sweep's table as columns, the one row schema of the sweep stage and of
-//!   Python's `sweep`.
-//! - [`atomic`], [`regular`], [`layout`]: writes that land whole or not at all, reads of
-//!   regular files only, and where everything of a results tree lives.
+//! - [`rows`]: a sweep's table rows, the one row schema of the sweep stage and of Python's
+//!   `sweep`.
 #![warn(missing_docs)]
 
-pub mod atomic;
 pub mod canonical;
-pub mod error;
-pub mod layout;
 pub mod point;
-pub mod regular;
 pub mod rows;
 pub mod store;
 
-pub use canonical::Key;
-pub use error::{FileError, Result};
 pub use point::{
-    point_key, simulate_point, simulate_points_until, PointData, PointResult, PointStats, Shares,
+    point_key, simulate_point, simulate_points_until, stats_of, PointData, PointResult, Shares,
 };
 pub use store::{Fetched, PointStore};

@@ -8,7 +8,10 @@ use woodpile_sim::observe::FractionSeries;
 use woodpile_sim::simulation::{simulate_batch, Outcome, Scenario};
 use woodpile_sim::{Share, SimError};
 
-use crate::canonical::{code_version, scene_json, Key};
+use woodpile_files::key::{code_version, Key};
+use woodpile_files::PointStats;
+
+use crate::canonical::scene_json;
 
 /// What simulating one scene gave: its fraction time series, or why it failed.
 pub type PointResult = std::result::Result<PointData, String>;
@@ -205,62 +208,16 @@ pub fn point_key(scene: &Scene, series: Shares) -> Key {
     Key::of(&key)
 }
 
-/// Facts about a set of simulated points that combine exactly across shards (counts, sums of
-/// integers, maxima), so a merged sweep reports what a single run would.
-#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct PointStats {
-    /// Points.
-    pub points: usize,
-    /// Of which failed.
-    pub failed: usize,
-    /// Scenes this run simulated (the others came from the cache).
-    #[serde(default)]
-    pub simulated: usize,
-    /// Right-hand-side evaluations of all successful points.
-    pub rhs_evals: u64,
-    /// Largest `auto` error estimate.
-    pub max_error_estimate: Option<f64>,
-    /// Largest relative energy drift.
-    pub max_energy_drift: Option<f64>,
-}
-
-impl PointStats {
-    /// The statistics of `results`.
-    pub fn of(results: &[PointResult]) -> Self {
-        let ok = || results.iter().filter_map(|r| r.as_ref().ok());
-        let max = |f: fn(&PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
-        Self {
-            points: results.len(),
-            failed: results.iter().filter(|r| r.is_err()).count(),
-            simulated: 0,
-            rhs_evals: ok().map(|p| p.rhs_evals).sum(),
-            max_error_estimate: max(|p| p.error_estimate),
-            max_energy_drift: max(|p| p.energy_drift),
-        }
-    }
-
-    /// Only a count of scenes simulated: what a kind that simulates outside a grid (a map, a
-    /// survey, an optimiser) reports.
-    pub fn simulated(count: usize) -> Self {
-        Self {
-            simulated: count,
-            ..Self::default()
-        }
-    }
-
-    /// The statistics of the union of two disjoint point sets.
-    pub fn merge(self, other: PointStats) -> PointStats {
-        let max = |a: Option<f64>, b: Option<f64>| match (a, b) {
-            (Some(x), Some(y)) => Some(x.max(y)),
-            (x, y) => x.or(y),
-        };
-        PointStats {
-            points: self.points + other.points,
-            failed: self.failed + other.failed,
-            simulated: self.simulated + other.simulated,
-            rhs_evals: self.rhs_evals + other.rhs_evals,
-            max_error_estimate: max(self.max_error_estimate, other.max_error_estimate),
-            max_energy_drift: max(self.max_energy_drift, other.max_energy_drift),
-        }
+/// The statistics of `results`.
+pub fn stats_of(results: &[PointResult]) -> PointStats {
+    let ok = || results.iter().filter_map(|r| r.as_ref().ok());
+    let max = |f: fn(&PointData) -> Option<f64>| ok().filter_map(f).reduce(f64::max);
+    PointStats {
+        points: results.len(),
+        failed: results.iter().filter(|r| r.is_err()).count(),
+        simulated: 0,
+        rhs_evals: ok().map(|p| p.rhs_evals).sum(),
+        max_error_estimate: max(|p| p.error_estimate),
+        max_energy_drift: max(|p| p.energy_drift),
     }
 }

@@ -13,11 +13,11 @@
 
 use std::path::{Path, PathBuf};
 
+use woodpile_files::error::{FileError, Result};
+use woodpile_files::key::Key;
+use woodpile_files::{atomic, layout, PointsDir};
 use woodpile_scene::Scene;
 
-use crate::atomic;
-use crate::canonical::Key;
-use crate::error::{FileError, Result};
 use crate::point::{simulate_points_until, PointData, PointResult, Shares};
 
 const MAGIC: &[u8; 4] = b"WPPT";
@@ -35,35 +35,41 @@ pub struct Fetched {
     pub simulated: bool,
 }
 
-/// The directory of point files.
+/// The point files of a [`PointsDir`], read, written and simulated into.
 #[derive(Debug, Clone)]
 pub struct PointStore {
-    dir: PathBuf,
+    dir: PointsDir,
+}
+
+impl From<&PointsDir> for PointStore {
+    fn from(dir: &PointsDir) -> Self {
+        Self { dir: dir.clone() }
+    }
 }
 
 impl PointStore {
     /// A store rooted at `dir` (created on first write).
     pub fn new(dir: impl Into<PathBuf>) -> Self {
-        Self { dir: dir.into() }
+        Self {
+            dir: PointsDir::new(dir),
+        }
     }
 
     /// The root directory.
     pub fn dir(&self) -> &Path {
-        &self.dir
+        self.dir.dir()
     }
 
-    /// Where the point `key` lives: two-hex-digit fan-out keeps directories small.
+    /// Where the point `key` lives.
     pub fn path(&self, key: &Key) -> PathBuf {
-        self.dir
-            .join(&key.as_str()[..2])
-            .join(format!("{key}.wppt"))
+        self.dir.path(key)
     }
 
     /// The cached result of `key`, or `None` when absent or damaged.
     pub fn load(&self, key: &Key) -> Option<PointResult> {
         // Only a regular file of bounded size: a FIFO or a link to /dev/zero in the cache
         // reads as absent (and is recomputed), never blocks or fills the memory.
-        let bytes = crate::regular::read(&self.path(key), MAX_POINT_BYTES).ok()?;
+        let bytes = woodpile_files::regular::read(&self.path(key), MAX_POINT_BYTES).ok()?;
         decode(&bytes, key)
     }
 
@@ -140,22 +146,10 @@ impl PointStore {
     pub fn save(&self, key: &Key, result: &PointResult) -> Result<()> {
         let path = self.path(key);
         if let Some(folder) = path.parent() {
-            crate::layout::check_tree_folder(folder)
+            layout::check_tree_folder(folder)
                 .map_err(|reason| FileError::refused(folder, reason))?;
         }
         atomic::write_checksummed(&path, &encode(key, result))
-    }
-
-    /// Removes leftovers of killed writers from the fan-out directory of `key`.
-    pub fn sweep_stale_temps(&self) -> usize {
-        let Ok(entries) = std::fs::read_dir(&self.dir) else {
-            return 0;
-        };
-        entries
-            .flatten()
-            .filter(|e| e.file_type().is_ok_and(|t| t.is_dir()))
-            .map(|e| atomic::sweep_stale_temps(&e.path()))
-            .sum()
     }
 }
 

@@ -8,7 +8,8 @@
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use woodpile_points::canonical::{scene_json, Key};
+use woodpile_files::Key;
+use woodpile_points::canonical::scene_json;
 
 const MATERIAL: &str = "{ youngs_modulus = 72e9, poisson_ratio = 0.17, density = 2200.0 }";
 

@@ -88,7 +88,7 @@ impl Calibrate {
     /// The trace, read from the project and checked against the digest the stage was keyed by.
     fn read_trace(&self, ctx: &Context<'_>) -> Result<Trace> {
         let (file, digest) = &self.trace;
-        let path = woodpile_points::layout::contained(ctx.root, file)
+        let path = woodpile_files::layout::contained(ctx.root, file)
             .map_err(|reason| PipelineError::stage(ctx.name(), format!("trace: {reason}")))?;
         let bytes = std::fs::read(&path).map_err(|e| PipelineError::io(&path, e.to_string()))?;
         if blake3::hash(&bytes).to_hex().as_str() != digest {

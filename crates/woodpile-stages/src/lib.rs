@@ -15,6 +15,7 @@ pub mod approximate;
 pub mod calibrate;
 pub mod design;
 pub mod fit;
+pub mod grid;
 pub mod optimize;
 pub mod reduce;
 pub mod render;

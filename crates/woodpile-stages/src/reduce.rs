@@ -20,11 +20,11 @@
 
 use serde_json::json;
 
+use crate::grid::Axis;
 use crate::schema::{sweep, Fraction};
 use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::grid::Axis;
 use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, rows_frame, str_column, Cell, Row};

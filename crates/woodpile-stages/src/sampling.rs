@@ -5,8 +5,8 @@
 use woodpile_sim::simulation::Scenario;
 use woodpile_sim::testing::Lcg;
 
+use crate::grid::AxisValue;
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::pipeline::Pipeline;
 
 use crate::sweep::Sweep;

@@ -33,11 +33,11 @@ use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::observe::SpaceTimeField;
 use woodpile_sim::simulation::simulate;
 
+use crate::grid::{Axis, AxisValue};
 use crate::sweep::Sweep;
 use crate::table_units;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::grid::{Axis, AxisValue};
 use woodpile_pipeline::kind::{no_inputs, wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::Columns;

@@ -23,10 +23,10 @@
 //! has axes. A scene without a static load, a cell that does not repeat, or a frequency range
 //! outside the leads' band stops the stage, naming the key.
 
+use crate::grid::AxisValue;
 use serde_json::json;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::kind::{no_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::Columns;

@@ -130,8 +130,9 @@ impl Stability {
             Vary::Eps => defect.insert("eps".into(), toml::Value::Float(value)),
             Vary::P => defect.insert("p".into(), toml::Value::Integer(value as i64)),
         };
-        woodpile_scene::from_table(table, &self.file)
-            .map_err(|e| PipelineError::scene(&self.file, "scene", e, &format!(" (at {value})")))
+        woodpile_scene::from_table(table, &self.file).map_err(|e| {
+            crate::grid::scene_error(&self.file, "scene", e, &format!(" (at {value})"))
+        })
     }
 
     /// The stage: each value's reference, every (value, method, step) run classified, then

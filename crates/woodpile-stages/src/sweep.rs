@@ -45,18 +45,19 @@ use woodpile_sim::integrate::MethodChoice;
 use woodpile_sim::simulation::batch_size;
 use woodpile_sim::ShareSet;
 
+use crate::grid::{parse_axes, Axis, AxisValue};
 use crate::table_units;
+use woodpile_files::key::Key;
+use woodpile_files::{PointStats, PointsDir};
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::grid::{parse_axes, Axis, AxisValue};
 use woodpile_pipeline::kind::{Context, Kind, PointGrid, PointsAt};
 use woodpile_pipeline::table::rows_frame;
-use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
-use woodpile_points::canonical::Key;
 use woodpile_points::rows::{SweepPoint, SweepShape};
-use woodpile_points::{point_key, Fetched, PointResult, PointStats, PointStore, Shares};
+use woodpile_points::{point_key, Fetched, PointResult, PointStore, Shares};
+use woodpile_scene::template::Template;
 
 /// A parsed sweep stage.
 #[derive(Debug, Clone)]
@@ -193,17 +194,17 @@ impl Sweep {
             .collect()
     }
 
-    /// Simulates what `store` lacks and assembles the whole output.
+    /// Simulates what `points` lacks and assembles the whole output.
     pub(crate) fn compute(
         &self,
         stage: &str,
-        store: &PointStore,
+        points: &PointsDir,
         events: &dyn Events,
     ) -> Result<Output> {
         let all: Vec<usize> = (0..self.count()).collect();
         let at = PointsAt {
             stage,
-            store,
+            points,
             events,
         };
         let (frame, stats) = self.run_points(at, &all)?;
@@ -283,7 +284,7 @@ fn grid_error(file: &std::path::Path, e: GridError) -> PipelineError {
     };
     match e {
         GridError::Template { key, reason } => definition(key, reason),
-        GridError::Scene { error, at } => PipelineError::scene(file, "scene", error, &at),
+        GridError::Scene { error, at } => crate::grid::scene_error(file, "scene", error, &at),
         GridError::Memory(reason) => definition("axes".into(), reason),
     }
 }
@@ -293,26 +294,27 @@ impl PointGrid for Sweep {
         self.count()
     }
 
-    /// How many of the points are already in `store`.
-    fn cached(&self, store: &PointStore) -> Result<usize> {
+    /// How many of the points are already in `points`.
+    fn cached(&self, points: &PointsDir) -> Result<usize> {
         // One scene at a time per thread: a dry run of a large grid holds no list of scenes.
         (0..self.count())
             .into_par_iter()
             .map(|i| {
                 let key = point_key(&self.scene_at(i)?, self.series);
-                Ok(usize::from(store.path(&key).exists()))
+                Ok(usize::from(points.path(&key).exists()))
             })
             .sum()
     }
 
-    /// Simulates what `store` lacks among the points `indices` (increasing) and assembles
-    /// their rows: the whole output, or one shard's part of it.
+    /// Simulates what `at`'s points lack among the points `indices` (increasing) and
+    /// assembles their rows: the whole output, or one shard's part of it.
     fn run_points(&self, at: PointsAt<'_>, indices: &[usize]) -> Result<(DataFrame, PointStats)> {
         let PointsAt {
             stage,
-            store,
+            points,
             events,
         } = at;
+        let store = PointStore::from(points);
         let keys = self.keys_at(indices)?;
         let mut results: Vec<Option<PointResult>> =
             keys.par_iter().map(|k| store.load(k)).collect();
@@ -354,7 +356,7 @@ impl PointGrid for Sweep {
         let results: Vec<PointResult> = results.into_iter().flatten().collect();
         let stats = PointStats {
             simulated,
-            ..PointStats::of(&results)
+            ..woodpile_points::stats_of(&results)
         };
         if stats.failed > 0 {
             events.warn(&format!(
@@ -402,7 +404,7 @@ impl Kind for Sweep {
     }
 
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
-        self.compute(ctx.name(), ctx.store, ctx.events)
+        self.compute(ctx.name(), ctx.points, ctx.events)
     }
 
     fn points(&self) -> Option<&dyn PointGrid> {

@@ -21,13 +21,13 @@ use std::path::{Path, PathBuf};
 use polars::prelude::{AnyValue, DataFrame, IdxCa, IdxSize};
 use serde_json::json;
 
+use woodpile_files::layout;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
 use woodpile_pipeline::kind::{wrong_inputs, Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{matching_rows, missing_column, Match};
 use woodpile_pipeline::Output;
-use woodpile_points::layout;
 
 /// A parsed table stage.
 #[derive(Debug, Clone, PartialEq)]

@@ -31,18 +31,19 @@
 //! Points are cached and shared as a sweep's are. `units = "SI"` gives the table in SI, as a
 //! sweep's (inputs whose best scenes are `[physical]`, such as a design of defect rods).
 
+use crate::grid::{parse_axes, Axis};
 use polars::prelude::{Column, DataFrame};
 use serde_json::json;
+use woodpile_files::PointStats;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::Fields;
-use woodpile_pipeline::grid::{parse_axes, Axis};
 use woodpile_pipeline::kind::{
     wrong_inputs, Context, Inputs, Kind, KindCheck, PointGrid, PointsAt,
 };
 use woodpile_pipeline::stage::Stage;
-use woodpile_pipeline::template::Template;
 use woodpile_pipeline::Output;
-use woodpile_points::{PointStats, Shares};
+use woodpile_points::Shares;
+use woodpile_scene::template::Template;
 use woodpile_scene::units_out::Units;
 use woodpile_sim::integrate::MethodChoice;
 
@@ -111,11 +112,11 @@ impl Vary {
     fn sweep_of(&self, ctx: &Context<'_>, design: &str) -> Result<Sweep> {
         let stage = ctx.name();
         let path = ctx.best_scene(design)?;
-        let text = woodpile_scene::read_input(&path).map_err(|reason| {
+        let text = woodpile_files::input::read_input(&path).map_err(|reason| {
             PipelineError::stage(stage, format!("{}: {reason}", path.display()))
         })?;
         let mut scene: toml::Table = toml::from_str(&text).map_err(|e| {
-            let reason = woodpile_scene::syntax_reason(&e, &text);
+            let reason = woodpile_files::input::syntax_reason(&e, &text);
             PipelineError::stage(stage, format!("{}: {reason}", path.display()))
         })?;
         for key in &self.unset {
@@ -204,7 +205,7 @@ impl Kind for Vary {
     fn run(&self, ctx: &Context<'_>) -> Result<Output> {
         let at = PointsAt {
             stage: ctx.name(),
-            store: ctx.store,
+            points: ctx.points,
             events: ctx.events,
         };
         let mut stacked: Option<DataFrame> = None;

@@ -90,7 +90,7 @@ fn parse_scenes(fields: &mut Fields<'_>) -> Result<Vec<(String, Scene)>> {
             _ => return Err(fields.error(&format!("{key}.name"), "expected a string")),
         };
         let scene = woodpile_scene::from_table(table, &file)
-            .map_err(|e| PipelineError::scene(&file, &key, e, ""))?;
+            .map_err(|e| crate::grid::scene_error(&file, &key, e, ""))?;
         scenes.push((name, scene));
     }
     Ok(scenes)

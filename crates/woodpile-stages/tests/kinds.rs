@@ -10,9 +10,9 @@ use common::{
     design, load_error, load_error_after_reduce, single_defect_sweep_to, Project, BEST, REDUCE,
     REPORT, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
 };
+use woodpile_files::layout::points_dir;
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::table;
-use woodpile_points::layout::points_dir;
 
 #[test]
 fn optimize_refines_a_grid_maximum_between_grid_points() {

@@ -10,11 +10,11 @@ use std::sync::Mutex;
 use common::{
     load_error, Counter, Project, BEST, REDUCE, SWEEP, WORK_PRECISION, WORK_PRECISION_CHART,
 };
+use woodpile_files::layout::points_dir;
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::status::State;
 use woodpile_pipeline::{table, Pipeline, PipelineError};
-use woodpile_points::layout::points_dir;
 use woodpile_points::PointStore;
 use woodpile_stages::KINDS;
 

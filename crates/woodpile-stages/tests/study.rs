@@ -5,10 +5,10 @@
 mod common;
 
 use common::Project;
+use woodpile_files::layout::output_path;
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::{table, Pipeline};
-use woodpile_points::layout::output_path;
 use woodpile_stages::KINDS;
 
 const DESIGN: &str = r#"

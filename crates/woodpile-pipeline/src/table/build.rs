@@ -3,8 +3,8 @@
 
 use polars::prelude::*;
 
-use woodpile_points::rows::Column as Typed;
-pub use woodpile_points::rows::{Cell, Row};
+use woodpile_files::rows::Column as Typed;
+pub use woodpile_files::rows::{Cell, Row};
 
 use crate::error::{PipelineError, Result};
 
@@ -71,7 +71,7 @@ impl Columns {
 /// The table of `rows`: one column per cell name, in the first row's order. Every row must
 /// give the same names with the same kinds of cell (an error names the first that does not).
 pub fn rows_frame<R: Row>(rows: &[R]) -> Result<DataFrame> {
-    let columns = woodpile_points::rows::columns(rows)
+    let columns = woodpile_files::rows::columns(rows)
         .map_err(|reason| PipelineError::stage("table", reason))?;
     if columns.is_empty() {
         return Ok(DataFrame::empty());

@@ -8,8 +8,8 @@ use polars::prelude::*;
 
 use crate::error::{PipelineError, Result};
 use crate::manifest::{Manifest, METADATA_KEY};
-use woodpile_points::atomic;
-use woodpile_points::regular;
+use woodpile_files::atomic;
+use woodpile_files::regular;
 
 mod build;
 mod columns;

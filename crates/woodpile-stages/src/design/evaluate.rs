@@ -3,9 +3,10 @@
 use rayon::prelude::*;
 use woodpile_scene::Scene;
 
-use woodpile_pipeline::error::{PipelineError, Result};
+use woodpile_files::Key;
+use woodpile_pipeline::error::Result;
 use woodpile_pipeline::events::Events;
-use woodpile_points::{point_key, Key, PointResult, PointStore, Shares};
+use woodpile_points::{point_key, PointResult, PointStore, Shares};
 use woodpile_sim::integrate::lanes::LANES;
 
 use super::space::round_sig;
@@ -72,7 +73,7 @@ impl Design {
 
     pub(super) fn scene(&self, layout: &Layout, tolerance: Option<f64>) -> Result<Scene> {
         woodpile_scene::from_table(self.table(layout, tolerance), &self.file)
-            .map_err(|e| PipelineError::scene(&self.file, "scene", e, ""))
+            .map_err(|e| crate::grid::scene_error(&self.file, "scene", e, ""))
     }
 
     /// The objective of a result, as a score to maximise (failures and infeasible designs

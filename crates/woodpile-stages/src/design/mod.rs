@@ -62,11 +62,11 @@ use rayon::prelude::*;
 use serde_json::json;
 use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64};
 
+use woodpile_files::layout::best_path;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::events::Events;
 use woodpile_pipeline::kind::{Context, Kind, PointsAt};
 use woodpile_pipeline::Output;
-use woodpile_points::layout::best_path;
 use woodpile_points::{PointResult, PointStore};
 
 use crate::schema::Fraction;
@@ -131,7 +131,8 @@ impl Design {
     /// The stage: the searches, their refinement, the robustness study around the best design,
     /// then the best design inside the space verified and written as a scene file.
     pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {
-        let (stage, store, events) = (ctx.name(), ctx.store, ctx.events);
+        let (stage, points, events) = (ctx.name(), ctx.points, ctx.events);
+        let store = &PointStore::from(points);
         let robust: usize = self
             .robustness
             .as_ref()
@@ -140,7 +141,7 @@ impl Design {
         events.simulating(stage, total, 0);
         let at = PointsAt {
             stage,
-            store,
+            points,
             events,
         };
         let (mut rows, starts) = self.search(at)?;
@@ -185,7 +186,8 @@ impl Design {
     /// (the baseline): their rows, and where each search's refinement starts (the best genome
     /// of each, with its score).
     fn search(&self, at: PointsAt<'_>) -> Result<(Vec<Evaluated>, Vec<Start>)> {
-        let PointsAt { store, events, .. } = at;
+        let PointsAt { points, events, .. } = at;
+        let store = &PointStore::from(points);
         let d = self.space.dimension();
         let mut rows = Vec::new();
         let mut de = DifferentialEvolution::new(d, SplitMix64(self.seed ^ 0xde));
@@ -271,7 +273,13 @@ impl Design {
                 })
                 .collect();
             let label = Search::robustness(spread);
-            let mut samples = self.evaluate(label, layouts, None, at.store, at.events)?;
+            let mut samples = self.evaluate(
+                label,
+                layouts,
+                None,
+                &PointStore::from(at.points),
+                at.events,
+            )?;
             samples.sort_by(|a, b| a.score.total_cmp(&b.score));
             rows.extend(samples);
         }
@@ -301,7 +309,7 @@ impl Design {
                 Search::Verification,
                 vec![best.layout.clone()],
                 Some(self.verify_tolerance),
-                at.store,
+                &PointStore::from(at.points),
                 at.events,
             )?
             .remove(0);

@@ -29,16 +29,16 @@ use std::path::{Path, PathBuf};
 use serde_json::json;
 use woodpile_sim::simulation::Outcome;
 
+use crate::grid::AxisValue;
 use crate::reduce::Reduce;
 use crate::sweep::Sweep;
+use woodpile_files::layout::best_path;
 use woodpile_pipeline::error::{PipelineError, Result};
 use woodpile_pipeline::fields::{Ends, Fields};
-use woodpile_pipeline::grid::AxisValue;
 use woodpile_pipeline::kind::{Context, Inputs, Kind, KindCheck};
 use woodpile_pipeline::stage::Stage;
 use woodpile_pipeline::table::{f64_column, Columns};
 use woodpile_pipeline::Output;
-use woodpile_points::layout::best_path;
 
 use crate::schema::Fraction;
 
@@ -158,7 +158,7 @@ impl Optimize {
 
     /// The (lo, hi, initial simplex step) of searching `axis`: the grid's range and spacing,
     /// or the stage's own bounds for it.
-    fn bounds_of(&self, axis: &woodpile_pipeline::grid::Axis) -> (f64, f64, f64) {
+    fn bounds_of(&self, axis: &crate::grid::Axis) -> (f64, f64, f64) {
         let values: Vec<f64> = axis.values.iter().map(|v| v.as_f64()).collect();
         let (lo, hi) = values
             .iter()

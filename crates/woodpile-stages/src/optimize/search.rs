@@ -6,9 +6,9 @@ use std::cell::RefCell;
 use woodpile_sim::simulation::{simulate, Outcome};
 
 use super::Optimize;
+use crate::grid::AxisValue;
 use crate::sweep::Sweep;
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::grid::AxisValue;
 
 /// Relative move of one coordinate in the sensitivity check.
 const NUDGE: f64 = 0.01;

@@ -242,7 +242,7 @@ impl Render {
 
     /// The figure files of stage `name` under `figures`.
     pub fn files(figures: &Path, name: &str) -> [PathBuf; 2] {
-        woodpile_points::layout::figure_paths(figures, name)
+        woodpile_files::layout::figure_paths(figures, name)
     }
 
     /// Draws the panels from `inputs` (stage name to its table and manifest) and returns the

@@ -231,7 +231,7 @@ impl Report {
 
     /// The Markdown file for outputs under `results`.
     pub fn markdown_path(&self, results: &Path) -> PathBuf {
-        woodpile_points::layout::markdown_path(results, &self.markdown)
+        woodpile_files::layout::markdown_path(results, &self.markdown)
     }
 
     pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {

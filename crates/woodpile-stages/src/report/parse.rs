@@ -13,7 +13,7 @@ use super::{Convention, Paper, Quote, Read, Source};
 /// table or figure.
 pub(super) fn check_markdown_path(markdown: &str) -> std::result::Result<(), String> {
     let path = Path::new(markdown);
-    if !woodpile_points::layout::is_plain_relative(markdown) {
+    if !woodpile_files::layout::is_plain_relative(markdown) {
         return Err(format!(
             "`{markdown}` must be a relative path inside the project (no `..`, not absolute)"
         ));

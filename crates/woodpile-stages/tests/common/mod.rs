@@ -7,13 +7,13 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use woodpile_stages::KINDS;
 
+use woodpile_files::layout::output_path;
 use woodpile_pipeline::events::{Events, Silent};
 use woodpile_pipeline::run::{run, RunOptions};
 use woodpile_pipeline::shard::{run_shard, Shard, ShardRun};
 use woodpile_pipeline::status::{state, State};
 use woodpile_pipeline::variant::Set;
 use woodpile_pipeline::Pipeline;
-use woodpile_points::layout::output_path;
 
 pub struct Project {
     dir: tempfile::TempDir,

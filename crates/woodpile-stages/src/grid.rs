@@ -1,11 +1,14 @@
-//! A sweep's parameter grid, as `woodpile_scene::grid` defines it (axes, ranges rounded to 12
-//! significant digits, the product's order), read from a stage file's `[axes]` table so that
-//! every error names the stage file and the dotted key.
+//! The grids of scenes a kind declares, in a stage file's terms: a sweep's `[axes]`, as
+//! `woodpile_scene::grid` defines them (axes, ranges rounded to 12 significant digits, the
+//! product's order), and an embedded scene's errors, each naming the stage file and the dotted
+//! key.
 
+use std::path::Path;
+
+use woodpile_pipeline::fields::Fields;
+use woodpile_pipeline::PipelineError;
 pub use woodpile_scene::grid::{point, point_count, Axis, AxisValue, MAX_POINTS, RESERVED};
-
-use crate::error::PipelineError;
-use crate::fields::Fields;
+use woodpile_scene::SceneError;
 
 /// Parses the `[axes]` table.
 pub fn parse_axes(mut fields: Fields<'_>) -> Result<Vec<Axis>, PipelineError> {
@@ -24,10 +27,27 @@ pub fn parse_axes(mut fields: Fields<'_>) -> Result<Vec<Axis>, PipelineError> {
     })
 }
 
+/// A scene embedded in stage `file` under key `prefix` (`scene`, `scene[2]`) that
+/// woodpile-scene rejects: the scene's own key is appended to the prefix, and `context` (say,
+/// the grid point) to the reason. One mapping for every kind that embeds scenes.
+pub fn scene_error(file: &Path, prefix: &str, e: SceneError, context: &str) -> PipelineError {
+    let (key, reason) = match &e {
+        SceneError::Invalid { key, reason, .. } => (format!("{prefix}.{key}"), reason.clone()),
+        SceneError::Syntax { reason, .. } | SceneError::Read { reason, .. } => {
+            (prefix.to_string(), reason.clone())
+        }
+    };
+    PipelineError::Definition {
+        file: file.to_path_buf(),
+        key,
+        reason: reason + context,
+        source: Some(Box::new(e)),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
 
     fn axes(text: &str) -> Result<Vec<Axis>, PipelineError> {
         let table: toml::Table = toml::from_str(text).unwrap();

@@ -46,7 +46,7 @@ pub fn open(path: &Path, options: &mut OpenOptions) -> Result<File, Error> {
         return Err(Error::other("not a regular file"));
     }
     // procfs and sysfs files pass as regular ones (`/proc/kmsg` blocks a root reader).
-    if woodpile_scene::on_kernel_fs(&file) {
+    if crate::input::on_kernel_fs(&file) {
         return Err(Error::other("a kernel file (procfs or sysfs), not a table"));
     }
     Ok(file)
