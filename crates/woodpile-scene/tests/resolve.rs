@@ -225,6 +225,12 @@ fn a_contact_dashpot_whose_finest_rung_is_unaffordable_is_refused() {
             "segment[0].damping",
             5000.0,
         ),
+        // A dashpot of 0 declares nothing that acts: the first that acts is blamed.
+        (
+            "[[segment]]\nsites = [-15, -1]\ndamping = 0.0\n[[segment]]\nsites = [0, 14]\ndamping = 1000.0\n",
+            "segment[1].damping",
+            5000.0,
+        ),
     ] {
         let error = scene(damping, &format!("t_end = {t_end:?}\n"))
             .unwrap_err()

@@ -116,7 +116,6 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     };
     let built = model(&file, &layout, si.as_ref())?;
     // Named before `run` and `fractions` are taken from the file.
-    let contact_dashpot = run::contact_dashpot_key(&file);
     let contact_dashpots = run::ContactDashpots::of(&file, &layout);
     let settings = run::settings(file.run, si.as_ref())?;
     let (region_paper, (lo, hi)) = run::region(file.fractions, &file.defect, &layout)?;
@@ -139,7 +138,6 @@ pub(crate) fn resolve(file: raw::SceneFile) -> Result<Scene, Invalid> {
     };
     let keys = run::StepKeys {
         defects: &file.defect,
-        contact_dashpot,
         contact_dashpots,
     };
     run::within_budget(&scenario, settings.sample_every_given, &keys)?;

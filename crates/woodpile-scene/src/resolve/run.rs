@@ -184,7 +184,7 @@ pub(crate) fn within_budget(
             StepSetBy::Resonator(i) => format!("defect[{i}]"),
             StepSetBy::Contacts => "chain".to_string(),
             StepSetBy::Dissipation(which) => dissipator_key(*which, keys),
-            StepSetBy::DashpotOnsets => keys.contact_dashpot.clone(),
+            StepSetBy::DashpotOnsets => keys.contact_dashpots.first_acting().to_string(),
         },
     };
     Err(invalid(key, error.to_string()))
@@ -194,9 +194,7 @@ pub(crate) fn within_budget(
 pub(crate) struct StepKeys<'a> {
     /// The defects, whose dashpots or quality factors may set the step.
     pub defects: &'a [raw::Defect],
-    /// The key that declares a contact dashpot ([`contact_dashpot_key`]).
-    pub contact_dashpot: String,
-    /// The keys that declare the contacts' own dashpots ([`ContactDashpots::of`]).
+    /// The keys that declare the contacts' dashpots ([`ContactDashpots::of`]).
     pub contact_dashpots: ContactDashpots,
 }
 
@@ -210,49 +208,65 @@ pub(crate) struct ContactDashpots {
     chain: &'static str,
     /// Bond ranges with their own dashpot, in the order they are applied.
     own: Vec<(std::ops::RangeInclusive<usize>, String)>,
+    /// The first key whose dashpot acts (a coefficient above 0, or a restitution): the
+    /// chain's, then the striker's, then a segment's; `damping` when none does.
+    first_acting: String,
 }
 
 impl ContactDashpots {
     /// The keys of `file`'s dashpots on the chain `layout` lays out.
     pub fn of(file: &raw::SceneFile, layout: &Layout) -> ContactDashpots {
-        let chain = match file
-            .damping
-            .as_ref()
-            .is_some_and(|d| d.restitution.is_some())
-        {
+        let damping = file.damping.as_ref();
+        let chain = match damping.is_some_and(|d| d.restitution.is_some()) {
             true => "damping.restitution",
             false => "damping.contact",
         };
-        let own = |damping: Option<f64>, restitution: bool, key: &str| match (damping, restitution)
-        {
-            (_, true) => Some(format!("{key}.restitution")),
-            (Some(_), false) => Some(format!("{key}.damping")),
-            (None, false) => None,
-        };
+        let chain_acts = damping.is_some_and(|d| d.contact.is_some_and(|c| c > 0.0))
+            || damping.is_some_and(|d| d.restitution.is_some());
         let mut ranges = Vec::new();
+        let mut first_segment = None;
         for (i, segment) in file.segment.iter().enumerate() {
-            if segment.damping.is_none() && segment.restitution.is_none() {
-                continue;
-            }
             let key = format!("segment[{i}]");
+            let restitution = segment.restitution.is_some();
+            let Some((own, acts)) = own_dashpot(segment.damping, restitution, &key) else {
+                continue;
+            };
+            if acts && first_segment.is_none() {
+                first_segment = Some(own.clone());
+            }
             let sites = segment
                 .sites
                 .as_deref()
                 .and_then(|s| <[i64; 2]>::try_from(s).ok());
-            let own = own(segment.damping, segment.restitution.is_some(), &key);
-            let (Some([lo, hi]), Some(own)) = (sites, own) else {
+            let Some([lo, hi]) = sites else {
                 continue;
             };
             if let (Ok(start), Ok(end)) = (layout.index(&key, lo), layout.index(&key, hi)) {
                 ranges.push((start + 1..=end, own));
             }
         }
-        if let Some(striker) = &file.striker {
-            if let Some(own) = own(striker.damping, striker.restitution.is_some(), "striker") {
-                ranges.push((1..=1, own));
-            }
+        let striker = file.striker.as_ref().and_then(|s| {
+            let (own, acts) = own_dashpot(s.damping, s.restitution.is_some(), "striker")?;
+            ranges.push((1..=1, own.clone()));
+            acts.then_some(own)
+        });
+        let first_acting = match chain_acts {
+            true => chain.to_string(),
+            false => striker
+                .or(first_segment)
+                .unwrap_or_else(|| "damping".into()),
+        };
+        ContactDashpots {
+            chain,
+            own: ranges,
+            first_acting,
         }
-        ContactDashpots { chain, own: ranges }
+    }
+
+    /// The first key whose dashpot acts: what a refusal blames when every dashpot's onsets
+    /// together set the step.
+    pub fn first_acting(&self) -> &str {
+        &self.first_acting
     }
 
     /// The key that declares bond `bond`'s dashpot.
@@ -266,46 +280,14 @@ impl ContactDashpots {
     }
 }
 
-/// The first key that declares a contact dashpot: the chain's, then the striker's, then a
-/// segment's.
-pub(crate) fn contact_dashpot_key(file: &raw::SceneFile) -> String {
-    let damping = file.damping.as_ref();
-    let striker = file.striker.as_ref();
-    let segment = file
-        .segment
-        .iter()
-        .enumerate()
-        .find(|(_, s)| s.damping.is_some_and(|d| d > 0.0) || s.restitution.is_some());
-    let declared = [
-        (
-            damping.is_some_and(|d| d.contact.is_some_and(|c| c > 0.0)),
-            "damping.contact".to_string(),
-        ),
-        (
-            damping.is_some_and(|d| d.restitution.is_some()),
-            "damping.restitution".to_string(),
-        ),
-        (
-            striker.is_some_and(|s| s.damping.is_some_and(|d| d > 0.0)),
-            "striker.damping".to_string(),
-        ),
-        (
-            striker.is_some_and(|s| s.restitution.is_some()),
-            "striker.restitution".to_string(),
-        ),
-    ];
-    let chain_or_striker = declared
-        .into_iter()
-        .find(|(yes, _)| *yes)
-        .map(|(_, key)| key);
-    chain_or_striker
-        .or_else(|| {
-            segment.map(|(i, s)| match s.restitution {
-                Some(_) => format!("segment[{i}].restitution"),
-                None => format!("segment[{i}].damping"),
-            })
-        })
-        .unwrap_or_else(|| "damping".into())
+/// A segment's or the striker's own dashpot: `<table>.restitution` or `<table>.damping`, and
+/// whether it acts (a restitution, or a coefficient above 0); `None` when neither is given.
+fn own_dashpot(damping: Option<f64>, restitution: bool, table: &str) -> Option<(String, bool)> {
+    match (damping, restitution) {
+        (_, true) => Some((format!("{table}.restitution"), true)),
+        (Some(gamma), false) => Some((format!("{table}.damping"), gamma > 0.0)),
+        (None, false) => None,
+    }
 }
 
 /// The key that declares `which` dashpot or soft end.
