@@ -1,4 +1,5 @@
-//! What can go wrong between a point and the disk: each error names the path it concerns.
+//! What can go wrong between a results tree's files and the disk: each error names the path
+//! it concerns.
 
 use std::path::PathBuf;
 

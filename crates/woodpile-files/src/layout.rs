@@ -5,7 +5,7 @@
 //! ```text
 //! results/<stage>.parquet                          a stage's table (with its manifest)
 //! results/<stage>.best.toml                        an optimum as a scene file (optimize, design)
-//! results/points/<key[..2]>/<key>.bin              one cached scene (points.rs)
+//! results/points/<key[..2]>/<key>.wppt             one cached scene (points.rs)
 //! results/parts/<stage>/<key>.shard-I-of-N.parquet one shard of a sweep
 //! results/.lock                                    held by the run writing the tree
 //! figures/<stage>.png, figures/<stage>.svg         a render stage's figure

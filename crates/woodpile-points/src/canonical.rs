@@ -1,6 +1,7 @@
-//! A point's canonical JSON, which its [`Key`](woodpile_files::key::Key) hashes. Two descriptions that mean the same
-//! thing must hash the same, so scenes are hashed in their *resolved* form ([`scene_json`]): a
-//! sweep that spells out a default and one that omits it share their cached points.
+//! A point's canonical JSON, which its [`Key`](woodpile_files::key::Key) hashes. Two
+//! descriptions that mean the same thing must hash the same, so scenes are hashed in their
+//! *resolved* form ([`scene_json`]): a sweep that spells out a default and one that omits it
+//! share their cached points.
 
 use serde_json::{json, Map, Value};
 use woodpile_scene::Scene;

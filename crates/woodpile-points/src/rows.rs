@@ -1,6 +1,6 @@
-//! The sweep's row ([`SweepRow`], columns named in [`sweep`]) lives here too, so a sweep
-//! stage's table and Python's `sweep` have the same columns, in the same order, from the same
-//! code.
+//! The sweep's row ([`SweepRow`], columns named in [`sweep`]): the one row schema of a sweep
+//! stage and of Python's `sweep`, so that both have the same columns, in the same order, from
+//! the same code.
 
 use woodpile_scene::grid::{Axis, AxisValue};
 use woodpile_scene::units_out::SiFactors;

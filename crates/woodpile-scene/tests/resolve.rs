@@ -246,4 +246,18 @@ fn a_contact_dashpot_whose_finest_rung_is_unaffordable_is_refused() {
     }
     // Without a contact dashpot the same run is admitted: its halvings are not likely.
     assert!(scene("[damping]\nground = 0.001\n", "t_end = 5000.0\n").is_ok());
+    // A striker's own dashpot is blamed before a segment's, unless it is 0.
+    let struck = |striker_damping: f64| {
+        let text = format!(
+            "[chain]\nsites = [0, 30]\nboundary = \"free\"\n[striker]\nmass = 2.0\n\
+             damping = {striker_damping:?}\n[[segment]]\nsites = [5, 25]\ndamping = 1000.0\n\
+             [run]\nt_end = 5000.0\n"
+        );
+        let error = woodpile_scene::parse(&text, std::path::Path::new("struck.toml"));
+        let error = error.unwrap_err().to_string();
+        assert!(error.contains("finest rung"), "{error}");
+        error
+    };
+    assert!(struck(1000.0).contains("key `striker.damping`"));
+    assert!(struck(0.0).contains("key `segment[0].damping`"));
 }
