@@ -67,6 +67,20 @@ impl<'a> Phase<'a, [f64]> {
     }
 }
 
+/// A step's two states `[q, q', …]`: the one it began from and the one it ended at, before
+/// any correction: what the contact scans read to find the bonds that changed.
+#[derive(Clone, Copy)]
+pub(crate) struct StepStates<'a> {
+    pub start: &'a [f64],
+    pub end: &'a [f64],
+}
+
+/// [`StepStates`] whose end the corrections write.
+pub(crate) struct StepStatesMut<'a> {
+    pub start: &'a [f64],
+    pub end: &'a mut [f64],
+}
+
 /// [`Phase`], written through [`DofsMut`]: a step's end as the corrections change it.
 pub(crate) struct PhaseMut<'a, D: ?Sized> {
     pub q: &'a mut D,

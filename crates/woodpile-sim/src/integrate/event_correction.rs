@@ -15,7 +15,7 @@ use super::contact_event::{first_crossing, first_switch, BondPath};
 use super::contact_scan::{block_changes, block_of, changes_contact, negligible};
 use super::exact_resonator::{ExactResonators, FastModeCorrection};
 use crate::contact::{with_law, Law};
-use crate::dofs::{Phase, PhaseMut};
+use crate::dofs::{Phase, PhaseMut, StepStates, StepStatesMut};
 use crate::model::{Model, Window};
 
 /// Extra passes of a dissipative chain's corrections ([`ContactEvents::refine`]).
@@ -119,17 +119,18 @@ impl<const S: usize> ContactEvents<S> {
     }
 
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
-    /// contact opened or closed during the step of size `h` from `start` to `end` (states
-    /// `[q, q']`, the end not yet corrected). Bonds at the host of an `exact` resonator are
-    /// corrected along its fast mode too ([`bond_correction`]).
+    /// contact opened or closed during the step of size `h` between `states` (the end not yet
+    /// corrected, and corrected here). Bonds at the host of an `exact` resonator are corrected
+    /// along its fast mode too ([`bond_correction`]).
     pub(super) fn correct(
         &mut self,
         model: &Model,
-        (start, end): (&[f64], &mut [f64]),
+        states: StepStatesMut<'_>,
         h: f64,
         (window, exact): (Window, Option<&ExactResonators<S>>),
     ) {
         let n = model.n_dof();
+        let StepStatesMut { start, end } = states;
         self.scan(model, &end[..n], window);
         if !self.carried.is_empty() {
             for bond in self.carried.drain(..) {
@@ -181,7 +182,8 @@ impl<const S: usize> ContactEvents<S> {
         apply(model.inv_mass(), &pending, ended.reborrow());
         apply_fast(self.pending_fast.drain(..), ended);
         if model.is_dissipative() {
-            self.refine(model, (start, end), h, (&mut pending, &mut corrected));
+            let states = StepStatesMut { start, end };
+            self.refine(model, states, h, (&mut pending, &mut corrected));
         }
         self.corrected = corrected;
         self.events += pending.len() as u64;
@@ -197,11 +199,12 @@ impl<const S: usize> ContactEvents<S> {
     fn refine(
         &mut self,
         model: &Model,
-        (start, end): (&[f64], &mut [f64]),
+        states: StepStatesMut<'_>,
         h: f64,
         (pending, corrected): (&mut [Correction], &mut [(usize, f64)]),
     ) {
         let n = model.n_dof();
+        let StepStatesMut { start, end } = states;
         let begun = Phase::of(start, n);
         for _ in 0..REFINE_PASSES {
             let (new_q, new_v) = end.split_at_mut(n);
@@ -236,17 +239,17 @@ impl<const S: usize> ContactEvents<S> {
 
     /// The earliest moment, as a fraction of the step in (`after`, 1), at which a contact of
     /// `window` that is not [`negligible`] opens or closes along its path over the step of size
-    /// `h` from `start` to `end` (states `[q, q']`): where an event-located method ends its step.
+    /// `h` between `states`: where an event-located method ends its step.
     pub(crate) fn first_event(
         &mut self,
         model: &Model,
-        (start, end): (&[f64], &[f64]),
+        states: StepStates<'_>,
         h: f64,
         window: Window,
         after: f64,
     ) -> Option<f64> {
         let crossing = |_: usize, path: &BondPath| first_crossing(path, h, after);
-        self.earliest(model, (start, end), window, crossing)
+        self.earliest(model, states, window, crossing)
             .map(|(x, _)| x)
     }
 
@@ -258,7 +261,7 @@ impl<const S: usize> ContactEvents<S> {
     pub(crate) fn first_switch(
         &mut self,
         model: &Model,
-        (start, end): (&[f64], &[f64]),
+        states: StepStates<'_>,
         h: f64,
         window: Window,
     ) -> Option<(f64, Bond)> {
@@ -268,19 +271,20 @@ impl<const S: usize> ContactEvents<S> {
                 first_switch(path, h, damped_force(law, damping, bond))
             })
         };
-        self.earliest(model, (start, end), window, switch)
+        self.earliest(model, states, window, switch)
     }
 
     /// The earliest `moment` (a fraction of the step, or none) over the bonds of `window` that
-    /// changed during the step from `start` to `end` and are not [`negligible`], with its bond.
+    /// changed during the step between `states` and are not [`negligible`], with its bond.
     fn earliest(
         &mut self,
         model: &Model,
-        (start, end): (&[f64], &[f64]),
+        states: StepStates<'_>,
         window: Window,
         moment: impl Fn(usize, &BondPath) -> Option<f64>,
     ) -> Option<(f64, Bond)> {
         let n = model.n_dof();
+        let StepStates { start, end } = states;
         self.scan(model, &end[..n], window);
         let (begun, ended) = (Phase::of(start, n), Phase::of(end, n));
         let mut first: Option<(f64, Bond)> = None;

@@ -14,6 +14,7 @@ use super::contact_event::rk4_quadrature;
 use super::event_correction::Quadrature;
 use super::stage_step::{finish_step, stage_accelerations, FixedStepScratch};
 use super::{Method, StepOutcome, StepSpan, Stepper};
+use crate::dofs::StepStates;
 use crate::model::Model;
 
 const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
@@ -119,7 +120,11 @@ impl Rk4Fused {
             let away = |x: f64| {
                 x * rest.h > MIN_LOCATED * span.h && (1.0 - x) * rest.h > MIN_LOCATED * span.h
             };
-            let switch = contact.first_switch(model, (y, &s.y_new), rest.h, rest.window);
+            let states = StepStates {
+                start: y,
+                end: &s.y_new,
+            };
+            let switch = contact.first_switch(model, states, rest.h, rest.window);
             let Some((x, bond)) = switch.filter(|&(x, _)| away(x)) else {
                 return self.finish(model, y, rest);
             };

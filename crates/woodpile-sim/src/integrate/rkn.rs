@@ -25,6 +25,7 @@ use super::exact_resonator::ExactResonators;
 use super::stage_step::{copy_window, finish_step, stage_accelerations, NYSTROM_VELOCITIES};
 use super::stage_sum::{sum_into, Base, Terms, MAX_TERMS};
 use super::{Method, StepOutcome, StepSpan, Stepper};
+use crate::dofs::StepStates;
 use crate::model::{Model, Window};
 
 /// An explicit Nyström tableau of `S` stages. `a` is strictly lower triangular.
@@ -341,7 +342,11 @@ impl<const S: usize> Rkn<S> {
             self.raw_step(model, t + done, y, rest, window);
             let event = match self.contact.as_mut() {
                 Some(c) if cuts < MAX_SUB_STEPS => {
-                    c.first_event(model, (y, &self.y_new), rest, window, SAME_EVENT)
+                    let states = StepStates {
+                        start: y,
+                        end: &self.y_new,
+                    };
+                    c.first_event(model, states, rest, window, SAME_EVENT)
                 }
                 _ => None,
             };

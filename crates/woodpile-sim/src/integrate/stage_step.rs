@@ -5,6 +5,7 @@
 use super::event_correction::{ContactEvents, Quadrature};
 use super::exact_resonator::ExactResonators;
 use crate::damped_force::BondRecord;
+use crate::dofs::StepStatesMut;
 use crate::model::{Model, Window};
 
 /// What the hand-written fixed-step steppers ([`super::Rk4Fused`], [`super::Rkn4`]) keep
@@ -98,7 +99,11 @@ pub(crate) fn finish_step<const S: usize>(
     window: Window,
 ) {
     if let Some(contact) = contact {
-        contact.correct(model, (y, y_new), h, (window, exact));
+        let states = StepStatesMut {
+            start: y,
+            end: y_new,
+        };
+        contact.correct(model, states, h, (window, exact));
     }
     copy_window(model, (y, y_new), window);
 }
