@@ -28,18 +28,20 @@ pub(super) struct LaneEvents {
 }
 
 impl LaneEvents {
-    /// Corrects the end state `(new_q, new_v)` of the step of size `h` from `(q, v)`, in every
-    /// live lane whose bonds of `window` changed contact, from the stages' bond forces
-    /// `stage_force`. Returns which lanes were corrected.
+    /// Corrects the state the step of size `h` from `begun` has `ended` at, in every live lane
+    /// whose bonds of `window` changed contact, from the stages' bond forces `stage_force`.
+    /// Returns which lanes were corrected.
     pub fn correct(
         &mut self,
         models: &[&Model; LANES],
-        (q, v): (&[Lanes], &[Lanes]),
-        (new_q, new_v): (&mut [Lanes], &mut [Lanes]),
+        begun: Phase<'_, [Lanes]>,
+        ended: PhaseMut<'_, [Lanes]>,
         (stage_force, h): (&[Vec<Lanes>; S], f64),
         (window, live): (Window, [bool; LANES]),
         exact: &[Option<ExactResonators<S>>; LANES],
     ) -> [bool; LANES] {
+        let Phase { q, v } = begun;
+        let PhaseMut { q: new_q, v: new_v } = ended;
         let live_mask = (0..LANES).fold(0, |m, l| m | (u32::from(live[l]) << l));
         self.scan(models[0], new_q, stage_force, window, live_mask);
         let mut corrected = [false; LANES];

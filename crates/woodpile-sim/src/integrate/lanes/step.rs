@@ -8,6 +8,7 @@ use super::events::LaneEvents;
 use super::force::{accelerations, patch};
 use super::{Lane, LaneChain, LaneMut, Lanes, LANES, S, ZERO};
 use crate::contact::{with_law, Law};
+use crate::dofs::{Phase, PhaseMut};
 use crate::integrate::erkn_weights::NystromWeights;
 use crate::integrate::exact_resonator::ExactResonators;
 use crate::integrate::rkn::DPRKN6;
@@ -78,10 +79,15 @@ impl LaneRkn6 {
         (window, live): (Window, [bool; LANES]),
     ) {
         self.raw_step(q, v, h, window, live);
+        let begun = Phase { q: &*q, v: &*v };
+        let ended = PhaseMut {
+            q: &mut self.new_q[..],
+            v: &mut self.new_v[..],
+        };
         let corrected = self.events.correct(
             models,
-            (&*q, &*v),
-            (&mut self.new_q, &mut self.new_v),
+            begun,
+            ended,
             (&self.stage_force, h),
             (window, live),
             &self.exact,
