@@ -31,7 +31,7 @@ mod rk4_fused;
 mod rkn;
 mod rkn4;
 mod split_losses;
-mod stage_step;
+pub(crate) mod stage_step;
 mod stage_sum;
 mod symplectic;
 
