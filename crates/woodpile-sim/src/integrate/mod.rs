@@ -33,6 +33,7 @@ mod rkn4;
 mod split_losses;
 pub(crate) mod stage_step;
 mod stage_sum;
+pub(crate) mod switches;
 mod symplectic;
 
 pub use active_sites::ActiveSites;

@@ -13,8 +13,8 @@
 use super::contact_event::rk4_quadrature;
 use super::event_correction::Quadrature;
 use super::stage_step::{finish_step, stage_accelerations, FixedStepScratch};
+use super::switches::{self, Staged};
 use super::{Method, StepOutcome, StepSpan, Stepper};
-use crate::dofs::StepStates;
 use crate::model::Model;
 
 const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
@@ -65,14 +65,7 @@ impl Stepper for Rk4Fused {
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
-        match locates_switches(model, &self.scratch) {
-            true => self.located_step(model, y, span),
-            false => {
-                self.stages(model, y, span);
-                self.finish(model, y, span);
-            }
-        }
-        StepOutcome::Accepted { h_next: span.h }
+        switches::step(self, model, y, span)
     }
 
     fn reach(&self) -> usize {
@@ -84,69 +77,21 @@ impl Stepper for Rk4Fused {
     }
 }
 
-/// Most force switches one step is split at; one beyond them is corrected as any event.
-const MAX_LOCATED: usize = 8;
+impl Staged<4> for Rk4Fused {
+    fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan) {
+        Rk4Fused::stages(self, model, y, span);
+    }
 
-/// A switch this close to either end of a step (as a fraction of it) is left to the correction.
-const MIN_LOCATED: f64 = 1e-6;
+    fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
+        Rk4Fused::finish(self, model, y, span);
+    }
 
-/// How far after a switch a located step ends, as a fraction of the whole step.
-const LATE: f64 = 1e-8;
-
-/// Whether `rk4-contact` ends its steps at force switches: on a chain whose contacts carry a
-/// dashpot.
-fn locates_switches(model: &Model, scratch: &FixedStepScratch<4>) -> bool {
-    scratch.contact.is_some() && model.damping().is_some_and(|d| d.has_contact_dashpot())
+    fn scratch(&mut self) -> &mut FixedStepScratch<4> {
+        &mut self.scratch
+    }
 }
 
 impl Rk4Fused {
-    /// The step `span` in parts that end at its force switches. A contact dashpot's force
-    /// switches inside a step: it jumps to γ ċ as a contact closes (linear law), and has a
-    /// kink where its clip starts. RK4's later stages would carry those into every stage
-    /// state, which the bond's own correction cannot undo (order 2 instead of 2.5). So a part
-    /// ends LATE after the first switch, so that its last stage alone sees the new force, and
-    /// the next part is corrected on that bond, whose force is not smooth just behind its
-    /// start. Switches within MIN_LOCATED of a part's ends (in the whole step's measure) are
-    /// left to the correction.
-    fn located_step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
-        let mut rest = span;
-        for _ in 0..MAX_LOCATED {
-            self.stages(model, y, rest);
-            let s = &mut self.scratch;
-            let contact = s
-                .contact
-                .as_mut()
-                .expect("a located step keeps contact events");
-            let away = |x: f64| {
-                x * rest.h > MIN_LOCATED * span.h && (1.0 - x) * rest.h > MIN_LOCATED * span.h
-            };
-            let states = StepStates {
-                start: y,
-                end: &s.y_new,
-            };
-            let switch = contact.first_switch(model, states, rest.h, rest.window);
-            let Some((x, bond)) = switch.filter(|&(x, _)| away(x)) else {
-                return self.finish(model, y, rest);
-            };
-            let part = StepSpan {
-                h: x * rest.h + LATE * span.h,
-                ..rest
-            };
-            self.stages(model, y, part);
-            self.finish(model, y, part);
-            if let Some(contact) = self.scratch.contact.as_mut() {
-                contact.correct_next(bond);
-            }
-            rest = StepSpan {
-                t: rest.t + part.h,
-                h: rest.h - part.h,
-                ..rest
-            };
-        }
-        self.stages(model, y, rest);
-        self.finish(model, y, rest);
-    }
-
     /// Corrects the new state the last [`Rk4Fused::stages`] left (contact events) and copies it
     /// into `y` over `span`'s window.
     fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {

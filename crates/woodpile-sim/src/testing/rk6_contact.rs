@@ -5,10 +5,10 @@
 //! forces depend on velocities. Not a method a scene can name: at equal force evaluations it is
 //! no more accurate than `rk4-contact` on a contact dashpot, whose events set the error.
 
-use crate::dofs::StepStates;
 use crate::energy::{total_energy, Fractions};
 use crate::error::SimError;
 use crate::integrate::stage_step::{finish_step, stage_accelerations, FixedStepScratch};
+use crate::integrate::switches::{self, Staged};
 use crate::integrate::{
     drive, DriveConfig, StepControl, StepOutcome, StepSpan, Stepper, MAX_STEPS,
 };
@@ -179,6 +179,12 @@ impl Rk6Contact {
         }
         s.evals += S as u64;
     }
+}
+
+impl Staged<S> for Rk6Contact {
+    fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan) {
+        Rk6Contact::stages(self, model, y, span);
+    }
 
     fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
         let s = &mut self.scratch;
@@ -191,45 +197,8 @@ impl Rk6Contact {
         );
     }
 
-    fn located_step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
-        const MAX_LOCATED: usize = 8;
-        const MIN_LOCATED: f64 = 1e-6;
-        const LATE: f64 = 1e-8;
-        let mut rest = span;
-        for _ in 0..MAX_LOCATED {
-            self.stages(model, y, rest);
-            let s = &mut self.scratch;
-            let Some(contact) = s.contact.as_mut() else {
-                return self.finish(model, y, rest);
-            };
-            let away = |x: f64| {
-                x * rest.h > MIN_LOCATED * span.h && (1.0 - x) * rest.h > MIN_LOCATED * span.h
-            };
-            let states = StepStates {
-                start: y,
-                end: &s.y_new,
-            };
-            let switch = contact.first_switch(model, states, rest.h, rest.window);
-            let Some((x, bond)) = switch.filter(|&(x, _)| away(x)) else {
-                return self.finish(model, y, rest);
-            };
-            let part = StepSpan {
-                h: x * rest.h + LATE * span.h,
-                ..rest
-            };
-            self.stages(model, y, part);
-            self.finish(model, y, part);
-            if let Some(contact) = self.scratch.contact.as_mut() {
-                contact.correct_next(bond);
-            }
-            rest = StepSpan {
-                t: rest.t + part.h,
-                h: rest.h - part.h,
-                ..rest
-            };
-        }
-        self.stages(model, y, rest);
-        self.finish(model, y, rest);
+    fn scratch(&mut self) -> &mut FixedStepScratch<S> {
+        &mut self.scratch
     }
 }
 
@@ -239,15 +208,7 @@ impl Stepper for Rk6Contact {
     }
 
     fn step(&mut self, model: &Model, y: &mut [f64], span: StepSpan) -> StepOutcome {
-        let locate = model.damping().is_some_and(|d| d.has_contact_dashpot());
-        match locate {
-            true => self.located_step(model, y, span),
-            false => {
-                self.stages(model, y, span);
-                self.finish(model, y, span);
-            }
-        }
-        StepOutcome::Accepted { h_next: span.h }
+        switches::step(self, model, y, span)
     }
 
     fn reach(&self) -> usize {
