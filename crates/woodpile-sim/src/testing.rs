@@ -16,7 +16,7 @@ use crate::simulation::{simulate, Scenario};
 
 mod audit_kinds;
 mod lanes;
-mod rk6_contact;
+pub use crate::integrate::rk6_contact::{run_fixed_step, Rk6Contact};
 pub use audit_kinds::{
     chain_audit_scene, damped_audit_scene, gap_audit_scene, gravity_audit_scene,
     linear_losses_audit_scene,
@@ -25,7 +25,6 @@ pub use lanes::{
     by_lanes_and_alone, lane_neighbours, with_resonator_masses_scaled, RecordedRun,
     THIRD_RUN_POINTS,
 };
-pub use rk6_contact::{run_fixed_step, Rk6Contact};
 
 /// Half-width N of the paper's chains (sites -N..N).
 pub const PAPER_N: usize = 100;

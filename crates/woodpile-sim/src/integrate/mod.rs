@@ -28,12 +28,14 @@ mod method;
 mod plan;
 mod rk;
 mod rk4_fused;
+#[cfg(any(test, feature = "testing"))]
+pub(crate) mod rk6_contact;
 mod rkn;
 mod rkn4;
 mod split_losses;
-pub(crate) mod stage_step;
+mod stage_step;
 mod stage_sum;
-pub(crate) mod switches;
+mod switches;
 mod symplectic;
 
 pub use active_sites::ActiveSites;

@@ -12,7 +12,7 @@
 
 use super::contact_event::rk4_quadrature;
 use super::event_correction::Quadrature;
-use super::stage_step::{finish_step, stage_accelerations, FixedStepScratch};
+use super::stage_step::{stage_accelerations, FixedStepScratch};
 use super::switches::{self, Staged};
 use super::{Method, StepOutcome, StepSpan, Stepper};
 use crate::model::Model;
@@ -79,11 +79,7 @@ impl Stepper for Rk4Fused {
 
 impl Staged<4> for Rk4Fused {
     fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan) {
-        Rk4Fused::stages(self, model, y, span);
-    }
-
-    fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
-        Rk4Fused::finish(self, model, y, span);
+        self.four_stages(model, y, span);
     }
 
     fn scratch(&mut self) -> &mut FixedStepScratch<4> {
@@ -92,23 +88,10 @@ impl Staged<4> for Rk4Fused {
 }
 
 impl Rk4Fused {
-    /// Corrects the new state the last [`Rk4Fused::stages`] left (contact events) and copies it
-    /// into `y` over `span`'s window.
-    fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
-        let s = &mut self.scratch;
-        finish_step(
-            (s.contact.as_mut(), None),
-            model,
-            (y, &mut s.y_new),
-            span.h,
-            span.window,
-        );
-    }
-
     crate::simd::dispatched! {
         /// RK4's four stages from `y` over `span`, the new state (uncorrected) left in the
         /// scratch's `y_new`; in its AVX2 or AVX-512 copy where the CPU has one (`crate::simd`).
-        fn stages[&mut self](model: &Model, y: &[f64], span: StepSpan)
+        fn four_stages[&mut self](model: &Model, y: &[f64], span: StepSpan)
             => stages_body, stages_avx2, stages_avx512
     }
 

@@ -8,7 +8,8 @@ use crate::damped_force::BondRecord;
 use crate::dofs::StepStatesMut;
 use crate::model::{Model, Window};
 
-/// What the hand-written fixed-step steppers ([`super::Rk4Fused`], [`super::Rkn4`]) keep
+/// What the hand-written fixed-step steppers ([`super::Rk4Fused`], [`super::Rkn4`], and the
+/// measured `crate::testing::Rk6Contact`) keep
 /// beside their stage derivatives: the position of the next force evaluation, the new state
 /// being assembled, the evaluations spent, and, for the `-contact` variant, each stage's bond
 /// forces. One constructor serves a method and its `-contact` variant.

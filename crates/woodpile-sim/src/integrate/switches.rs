@@ -7,7 +7,7 @@
 //! new force, and the next part corrects that bond too, whose force is not smooth just behind
 //! its start.
 
-use super::stage_step::FixedStepScratch;
+use super::stage_step::{finish_step, FixedStepScratch};
 use super::{StepOutcome, StepSpan};
 use crate::dofs::StepStates;
 use crate::model::Model;
@@ -26,8 +26,18 @@ pub(crate) trait Staged<const S: usize> {
     /// The stages over `span` from `y`, the new state (uncorrected) left in the scratch.
     fn stages(&mut self, model: &Model, y: &[f64], span: StepSpan);
 
-    /// Corrects the new state the stages left and copies it into `y`.
-    fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan);
+    /// Corrects the new state the stages left (the contact events) and copies it into `y`
+    /// over `span`'s window.
+    fn finish(&mut self, model: &Model, y: &mut [f64], span: StepSpan) {
+        let s = self.scratch();
+        finish_step(
+            (s.contact.as_mut(), None),
+            model,
+            (y, &mut s.y_new),
+            span.h,
+            span.window,
+        );
+    }
 
     /// Its scratch, with the new state and the contact events.
     fn scratch(&mut self) -> &mut FixedStepScratch<S>;

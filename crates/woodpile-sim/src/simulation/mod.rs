@@ -211,9 +211,7 @@ pub fn run_with_plan<O: Observer + ?Sized>(
     active_window: bool,
 ) -> Result<Outcome, SimError> {
     let model: &Model = &scenario.model;
-    let mut y = model.rest_state();
-    model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)?;
-    let e_initial = crate::energy::total_energy(model, 0.0, &y);
+    let (mut y, e_initial) = struck(scenario)?;
     let stats = plan.integrate_model(
         model,
         &mut y,
@@ -224,6 +222,29 @@ pub fn run_with_plan<O: Observer + ?Sized>(
     Ok(outcome_of(scenario, plan, (y, e_initial), stats))
 }
 
+/// `scenario`'s chain at rest and struck: the state a run starts from, and its energy.
+pub(crate) fn struck(scenario: &Scenario) -> Result<(Vec<f64>, f64), SimError> {
+    let model = &scenario.model;
+    let mut y = model.rest_state();
+    model.apply_impulse(&mut y, scenario.impulse_site, scenario.impulse_velocity)?;
+    let e_initial = crate::energy::total_energy(model, 0.0, &y);
+    Ok((y, e_initial))
+}
+
+/// The fractions of a run of `scenario` that ended in state `y`, having started with the energy
+/// `e_initial`, and the energy density they were read from.
+pub(crate) fn end_fractions(
+    scenario: &Scenario,
+    y: &[f64],
+    e_initial: f64,
+) -> (Fractions, Vec<f64>) {
+    let model = &scenario.model;
+    let mut density = vec![0.0; model.n_sites()];
+    let end = (scenario.t_end, y);
+    let fractions = Fractions::of_state(model, end, scenario.region, e_initial, &mut density);
+    (fractions, density)
+}
+
 /// The outcome of a run of `scenario` by `plan` that ended in state `y` with `stats`, having
 /// started with the energy `e_initial`.
 fn outcome_of(
@@ -232,11 +253,8 @@ fn outcome_of(
     (y, e_initial): (Vec<f64>, f64),
     stats: Stats,
 ) -> Outcome {
-    let model = &scenario.model;
-    let mut density = vec![0.0; model.n_sites()];
-    let end = (scenario.t_end, y.as_slice());
-    let fractions = Fractions::of_state(model, end, scenario.region, e_initial, &mut density);
-    let e_final = match model.is_dissipative() {
+    let (fractions, density) = end_fractions(scenario, &y, e_initial);
+    let e_final = match scenario.model.is_dissipative() {
         true => density.iter().sum(),
         false => fractions.total,
     };
