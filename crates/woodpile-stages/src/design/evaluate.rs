@@ -6,6 +6,7 @@ use woodpile_scene::Scene;
 use woodpile_files::Key;
 use woodpile_pipeline::error::Result;
 use woodpile_pipeline::events::Events;
+use woodpile_pipeline::kind::PointsAt;
 use woodpile_points::{point_key, PointResult, PointStore, Shares};
 use woodpile_sim::integrate::lanes::LANES;
 
@@ -99,16 +100,17 @@ impl Design {
         }
     }
 
-    /// Evaluates `layouts` in parallel through the point cache, in order, four neighbours at
-    /// a time (the robustness samples of one design share a chain, and take SIMD lanes).
+    /// Evaluates `layouts` in parallel through `at`'s point cache, in order, four neighbours
+    /// at a time (the robustness samples of one design share a chain, and take SIMD lanes).
     pub(super) fn evaluate(
         &self,
         search: Search,
         layouts: Vec<Layout>,
         tolerance: Option<f64>,
-        store: &PointStore,
-        events: &dyn Events,
+        at: PointsAt<'_>,
     ) -> Result<Vec<Evaluated>> {
+        let store = &PointStore::from(at.points);
+        let events = at.events;
         let groups: Vec<Vec<Evaluated>> = layouts
             .par_chunks(LANES)
             .map(|group| self.evaluate_group(search, group, tolerance, (store, events)))

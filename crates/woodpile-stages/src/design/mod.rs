@@ -64,10 +64,9 @@ use woodpile_analysis::search::{random_points, DifferentialEvolution, SplitMix64
 
 use woodpile_files::layout::best_path;
 use woodpile_pipeline::error::{PipelineError, Result};
-use woodpile_pipeline::events::Events;
 use woodpile_pipeline::kind::{Context, Kind, PointsAt};
 use woodpile_pipeline::Output;
-use woodpile_points::{PointResult, PointStore};
+use woodpile_points::PointResult;
 
 use crate::schema::Fraction;
 
@@ -132,7 +131,6 @@ impl Design {
     /// then the best design inside the space verified and written as a scene file.
     pub(crate) fn compute(&self, ctx: &Context<'_>) -> Result<Output> {
         let (stage, points, events) = (ctx.name(), ctx.points, ctx.events);
-        let store = &PointStore::from(points);
         let robust: usize = self
             .robustness
             .as_ref()
@@ -149,9 +147,7 @@ impl Design {
         // best and from the random search's) are independent, so they run side by side.
         let refined: Vec<Result<Vec<Evaluated>>> = starts
             .par_iter()
-            .map(|(label, start, score)| {
-                self.refine_from(stage, *label, start, *score, store, events)
-            })
+            .map(|(label, start, score)| self.refine_from(at, *label, start, *score))
             .collect();
         for refinement in refined {
             rows.extend(refinement?);
@@ -186,8 +182,6 @@ impl Design {
     /// (the baseline): their rows, and where each search's refinement starts (the best genome
     /// of each, with its score).
     fn search(&self, at: PointsAt<'_>) -> Result<(Vec<Evaluated>, Vec<Start>)> {
-        let PointsAt { points, events, .. } = at;
-        let store = &PointStore::from(points);
         let d = self.space.dimension();
         let mut rows = Vec::new();
         let mut de = DifferentialEvolution::new(d, SplitMix64(self.seed ^ 0xde));
@@ -196,15 +190,14 @@ impl Design {
             .iter()
             .map(|g| self.space.decode(g))
             .collect();
-        let first = self.evaluate(Search::DifferentialEvolution, layouts, None, store, events)?;
+        let first = self.evaluate(Search::DifferentialEvolution, layouts, None, at)?;
         de.start(first.iter().map(|e| e.score).collect());
         rows.extend(first);
         let mut spent = POPULATION;
         while spent < self.budget {
             let trials = de.trials(POPULATION.min(self.budget - spent));
             let layouts = trials.iter().map(|g| self.space.decode(g)).collect();
-            let evaluated =
-                self.evaluate(Search::DifferentialEvolution, layouts, None, store, events)?;
+            let evaluated = self.evaluate(Search::DifferentialEvolution, layouts, None, at)?;
             let scores: Vec<f64> = evaluated.iter().map(|e| e.score).collect();
             spent += trials.len();
             de.select(trials, &scores);
@@ -216,7 +209,7 @@ impl Design {
             .iter()
             .map(|g| self.space.decode(g))
             .collect();
-        let random_rows = self.evaluate(Search::Random, layouts, None, store, events)?;
+        let random_rows = self.evaluate(Search::Random, layouts, None, at)?;
         let random_best = (0..random_rows.len())
             .max_by(|&a, &b| random_rows[a].score.total_cmp(&random_rows[b].score));
         rows.extend(random_rows.iter().cloned());
@@ -273,13 +266,7 @@ impl Design {
                 })
                 .collect();
             let label = Search::robustness(spread);
-            let mut samples = self.evaluate(
-                label,
-                layouts,
-                None,
-                &PointStore::from(at.points),
-                at.events,
-            )?;
+            let mut samples = self.evaluate(label, layouts, None, at)?;
             samples.sort_by(|a, b| a.score.total_cmp(&b.score));
             rows.extend(samples);
         }
@@ -309,8 +296,7 @@ impl Design {
                 Search::Verification,
                 vec![best.layout.clone()],
                 Some(self.verify_tolerance),
-                &PointStore::from(at.points),
-                at.events,
+                at,
             )?
             .remove(0);
         rows.push(verified.clone());
@@ -395,12 +381,10 @@ impl Design {
     /// within the `refine` budget; every trial a row labelled `label`.
     fn refine_from(
         &self,
-        stage: &str,
+        at: PointsAt<'_>,
         label: Search,
         start: &[f64],
         score: f64,
-        store: &PointStore,
-        events: &dyn Events,
     ) -> Result<Vec<Evaluated>> {
         if self.refine == 0 || !score.is_finite() {
             return Ok(Vec::new());
@@ -423,7 +407,7 @@ impl Design {
                 g[j] = x[k].clamp(0.0, 1.0);
             }
             let layout = self.space.decode(&g);
-            match self.evaluate(label, vec![layout], None, store, events) {
+            match self.evaluate(label, vec![layout], None, at) {
                 Ok(mut e) => {
                     let e = e.remove(0);
                     let score = e.score;
@@ -431,7 +415,7 @@ impl Design {
                     Ok(score)
                 }
                 Err(err) => {
-                    failure = Some(PipelineError::stage(stage, err.to_string()));
+                    failure = Some(PipelineError::stage(at.stage, err.to_string()));
                     Ok(f64::NEG_INFINITY)
                 }
             }
