@@ -221,16 +221,17 @@ impl ContactDashpots {
             true => "damping.restitution",
             false => "damping.contact",
         };
-        let chain_acts = damping.is_some_and(|d| d.contact.is_some_and(|c| c > 0.0))
-            || damping.is_some_and(|d| d.restitution.is_some());
+        let chain_acts =
+            damping.is_some_and(|d| d.contact.is_some_and(|c| c > 0.0) || d.restitution.is_some());
         let mut ranges = Vec::new();
         let mut first_segment = None;
         for (i, segment) in file.segment.iter().enumerate() {
-            let key = format!("segment[{i}]");
             let restitution = segment.restitution.is_some();
-            let Some((own, acts)) = own_dashpot(segment.damping, restitution, &key) else {
+            let Some((field, acts)) = own_dashpot(segment.damping, restitution) else {
                 continue;
             };
+            let key = format!("segment[{i}]");
+            let own = format!("{key}.{field}");
             if acts && first_segment.is_none() {
                 first_segment = Some(own.clone());
             }
@@ -246,7 +247,8 @@ impl ContactDashpots {
             }
         }
         let striker = file.striker.as_ref().and_then(|s| {
-            let (own, acts) = own_dashpot(s.damping, s.restitution.is_some(), "striker")?;
+            let (field, acts) = own_dashpot(s.damping, s.restitution.is_some())?;
+            let own = format!("striker.{field}");
             ranges.push((1..=1, own.clone()));
             acts.then_some(own)
         });
@@ -280,12 +282,13 @@ impl ContactDashpots {
     }
 }
 
-/// A segment's or the striker's own dashpot: `<table>.restitution` or `<table>.damping`, and
-/// whether it acts (a restitution, or a coefficient above 0); `None` when neither is given.
-fn own_dashpot(damping: Option<f64>, restitution: bool, table: &str) -> Option<(String, bool)> {
+/// A segment's or the striker's own dashpot: the key of its table that declares it
+/// (`restitution` or `damping`), and whether it acts (a restitution, or a coefficient above
+/// 0); `None` when neither is given, so that a table without one costs no key.
+fn own_dashpot(damping: Option<f64>, restitution: bool) -> Option<(&'static str, bool)> {
     match (damping, restitution) {
-        (_, true) => Some((format!("{table}.restitution"), true)),
-        (Some(gamma), false) => Some((format!("{table}.damping"), gamma > 0.0)),
+        (_, true) => Some(("restitution", true)),
+        (Some(gamma), false) => Some(("damping", gamma > 0.0)),
         (None, false) => None,
     }
 }
