@@ -20,7 +20,7 @@ pub fn code_version() -> String {
 }
 
 /// Revision of the numerics and reductions (see [`code_version`]).
-pub const NUMERICS_REVISION: u32 = 16;
+pub const NUMERICS_REVISION: u32 = 17;
 
 /// A 256-bit content hash, shown as 64 lowercase hex digits.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]

@@ -8,14 +8,19 @@ use crate::model::Model;
 
 /// Whether a changed bond's forces, at every stage and at the end of its `path`, all stay
 /// below [`NEGLIGIBLE_FORCE`]: then its correction is skipped. The end is looked at only when
-/// every stage force is below it.
+/// every stage force is below it. A contact dashpot's clip records a zero force on a bond
+/// that still dissipates, so on a chain with one the elastic force at the start of the path
+/// must be negligible too.
 pub(super) fn negligible<const S: usize>(
     model: &Model,
     bond: usize,
     stage_forces: [f64; S],
     path: &BondPath,
 ) -> bool {
-    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE) && end_force_negligible(model, bond, path)
+    stage_forces.iter().all(|&f| f < NEGLIGIBLE_FORCE)
+        && end_force_negligible(model, bond, path)
+        && (!model.damping().is_some_and(|d| d.has_contact_dashpot())
+            || with_law!(model.law(), |law| law.force_negligible(bond, path.d0)))
 }
 
 /// Whether the bond's elastic force at the end of its path is below [`NEGLIGIBLE_FORCE`], by
