@@ -84,15 +84,25 @@ pub(crate) struct Frame {
 /// ([`Lossless`]) returns the conservative force by the conservative loop's operations, so
 /// that it compiles to that loop; a dissipative chain's adds its dashpots and sums their power.
 pub(crate) trait Losses<V: Width> {
-    /// Bond `bond`'s recorded force and the force it adds to the rest state's, at relative
-    /// displacement `r`, its members being `sites` (left, right; `None` for a wall).
+    /// Whether the chain dissipates: only then does the kernel sum the bonds' powers.
+    const DISSIPATES: bool;
+
+    /// Bond `bond`'s recorded force, the force it adds to the rest state's, and the power its
+    /// dashpot dissipates, at relative displacement `r`, its members being `sites` (left,
+    /// right; `None` for a wall).
     fn bond<L: Law>(
         &mut self,
         law: &L,
         bond: usize,
         r: V,
         sites: (Option<usize>, Option<usize>),
-    ) -> (V, V);
+    ) -> (V, V, V);
+
+    /// The power the chain's contacts dissipate, summed over its bonds left to right (asked
+    /// once, before the soft ends, and only when [`Losses::DISSIPATES`]). The kernel keeps the
+    /// sum in a register: summed into `self` bond by bond, it was a store and a load per bond
+    /// on the loop's critical path.
+    fn contacts_dissipated(&mut self, power: V);
 
     /// The force of a soft end (`spring`, `damping`) on its site `site`, at position `u`.
     fn soft_end(&mut self, end: (f64, f64), site: usize, u: V) -> V;
@@ -115,6 +125,8 @@ pub(crate) struct Lossless<'a, V> {
 }
 
 impl<V: Width> Losses<V> for Lossless<'_, V> {
+    const DISSIPATES: bool = false;
+
     #[inline(always)]
     fn bond<L: Law>(
         &mut self,
@@ -122,10 +134,13 @@ impl<V: Width> Losses<V> for Lossless<'_, V> {
         bond: usize,
         r: V,
         _: (Option<usize>, Option<usize>),
-    ) -> (V, V) {
+    ) -> (V, V, V) {
         let elastic = r.map(|r| law.elastic(bond, r));
-        (elastic, elastic.map(|e| law.net(bond, e)))
+        (elastic, elastic.map(|e| law.net(bond, e)), V::ZERO)
     }
+
+    #[inline(always)]
+    fn contacts_dissipated(&mut self, _: V) {}
 
     #[inline(always)]
     fn soft_end(&mut self, (spring, _): (f64, f64), _: usize, u: V) -> V {
@@ -195,9 +210,9 @@ pub(crate) fn chain_accelerations<L: Law, V: Width, K: Fn() -> V>(
 /// carries no extra store. The bonds are evaluated left to right, walls included, which is
 /// the order a dissipative chain sums its dashpots' power in.
 #[inline(always)]
-fn contact_chain<L: Law, V: Width>(
+fn contact_chain<L: Law, V: Width, Lo: Losses<V>>(
     (law, [left_wall, right_wall]): (&L, [bool; 2]),
-    losses: &mut impl Losses<V>,
+    losses: &mut Lo,
     u: &[V],
     acc_u: &mut [V],
     window: Window,
@@ -205,9 +220,18 @@ fn contact_chain<L: Law, V: Width>(
 ) {
     let (lo, hi) = (window.lo, window.hi);
     let n = u.len();
+    // The dissipated power, summed in the bonds' order (left wall, inner bonds, right wall).
+    let mut power = V::ZERO;
+    let mut dissipated = |p: V| {
+        if Lo::DISSIPATES {
+            power = power.zip(p, |sum, p| sum + p);
+        }
+    };
     let left = (lo == 0 && left_wall).then(|| {
         let r = u[0].map(|u| -u);
-        losses.bond(law, 0, r, (None, Some(0)))
+        let (recorded, f, p) = losses.bond(law, 0, r, (None, Some(0)));
+        dissipated(p);
+        (recorded, f)
     });
     let u_w = &u[lo..=hi];
     let acc_w = &mut acc_u[lo..=hi][..u_w.len()];
@@ -215,7 +239,8 @@ fn contact_chain<L: Law, V: Width>(
     match record.as_deref_mut() {
         None => {
             for i in 1..u_w.len() {
-                let (_, f) = inner_bond(law, losses, u_w, (lo, i));
+                let (_, f, p) = inner_bond(law, losses, u_w, (lo, i));
+                dissipated(p);
                 acc_w[i - 1] = previous.zip(f, |p, f| p - f);
                 previous = f;
             }
@@ -223,7 +248,8 @@ fn contact_chain<L: Law, V: Width>(
         Some(record) => {
             let record_w = &mut record[lo + 1..=hi][..u_w.len() - 1];
             for i in 1..u_w.len() {
-                let (recorded, f) = inner_bond(law, losses, u_w, (lo, i));
+                let (recorded, f, p) = inner_bond(law, losses, u_w, (lo, i));
+                dissipated(p);
                 acc_w[i - 1] = previous.zip(f, |p, f| p - f);
                 record_w[i - 1] = recorded;
                 previous = f;
@@ -238,23 +264,27 @@ fn contact_chain<L: Law, V: Width>(
         acc_u[0] = acc_u[0].zip(f, |a, f| a + f);
     }
     if hi == n - 1 && right_wall {
-        let (recorded, f) = losses.bond(law, n, u[n - 1], (Some(n - 1), None));
+        let (recorded, f, p) = losses.bond(law, n, u[n - 1], (Some(n - 1), None));
+        dissipated(p);
         if let Some(record) = record {
             record[n] = recorded;
         }
         acc_u[n - 1] = acc_u[n - 1].zip(f, |a, f| a - f);
     }
+    if Lo::DISSIPATES {
+        losses.contacts_dissipated(power);
+    }
 }
 
 /// The forces of the bond between the window's sites `i − 1` and `i` (`u_w`: the window's
-/// positions, starting at site `lo`): its recorded and its net force.
+/// positions, starting at site `lo`): its recorded and its net force, and its dashpot's power.
 #[inline(always)]
 fn inner_bond<L: Law, V: Width>(
     law: &L,
     losses: &mut impl Losses<V>,
     u_w: &[V],
     (lo, i): (usize, usize),
-) -> (V, V) {
+) -> (V, V, V) {
     let r = u_w[i - 1].zip(u_w[i], |l, r| l - r);
     losses.bond(law, lo + i, r, (Some(lo + i - 1), Some(lo + i)))
 }

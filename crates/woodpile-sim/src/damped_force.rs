@@ -178,6 +178,8 @@ struct Dissipating<'a> {
 }
 
 impl Losses<f64> for Dissipating<'_> {
+    const DISSIPATES: bool = true;
+
     #[inline(always)]
     fn bond<L: Law>(
         &mut self,
@@ -185,15 +187,19 @@ impl Losses<f64> for Dissipating<'_> {
         bond: usize,
         r: f64,
         (left, right): (Option<usize>, Option<usize>),
-    ) -> (f64, f64) {
+    ) -> (f64, f64, f64) {
         let at = |site: Option<usize>| site.map_or(0.0, |i| self.velocities.0[i]);
         let rate = at(left) - at(right);
         let (force, dashpot_power) = law.damped(self.damping, bond, r, rate);
         if let Some(record) = self.power_record.as_deref_mut() {
             record[bond] = dashpot_power;
         }
-        self.power += dashpot_power;
-        (force.total, force.total - force.rest)
+        (force.total, force.total - force.rest, dashpot_power)
+    }
+
+    #[inline(always)]
+    fn contacts_dissipated(&mut self, power: f64) {
+        self.power += power;
     }
 
     fn soft_end(&mut self, (spring, damping): (f64, f64), site: usize, u: f64) -> f64 {
