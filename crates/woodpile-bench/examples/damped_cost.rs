@@ -13,7 +13,7 @@
 
 use std::time::Instant;
 use woodpile_bench::independent::reference;
-use woodpile_bench::standard_scene_with;
+use woodpile_bench::{standard_scene_with, standard_scene_with_dashpot};
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::simulation::{simulate, Outcome, Scenario};
 use woodpile_sim::testing::tolerance;
@@ -49,11 +49,11 @@ fn main() {
         ),
         (
             "[damping] contact = 0.05, hertzian",
-            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"hertzian\""),
+            standard_scene_with_dashpot("hertzian"),
         ),
         (
             "[damping] contact = 0.05, linear",
-            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"linear\""),
+            standard_scene_with_dashpot("linear"),
         ),
     ];
     println!("| scene | method | ms (median of 5) | against undamped | evaluations | error against the independent reference |");

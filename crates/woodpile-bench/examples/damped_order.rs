@@ -13,7 +13,7 @@
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 
 use woodpile_bench::independent::reference;
-use woodpile_bench::standard_scene_with;
+use woodpile_bench::{standard_scene_with, standard_scene_with_dashpot};
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::{fixed_dt, run_fixed_step, Rk6Contact};
@@ -28,11 +28,11 @@ fn main() {
         ("undamped", standard_scene_with("", "")),
         (
             "contact = 0.05, hertzian",
-            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"hertzian\""),
+            standard_scene_with_dashpot("hertzian"),
         ),
         (
             "contact = 0.05, linear",
-            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"linear\""),
+            standard_scene_with_dashpot("linear"),
         ),
     ];
     println!("| scene | dt | `rk4-contact` error | evaluations | RK6 with the same events: error | evaluations |");

@@ -11,7 +11,7 @@
 //! ```
 #![allow(clippy::print_stdout, clippy::unwrap_used)]
 use woodpile_bench::independent::reference;
-use woodpile_bench::standard_scene_with;
+use woodpile_bench::{standard_scene_with, standard_scene_with_dashpot};
 use woodpile_sim::integrate::{Method, MethodChoice};
 use woodpile_sim::simulation::{simulate, Scenario};
 use woodpile_sim::testing::fixed_dt;
@@ -30,14 +30,8 @@ fn main() {
     );
     let rows = [
         ("undamped", standard_scene_with("", "")),
-        (
-            "hertzian",
-            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"hertzian\""),
-        ),
-        (
-            "linear",
-            standard_scene_with("", "[damping]\ncontact = 0.05\nlaw = \"linear\""),
-        ),
+        ("hertzian", standard_scene_with_dashpot("hertzian")),
+        ("linear", standard_scene_with_dashpot("linear")),
     ];
     println!("| scene | dt | largest error | R | T | E_tr | D | drift | evaluations | ms |");
     println!("|---|---|---|---|---|---|---|---|---|---|");

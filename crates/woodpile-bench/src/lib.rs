@@ -33,6 +33,12 @@ pub fn standard_scene_with(defect: &str, tail: &str) -> Scenario {
     }
 }
 
+/// The standard scene with a dashpot of 0.05 on every contact, of law `law` (`"hertzian"` or
+/// `"linear"`): the damped measurements' contact-dashpot rows.
+pub fn standard_scene_with_dashpot(law: &str) -> Scenario {
+    standard_scene_with("", &format!("[damping]\ncontact = 0.05\nlaw = \"{law}\""))
+}
+
 /// The standard scene by a named fixed-step method at step `dt`.
 pub fn fixed(method: Method, dt: f64) -> Scenario {
     standard_scene(MethodChoice::Named(method), fixed_dt(dt))
