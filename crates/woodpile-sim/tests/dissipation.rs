@@ -210,9 +210,9 @@ fn d_rises_and_the_ledger_closes_at_a_tight_tolerance() {
 
 /// `rk4-contact` on a chain with every kind of damping, against itself at a far finer step:
 /// order about 2.2 with a linear contact dashpot and 1.75 with a Hertzian one, and within
-/// 1.5e-9 at dt = 0.005. Before contacts that open inside their dashpot's clip were corrected
-/// (`ContactEvents::add_crossings`), the errors were 22 (linear) to 1.2 times larger at that
-/// step: 8.3e-9 and 1.7e-9 (docs/methods.md, "The onset of a dashpot").
+/// 1.5e-9 at dt = 0.005. Without the correction of contacts that open inside their dashpot's
+/// clip (`ContactEvents::add_crossings`) the errors at that step were 22 (linear) and 1.2
+/// times larger: 8.3e-9 and 1.65e-9 (docs/methods.md, "The onset of a dashpot").
 #[test]
 fn rk4_contact_converges_on_a_damped_chain() {
     for (law, least_order) in [(DashpotLaw::Linear, 2.1), (DashpotLaw::Hertzian, 1.6)] {

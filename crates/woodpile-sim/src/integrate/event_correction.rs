@@ -21,15 +21,16 @@ use crate::model::{Model, Window};
 /// Extra passes of a dissipative chain's corrections ([`ContactEvents::refine`]).
 const REFINE_PASSES: usize = 2;
 
-/// Steps after a located force switch in which its bond is corrected along its path, whatever
-/// the scan finds ([`ContactEvents::correct_next`]). A Hertzian dashpot's force rises like
-/// √s from the onset, and RK4's quadrature of it is off by O(h^{3/2}) not only in the step
-/// that begins there but in each of the next ones (by about k^{-7/2} in the k-th). With one
-/// step, the standard scene with a Hertzian dashpot was off by 7.3e-9, 1.5e-9 and 1.5e-10 at
-/// dt = 0.0086, 0.0022 and 0.001; with four, by 2.0e-9, 1.4e-10 and 3.6e-11 (docs/methods.md,
-/// "The onset of a dashpot"). A linear dashpot's chain moves by under 10%; sixteen steps gain
-/// nothing more.
-const CARRIED_STEPS: u32 = 4;
+/// Steps after a located force switch, each the size of the step it was located in, during
+/// which its bond is corrected along its path whatever the scan finds
+/// ([`ContactEvents::correct_next`]). A Hertzian dashpot's force rises like √s from the onset,
+/// and RK4's quadrature of it is off by O(h^{3/2}) not only in the step that begins there but
+/// in each of the next ones (by about k^{-7/2} in the k-th). With the contacts that open in
+/// their clip corrected ([`ContactEvents::add_crossings`]) and one step carried, the standard
+/// scene with a Hertzian dashpot was off by 7.3e-9, 1.5e-9 and 1.5e-10 at dt = 0.0086, 0.0022
+/// and 0.001; with four, by 2.0e-9, 1.4e-10 and 3.6e-11 (docs/methods.md, "The onset of a
+/// dashpot"). A linear dashpot's chain moves by under 10%; sixteen steps gain nothing more.
+const CARRIED_STEPS: f64 = 4.0;
 
 /// What a contact-event method keeps per step: every bond force of its `S` stages (indexing
 /// of [`Model::accelerations_recording`]) and the corrections found, applied after the scan so
@@ -49,11 +50,13 @@ pub(crate) struct ContactEvents<const S: usize> {
     corrected: Vec<(usize, f64)>,
     /// Bonds corrected so far.
     events: u64,
-    /// Scratch: the bonds that changed contact in this step.
+    /// Scratch: the bonds this step corrects: those that changed contact, and on a chain with
+    /// a contact dashpot those carried from a switch and those whose overlap changed sign.
     changed: Vec<Bond>,
-    /// Bonds the next steps correct whatever their scan finds, and in how many steps more
-    /// ([`ContactEvents::correct_next`]).
-    carried: Vec<(Bond, u32)>,
+    /// Bonds the next steps correct whatever their scan finds, and for how much longer
+    /// ([`ContactEvents::correct_next`]): time, not a count of calls, since a located step
+    /// corrects each of its parts.
+    carried: Vec<(Bond, f64)>,
 }
 
 impl<const S: usize> ContactEvents<S> {
@@ -131,8 +134,10 @@ impl<const S: usize> ContactEvents<S> {
 
     /// Replaces the method's quadrature by the path integral for every bond of `window` whose
     /// contact opened or closed during the step of size `h` between `states` (the end not yet
-    /// corrected, and corrected here). Bonds at the host of an `exact` resonator are corrected
-    /// along its fast mode too ([`bond_correction`]).
+    /// corrected, and corrected here), and on a chain with a contact dashpot every bond carried
+    /// from a switch ([`ContactEvents::correct_next`]) or whose overlap changed sign
+    /// ([`ContactEvents::add_crossings`]). Bonds at the host of an `exact` resonator are
+    /// corrected along its fast mode too ([`bond_correction`]).
     pub(super) fn correct(
         &mut self,
         model: &Model,
@@ -145,7 +150,7 @@ impl<const S: usize> ContactEvents<S> {
         self.scan(model, &end[..n], window);
         let begun = Phase::of(start, n);
         if model.damping().is_some_and(|d| d.has_contact_dashpot()) {
-            self.take_carried();
+            self.take_carried(h);
             let states = StepStates {
                 start,
                 end: &end[..],
@@ -313,27 +318,32 @@ impl<const S: usize> ContactEvents<S> {
         first
     }
 
-    /// Makes the next [`CARRIED_STEPS`] steps correct `bond` (as [`ContactEvents::first_switch`]
-    /// gives it) whether or not the scan finds it changed: steps that begin just after the
-    /// bond's force switched, whose force is not smooth near their start.
-    pub(crate) fn correct_next(&mut self, bond: Bond) {
+    /// Makes the steps of the next [`CARRIED_STEPS`] × `h` correct `bond` (as
+    /// [`ContactEvents::first_switch`] gives it, located in a step of size `h`) whether or not
+    /// their scan finds it changed: steps that begin just after the bond's force switched,
+    /// whose force is not smooth near their start.
+    pub(crate) fn correct_next(&mut self, bond: Bond, h: f64) {
         self.carried.retain(|&(b, _)| b != bond);
-        self.carried.push((bond, CARRIED_STEPS));
+        // Half a step short, so that rounding in the countdown neither adds a fifth step nor
+        // drops the fourth.
+        self.carried.push((bond, (CARRIED_STEPS - 0.5) * h));
     }
 
-    /// Adds the carried bonds to this step's changed ones, each with one step fewer to go.
-    fn take_carried(&mut self) {
+    /// Adds the carried bonds to the changed ones of this step (or part of a step) of size `h`,
+    /// each with `h` less to go.
+    fn take_carried(&mut self, h: f64) {
         for (bond, left) in &mut self.carried {
-            *left -= 1;
+            *left -= h;
             if !self.changed.contains(bond) {
                 self.changed.push(*bond);
             }
         }
-        self.carried.retain(|&(_, left)| left > 0);
+        self.carried.retain(|&(_, left)| left > 0.0);
     }
 
     /// Adds to this step's changed bonds every bond of `window` whose overlap changed sign
-    /// between `states` that the scan missed: a contact that opens while its dashpot's clip holds
+    /// between `states` (c = 0 counting as open) that the scan missed, as a contact that opens
+    /// while its dashpot's clip holds
     /// its force at zero. Its recorded forces are all zero, so the scan sees nothing, but it
     /// still dissipates (−c^{3/2} ċ until it opens, a power with a kink there): left to RK4's
     /// quadrature, that kink put an error of O(h^{5/2}) into D at every opening, ten to a

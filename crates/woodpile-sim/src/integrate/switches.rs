@@ -4,8 +4,8 @@
 //! closes (linear law) and has a kink where its clip starts; a step's later stages would carry
 //! either into every stage state, which the bond's own correction cannot undo (order 2 instead
 //! of 2.5). So a step is cut LATE after its first switch, so that its last stage alone sees the
-//! new force, and the next part corrects that bond too, whose force is not smooth just behind
-//! its start.
+//! new force, and the parts and steps after it correct that bond too, whose force is not smooth
+//! just behind its start (`ContactEvents::correct_next`).
 
 use super::stage_step::{finish_step, FixedStepScratch};
 use super::{StepOutcome, StepSpan};
@@ -96,7 +96,7 @@ fn located_step<const S: usize>(
         stepper.stages(model, y, part);
         stepper.finish(model, y, part);
         if let Some(contact) = stepper.scratch().contact.as_mut() {
-            contact.correct_next(bond);
+            contact.correct_next(bond, span.h);
         }
         rest = StepSpan {
             t: rest.t + part.h,
