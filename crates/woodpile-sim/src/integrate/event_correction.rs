@@ -343,9 +343,8 @@ impl<const S: usize> ContactEvents<S> {
 
     /// Adds to this step's changed bonds every bond of `window` whose overlap changed sign
     /// between `states` (c = 0 counting as open) that the scan missed, as a contact that opens
-    /// while its dashpot's clip holds
-    /// its force at zero. Its recorded forces are all zero, so the scan sees nothing, but it
-    /// still dissipates (−c^{3/2} ċ until it opens, a power with a kink there): left to RK4's
+    /// while its dashpot's clip holds its force at zero. Its recorded forces are all zero, so
+    /// the scan sees nothing, but it still dissipates (−c^{3/2} ċ until it opens, a power with a kink there): left to RK4's
     /// quadrature, that kink put an error of O(h^{5/2}) into D at every opening, ten to a
     /// thousand times the error of the motion (docs/methods.md, "The onset of a dashpot").
     fn add_crossings(&mut self, model: &Model, states: StepStates<'_>, window: Window) {
@@ -357,13 +356,17 @@ impl<const S: usize> ContactEvents<S> {
         let (left0, right0) = (&q0[lo..hi], &q0[lo + 1..=hi]);
         let (left1, right1) = (&q1[lo..hi], &q1[lo + 1..=hi]);
         let static_overlaps = with_law!(model.law(), |law| law.static_overlaps());
-        let mut found = Vec::new();
+        let mut add = |bond: Bond| {
+            if !self.changed.contains(&bond) {
+                self.changed.push(bond);
+            }
+        };
         for i in 0..hi - lo {
             let offset = static_overlaps.map_or(0.0, |delta| delta[lo + 1 + i]);
             let d0 = offset + (left0[i] - right0[i]);
             let d1 = offset + (left1[i] - right1[i]);
             if (d0 > 0.0) != (d1 > 0.0) {
-                found.push(Bond::inner(lo + 1 + i));
+                add(Bond::inner(lo + 1 + i));
             }
         }
         let n_sites = model.n_sites();
@@ -373,13 +376,10 @@ impl<const S: usize> ContactEvents<S> {
             (window.hi == n_sites - 1 && right_wall).then(|| Bond::right_wall(n_sites)),
         ];
         let (begun, ended) = (Phase::of(states.start, n), Phase::of(states.end, n));
-        found.extend(walls.into_iter().flatten().filter(|&wall| {
+        for wall in walls.into_iter().flatten() {
             let path = bond_path(model, wall, begun, ended);
-            (path.d0 > 0.0) != (path.d1 > 0.0)
-        }));
-        for bond in found {
-            if !self.changed.contains(&bond) {
-                self.changed.push(bond);
+            if (path.d0 > 0.0) != (path.d1 > 0.0) {
+                add(wall);
             }
         }
     }
